@@ -1,0 +1,75 @@
+//! The crate's top-level error: one variant per stage.
+
+use alloc::string::String;
+use core::fmt;
+
+use crate::nurbs::NurbsError;
+use crate::tessellate::OptionsError;
+
+/// Why a model could not be read or meshed. `Display` gives the one-line
+/// message the CLI prints and the JS binding throws.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum Error {
+    /// The input is not valid JSON or does not have the model's shape.
+    Json {
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What the parser said.
+        message: String,
+    },
+    /// A value in the model is invalid; `location` names face/loop/curve and field.
+    Model {
+        /// e.g. `face 2 surface knots[0]` or `face 0 loop 1 curve 3`.
+        location: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Invalid NURBS data at `location`.
+    Nurbs {
+        /// e.g. `face 2 surface knots[0]`.
+        location: String,
+        /// The geometric problem.
+        source: NurbsError,
+    },
+    /// An option out of range.
+    Options(OptionsError),
+    /// The input format is unknown or not supported in this build.
+    Format(String),
+    /// The mesher could not proceed on a face (loops that cross, etc.).
+    Mesh {
+        /// Face index.
+        face: usize,
+        /// What went wrong.
+        message: String,
+    },
+    /// A limit guarding memory or time was hit.
+    Limit(String),
+    /// A bug in surfmesh, not in the input.
+    Internal(String),
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Json { line, column, message } => write!(f, "JSON line {line} column {column}: {message}"),
+            Self::Model { location, message } => write!(f, "{location}: {message}"),
+            Self::Nurbs { location, source } => write!(f, "{location}: {source}"),
+            Self::Options(e) => write!(f, "{e}"),
+            Self::Format(m) => write!(f, "format: {m}"),
+            Self::Mesh { face, message } => write!(f, "face {face}: {message}"),
+            Self::Limit(m) => write!(f, "limit: {m}"),
+            Self::Internal(m) => write!(f, "internal error (a bug in surfmesh): {m}"),
+        }
+    }
+}
+
+impl core::error::Error for Error {}
+
+impl From<OptionsError> for Error {
+    fn from(e: OptionsError) -> Self {
+        Self::Options(e)
+    }
+}

@@ -1,0 +1,42 @@
+//! surfmesh: triangle meshes of trimmed NURBS surfaces within a verified tolerance.
+//!
+//! The core is `no_std` + `alloc`. Read a model ([`read_model`]), mesh it
+//! ([`mesh_model`]); every mesh comes with a [`Report`] of what was measured on
+//! it against the exact surfaces. See `ARCHITECTURE.md` for the data flow.
+#![no_std]
+#![warn(missing_docs)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+
+extern crate alloc;
+#[cfg(feature = "std")]
+extern crate std;
+
+mod error;
+mod io;
+mod math;
+mod mesh;
+mod model;
+mod nurbs;
+mod tessellate;
+#[cfg(target_arch = "wasm32")]
+mod wasm;
+
+pub use error::Error;
+pub use io::{read_json, read_model, write_glb, write_obj, write_stl, Format};
+pub use mesh::{angle_stats, edge_counts, weld_positions, AngleStats, EdgeCounts, FaceRange, Mesh, Report};
+pub use model::{Face, FaceSurface, Model, TrimLoop};
+pub use nurbs::{
+    project_to_surface, Aabb, BasisDers, CurveDerivs, KnotVector, NurbsCurve, NurbsError, NurbsSurface, Projection,
+    ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
+};
+pub use tessellate::{mesh_model, MeshOptions, MeshResult, OptionsError, Tolerance};
+
+/// Reads `bytes` in `format` and meshes the model: the one call both doors use.
+///
+/// # Errors
+/// Any reader, option or mesher error, with its location.
+pub fn mesh_bytes(bytes: &[u8], format: Format, options: &MeshOptions) -> Result<MeshResult, Error> {
+    options.validate()?;
+    let model = read_model(bytes, format)?;
+    mesh_model(&model, options)
+}

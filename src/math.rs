@@ -1,0 +1,46 @@
+//! Float functions through `libm`, so the core needs no `std`.
+
+#[inline]
+pub(crate) fn sqrt(x: f64) -> f64 {
+    libm::sqrt(x)
+}
+
+#[inline]
+pub(crate) fn sin(x: f64) -> f64 {
+    libm::sin(x)
+}
+
+#[inline]
+pub(crate) fn cos(x: f64) -> f64 {
+    libm::cos(x)
+}
+
+#[inline]
+pub(crate) fn acos(x: f64) -> f64 {
+    libm::acos(x.clamp(-1.0, 1.0))
+}
+
+#[inline]
+pub(crate) fn atan2(y: f64, x: f64) -> f64 {
+    libm::atan2(y, x)
+}
+
+#[inline]
+pub(crate) fn ceil(x: f64) -> f64 {
+    libm::ceil(x)
+}
+
+#[inline]
+pub(crate) fn floor(x: f64) -> f64 {
+    libm::floor(x)
+}
+
+/// Angle in radians between two vectors; 0 when either is zero.
+pub(crate) fn angle_between(a: glam::DVec3, b: glam::DVec3) -> f64 {
+    let la = a.length();
+    let lb = b.length();
+    if la <= 0.0 || lb <= 0.0 {
+        return 0.0;
+    }
+    atan2(a.cross(b).length(), a.dot(b))
+}

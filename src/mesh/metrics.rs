@@ -1,0 +1,163 @@
+//! Topology and shape measures of a mesh: free, crack and non-manifold edges; angles.
+
+use alloc::vec::Vec;
+use glam::DVec3;
+
+use super::{weld_positions, Mesh};
+
+/// Edge census after welding coincident vertices.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct EdgeCounts {
+    /// Edges with exactly one triangle.
+    pub boundary_edges: usize,
+    /// Boundary edges that face other boundary geometry within the sewing
+    /// distance: two borders lying on each other unconnected, or a T-junction.
+    /// An open sheet's true border is not a crack.
+    pub free_edges: usize,
+    /// Edges with more than two triangles.
+    pub nonmanifold_edges: usize,
+    /// Edges whose two triangles run the same way (orientation flips).
+    pub misoriented_edges: usize,
+}
+
+/// Counts boundary, crack and non-manifold edges after welding vertices closer
+/// than `weld_tol`; `sew_tol` is how close unconnected borders must be to count as a crack.
+pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
+    let (map, nverts) = weld_positions(&mesh.positions, weld_tol);
+    // Representative position of each welded vertex.
+    let mut pos = alloc::vec![DVec3::ZERO; nverts];
+    for (i, &m) in map.iter().enumerate() {
+        pos[m as usize] = mesh.positions[i];
+    }
+    // Directed edge counts keyed by the undirected pair.
+    let mut edges: hashbrown::HashMap<(u32, u32), (u32, u32)> = hashbrown::HashMap::new();
+    for t in mesh.indices.chunks_exact(3) {
+        let v = [map[t[0] as usize], map[t[1] as usize], map[t[2] as usize]];
+        if v[0] == v[1] || v[1] == v[2] || v[2] == v[0] {
+            continue; // collapsed by welding (pole)
+        }
+        for k in 0..3 {
+            let (a, b) = (v[k], v[(k + 1) % 3]);
+            let e = edges.entry((a.min(b), a.max(b))).or_insert((0, 0));
+            if a < b {
+                e.0 += 1;
+            } else {
+                e.1 += 1;
+            }
+        }
+    }
+    let mut out = EdgeCounts::default();
+    let mut free: Vec<(u32, u32)> = Vec::new();
+    for (&k, &(f, r)) in &edges {
+        match f + r {
+            1 => free.push(k),
+            2 => {
+                if f != 1 {
+                    out.misoriented_edges += 1;
+                }
+            }
+            _ => out.nonmanifold_edges += 1,
+        }
+    }
+    out.boundary_edges = free.len();
+    out.free_edges = count_cracks(&free, &pos, sew_tol);
+    out
+}
+
+/// A free edge is a crack when a vertex or midpoint of another free edge lies
+/// within `sew` of its quarter, half or three-quarter point.
+fn count_cracks(free: &[(u32, u32)], pos: &[DVec3], sew: f64) -> usize {
+    if free.is_empty() || !(sew > 0.0 && sew.is_finite()) {
+        return 0;
+    }
+    let inv = 1.0 / sew;
+    let key = |p: DVec3| {
+        let c = p * inv;
+        (crate::math::floor(c.x) as i64, crate::math::floor(c.y) as i64, crate::math::floor(c.z) as i64)
+    };
+    // Points of interest: free-edge vertices (tag = vertex id) and midpoints (tag = edge index).
+    #[derive(Clone, Copy)]
+    enum Tag {
+        Vertex(u32),
+        Mid(usize),
+    }
+    let mut grid: hashbrown::HashMap<(i64, i64, i64), Vec<(DVec3, Tag)>> = hashbrown::HashMap::new();
+    let mut seen = hashbrown::HashSet::new();
+    for (i, &(a, b)) in free.iter().enumerate() {
+        for v in [a, b] {
+            if seen.insert(v) {
+                let p = pos[v as usize];
+                grid.entry(key(p)).or_default().push((p, Tag::Vertex(v)));
+            }
+        }
+        let m = (pos[a as usize] + pos[b as usize]) * 0.5;
+        grid.entry(key(m)).or_default().push((m, Tag::Mid(i)));
+    }
+    let mut cracks = 0;
+    for (i, &(a, b)) in free.iter().enumerate() {
+        let (pa, pb) = (pos[a as usize], pos[b as usize]);
+        let mut hit = false;
+        'probe: for f in [0.25, 0.5, 0.75] {
+            let q = pa.lerp(pb, f);
+            let (kx, ky, kz) = key(q);
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        let Some(list) = grid.get(&(kx + dx, ky + dy, kz + dz)) else { continue };
+                        for &(p, tag) in list {
+                            let other = match tag {
+                                Tag::Vertex(v) => v != a && v != b,
+                                Tag::Mid(j) => j != i,
+                            };
+                            if other && p.distance(q) < sew {
+                                hit = true;
+                                break 'probe;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if hit {
+            cracks += 1;
+        }
+    }
+    cracks
+}
+
+/// Triangle angle distribution.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct AngleStats {
+    /// Smallest angle of any triangle, degrees.
+    pub min_deg: f64,
+    /// 1st percentile of the triangles' smallest angles, degrees.
+    pub p1_deg: f64,
+}
+
+/// Smallest and 1st-percentile triangle angles (of each triangle's smallest angle).
+/// Triangles of zero area count as 0°.
+pub fn angle_stats(mesh: &Mesh) -> AngleStats {
+    let n = mesh.triangle_count();
+    if n == 0 {
+        return AngleStats::default();
+    }
+    let mut mins: Vec<f64> = (0..n).map(|t| min_angle(mesh.triangle(t))).collect();
+    mins.sort_by(|a, b| a.total_cmp(b));
+    let p1 = mins[(n - 1) / 100];
+    AngleStats { min_deg: mins[0].to_degrees(), p1_deg: p1.to_degrees() }
+}
+
+/// Smallest interior angle of a triangle, radians.
+pub(crate) fn min_angle(t: [DVec3; 3]) -> f64 {
+    let mut m = f64::INFINITY;
+    for k in 0..3 {
+        let a = t[(k + 1) % 3] - t[k];
+        let b = t[(k + 2) % 3] - t[k];
+        let ang = crate::math::angle_between(a, b);
+        if a.length_squared() == 0.0 || b.length_squared() == 0.0 {
+            return 0.0;
+        }
+        m = m.min(ang);
+    }
+    m
+}

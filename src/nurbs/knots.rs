@@ -1,0 +1,239 @@
+//! Validated knot vectors and B-spline basis functions.
+
+use alloc::vec::Vec;
+
+use super::{NurbsError, MAX_DEGREE};
+
+/// A non-decreasing knot vector together with the degree it serves.
+///
+/// Invariants (checked by [`KnotVector::try_new`]): `1 <= degree <= MAX_DEGREE`,
+/// at least `2 * (degree + 1)` finite knots, non-decreasing, no inner multiplicity
+/// above `degree + 1`, and a non-empty parameter range `[knots[p], knots[n]]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KnotVector {
+    degree: usize,
+    knots: Vec<f64>,
+}
+
+impl KnotVector {
+    /// Builds a knot vector, checking every invariant.
+    ///
+    /// # Errors
+    /// [`NurbsError`] naming the offending knot index.
+    pub fn try_new(degree: usize, knots: Vec<f64>) -> Result<Self, NurbsError> {
+        if degree == 0 || degree > MAX_DEGREE {
+            return Err(NurbsError::BadDegree { degree });
+        }
+        let needed = 2 * (degree + 1);
+        if knots.len() < needed {
+            return Err(NurbsError::TooFewKnots { found: knots.len(), needed });
+        }
+        for (i, k) in knots.iter().enumerate() {
+            if !k.is_finite() {
+                return Err(NurbsError::NotFinite { what: "knot", index: i });
+            }
+        }
+        let mut run = 1;
+        for i in 1..knots.len() {
+            if knots[i] < knots[i - 1] {
+                return Err(NurbsError::DecreasingKnots { index: i });
+            }
+            if knots[i] == knots[i - 1] {
+                run += 1;
+                if run > degree + 1 {
+                    return Err(NurbsError::BadMultiplicity { index: i });
+                }
+            } else {
+                run = 1;
+            }
+        }
+        let n = knots.len() - degree - 1;
+        if knots[n] <= knots[degree] {
+            return Err(NurbsError::BadMultiplicity { index: n });
+        }
+        Ok(Self { degree, knots })
+    }
+
+    /// Uniform clamped knot vector for `count` control points (`count > degree`).
+    ///
+    /// # Errors
+    /// As [`KnotVector::try_new`].
+    pub fn clamped_uniform(degree: usize, count: usize) -> Result<Self, NurbsError> {
+        let mut knots = Vec::with_capacity(count + degree + 1);
+        let spans = count.saturating_sub(degree).max(1);
+        knots.extend(core::iter::repeat_n(0.0, degree + 1));
+        for i in 1..spans {
+            knots.push(i as f64 / spans as f64);
+        }
+        knots.extend(core::iter::repeat_n(1.0, degree + 1));
+        Self::try_new(degree, knots)
+    }
+
+    /// The degree the knot vector serves.
+    pub fn degree(&self) -> usize {
+        self.degree
+    }
+
+    /// The knot values.
+    pub fn knots(&self) -> &[f64] {
+        &self.knots
+    }
+
+    /// Number of control points this knot vector takes.
+    pub fn control_count(&self) -> usize {
+        self.knots.len() - self.degree - 1
+    }
+
+    /// Parameter range `[knots[p], knots[n]]`.
+    pub fn domain(&self) -> (f64, f64) {
+        (self.knots[self.degree], self.knots[self.control_count()])
+    }
+
+    /// Distinct knot values inside and at the ends of the domain, ascending.
+    pub fn breakpoints(&self) -> Vec<f64> {
+        let (a, b) = self.domain();
+        let mut out: Vec<f64> = Vec::new();
+        for &k in &self.knots {
+            if k >= a && k <= b && out.last().is_none_or(|&l| k > l) {
+                out.push(k);
+            }
+        }
+        out
+    }
+
+    /// Clamps `t` into the domain (NaN goes to the start).
+    pub fn clamp(&self, t: f64) -> f64 {
+        let (a, b) = self.domain();
+        if t.is_nan() {
+            a
+        } else {
+            t.clamp(a, b)
+        }
+    }
+
+    /// Knot span index `i` with `knots[i] <= t < knots[i+1]` (the last non-empty
+    /// span at the domain's end); `t` is clamped first. Binary search.
+    pub fn span(&self, t: f64) -> usize {
+        let p = self.degree;
+        let n = self.control_count() - 1;
+        let t = self.clamp(t);
+        if t >= self.knots[n + 1] {
+            // Last non-empty span.
+            let mut i = n;
+            while i > p && self.knots[i] >= self.knots[n + 1] {
+                i -= 1;
+            }
+            return i;
+        }
+        let (mut lo, mut hi) = (p, n + 1);
+        while hi - lo > 1 {
+            let mid = (lo + hi) / 2;
+            if t < self.knots[mid] {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        lo
+    }
+
+    /// Non-zero basis functions and their derivatives up to order `nd` at `t`.
+    ///
+    /// Writes `ders[k][j]` = k-th derivative of `N_{span-p+j}` for `k <= nd`,
+    /// `j <= p`, and returns the span (Piegl & Tiller, The NURBS Book, A2.3).
+    pub fn basis_ders(&self, t: f64, nd: usize, ders: &mut BasisDers) -> usize {
+        let p = self.degree;
+        let t = self.clamp(t);
+        let span = self.span(t);
+        let u = &self.knots;
+        let nd = nd.min(MAX_DERIV);
+        let mut ndu = [[0.0f64; MAX_DEGREE + 1]; MAX_DEGREE + 1];
+        let mut left = [0.0f64; MAX_DEGREE + 1];
+        let mut right = [0.0f64; MAX_DEGREE + 1];
+        ndu[0][0] = 1.0;
+        for j in 1..=p {
+            left[j] = t - u[span + 1 - j];
+            right[j] = u[span + j] - t;
+            let mut saved = 0.0;
+            for r in 0..j {
+                ndu[j][r] = right[r + 1] + left[j - r];
+                let temp = if ndu[j][r] != 0.0 { ndu[r][j - 1] / ndu[j][r] } else { 0.0 };
+                ndu[r][j] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            ndu[j][j] = saved;
+        }
+        for j in 0..=p {
+            ders.0[0][j] = ndu[j][p];
+        }
+        let mut a = [[0.0f64; MAX_DEGREE + 1]; 2];
+        for r in 0..=p {
+            let (mut s1, mut s2) = (0usize, 1usize);
+            a[0][0] = 1.0;
+            for k in 1..=nd {
+                let mut d = 0.0;
+                let rk = r as isize - k as isize;
+                let pk = p - k.min(p);
+                if k > p {
+                    ders.0[k][r] = 0.0;
+                    continue;
+                }
+                if rk >= 0 {
+                    let rk = rk as usize;
+                    let den = ndu[pk + 1][rk];
+                    a[s2][0] = if den != 0.0 { a[s1][0] / den } else { 0.0 };
+                    d = a[s2][0] * ndu[rk][pk];
+                }
+                let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
+                let j2 = if (r as isize - 1) <= pk as isize { k - 1 } else { p - r };
+                for j in j1..=j2 {
+                    let idx = (rk + j as isize) as usize;
+                    let den = ndu[pk + 1][idx];
+                    a[s2][j] = if den != 0.0 { (a[s1][j] - a[s1][j - 1]) / den } else { 0.0 };
+                    d += a[s2][j] * ndu[idx][pk];
+                }
+                if r <= pk {
+                    let den = ndu[pk + 1][r];
+                    a[s2][k] = if den != 0.0 { -a[s1][k - 1] / den } else { 0.0 };
+                    d += a[s2][k] * ndu[r][pk];
+                }
+                ders.0[k][r] = d;
+                core::mem::swap(&mut s1, &mut s2);
+            }
+        }
+        let mut factor = p as f64;
+        for k in 1..=nd {
+            for j in 0..=p {
+                ders.0[k][j] *= factor;
+            }
+            factor *= (p as f64) - k as f64;
+        }
+        span
+    }
+
+    /// Inserts knot `t` once (no validation of multiplicity beyond the degree);
+    /// used by curve and surface knot insertion.
+    pub(crate) fn with_inserted(&self, span: usize, t: f64) -> Self {
+        let mut knots = self.knots.clone();
+        knots.insert(span + 1, t);
+        Self { degree: self.degree, knots }
+    }
+
+    /// Multiplicity of the value `t` in the knot vector.
+    pub fn multiplicity(&self, t: f64) -> usize {
+        self.knots.iter().filter(|&&k| k == t).count()
+    }
+}
+
+/// Highest derivative order computed by [`KnotVector::basis_ders`].
+pub const MAX_DERIV: usize = 2;
+
+/// Scratch for basis functions: `[order][j]`.
+#[derive(Debug, Clone)]
+pub struct BasisDers(pub [[f64; MAX_DEGREE + 1]; MAX_DERIV + 1]);
+
+impl Default for BasisDers {
+    fn default() -> Self {
+        Self([[0.0; MAX_DEGREE + 1]; MAX_DERIV + 1])
+    }
+}

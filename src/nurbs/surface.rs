@@ -1,0 +1,242 @@
+//! Rational B-spline surfaces with derivatives up to second order.
+
+use alloc::vec::Vec;
+use glam::{DVec2, DVec3, DVec4};
+
+use super::knots::{BasisDers, KnotVector};
+use super::{Aabb, NurbsError, Surface, SurfaceDerivs};
+
+/// A (possibly rational) tensor-product B-spline surface.
+///
+/// Control points are stored homogeneous, row-major: index `i * count_v + j`,
+/// `i` along u, `j` along v.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NurbsSurface {
+    ku: KnotVector,
+    kv: KnotVector,
+    points: Vec<DVec4>,
+    rational: bool,
+}
+
+impl NurbsSurface {
+    /// Builds a surface from a grid of Euclidean points (`points[i][j]`, i along u)
+    /// and optional weights of the same shape.
+    ///
+    /// # Errors
+    /// Bad knot vectors (named `"u"`/`"v"` by the caller), shape mismatch,
+    /// non-finite values, non-positive weights.
+    pub fn try_new(
+        degree: [usize; 2],
+        knots_u: Vec<f64>,
+        knots_v: Vec<f64>,
+        points: &[Vec<DVec3>],
+        weights: Option<&[Vec<f64>]>,
+    ) -> Result<Self, NurbsError> {
+        let ku = KnotVector::try_new(degree[0], knots_u)?;
+        let kv = KnotVector::try_new(degree[1], knots_v)?;
+        Self::from_parts(ku, kv, points, weights)
+    }
+
+    /// As [`NurbsSurface::try_new`] with validated knot vectors.
+    ///
+    /// # Errors
+    /// Shape mismatch, non-finite values, non-positive weights.
+    pub fn from_parts(
+        ku: KnotVector,
+        kv: KnotVector,
+        points: &[Vec<DVec3>],
+        weights: Option<&[Vec<f64>]>,
+    ) -> Result<Self, NurbsError> {
+        let (nu, nv) = (ku.control_count(), kv.control_count());
+        if points.len() != nu {
+            return Err(NurbsError::CountMismatch { what: "control point rows (along u)".into(), found: points.len(), expected: nu });
+        }
+        if let Some(w) = weights {
+            if w.len() != nu {
+                return Err(NurbsError::CountMismatch { what: "weight rows (along u)".into(), found: w.len(), expected: nu });
+            }
+        }
+        let mut hp = Vec::with_capacity(nu * nv);
+        for (i, row) in points.iter().enumerate() {
+            if row.len() != nv {
+                return Err(NurbsError::CountMismatch {
+                    what: alloc::format!("control points in row {i} (along v)"),
+                    found: row.len(),
+                    expected: nv,
+                });
+            }
+            let wrow = weights.map(|w| &w[i]);
+            if let Some(wr) = wrow {
+                if wr.len() != nv {
+                    return Err(NurbsError::CountMismatch {
+                        what: alloc::format!("weights in row {i} (along v)"),
+                        found: wr.len(),
+                        expected: nv,
+                    });
+                }
+            }
+            for (j, p) in row.iter().enumerate() {
+                let index = i * nv + j;
+                if !p.is_finite() {
+                    return Err(NurbsError::NotFinite { what: "point", index });
+                }
+                let w = wrow.map_or(1.0, |wr| wr[j]);
+                if !w.is_finite() {
+                    return Err(NurbsError::NotFinite { what: "weight", index });
+                }
+                if w <= 0.0 {
+                    return Err(NurbsError::BadWeight { index, found: w });
+                }
+                hp.push((*p * w).extend(w));
+            }
+        }
+        Ok(Self { ku, kv, points: hp, rational: weights.is_some() })
+    }
+
+    /// Knot vector along u.
+    pub fn knots_u(&self) -> &KnotVector {
+        &self.ku
+    }
+
+    /// Knot vector along v.
+    pub fn knots_v(&self) -> &KnotVector {
+        &self.kv
+    }
+
+    /// Degrees `[p, q]`.
+    pub fn degree(&self) -> [usize; 2] {
+        [self.ku.degree(), self.kv.degree()]
+    }
+
+    /// Control point counts `[along u, along v]`.
+    pub fn counts(&self) -> [usize; 2] {
+        [self.ku.control_count(), self.kv.control_count()]
+    }
+
+    /// Whether weights were given.
+    pub fn is_rational(&self) -> bool {
+        self.rational
+    }
+
+    /// Homogeneous control point `(i, j)`.
+    pub fn homogeneous(&self, i: usize, j: usize) -> DVec4 {
+        self.points[i * self.kv.control_count() + j]
+    }
+
+    /// Euclidean control points, row-major.
+    pub fn control_points(&self) -> impl Iterator<Item = DVec3> + '_ {
+        self.points.iter().map(|h| h.truncate() / h.w)
+    }
+
+    /// Box around the control net (contains the surface).
+    pub fn bbox(&self) -> Aabb {
+        Aabb::from_points(self.control_points())
+    }
+
+    /// Homogeneous derivatives `A^{(k,l)}` for `k + l <= order` (order ≤ 2).
+    fn homogeneous_derivs(&self, uv: DVec2, order: usize) -> [[DVec4; 3]; 3] {
+        let mut bu = BasisDers::default();
+        let mut bv = BasisDers::default();
+        let su = self.ku.basis_ders(uv.x, order, &mut bu);
+        let sv = self.kv.basis_ders(uv.y, order, &mut bv);
+        let (p, q) = (self.ku.degree(), self.kv.degree());
+        let nv = self.kv.control_count();
+        let mut out = [[DVec4::ZERO; 3]; 3];
+        let mut temp = [DVec4::ZERO; super::MAX_DEGREE + 1];
+        for k in 0..=order {
+            for (s, t) in temp.iter_mut().enumerate().take(q + 1) {
+                let mut acc = DVec4::ZERO;
+                for r in 0..=p {
+                    acc += self.points[(su - p + r) * nv + sv - q + s] * bu.0[k][r];
+                }
+                *t = acc;
+            }
+            for l in 0..=(order - k) {
+                let mut acc = DVec4::ZERO;
+                for (s, t) in temp.iter().enumerate().take(q + 1) {
+                    acc += *t * bv.0[l][s];
+                }
+                out[k][l] = acc;
+            }
+        }
+        out
+    }
+
+    /// Inserts knot `t` once along u (`along_u`) or v; same shape.
+    pub fn insert_knot(&self, along_u: bool, t: f64) -> Self {
+        let (nu, nv) = (self.ku.control_count(), self.kv.control_count());
+        let kv = if along_u { &self.ku } else { &self.kv };
+        let (a, b) = kv.domain();
+        let p = kv.degree();
+        if !(t > a && t < b) || kv.multiplicity(t) >= p {
+            return self.clone();
+        }
+        let span = kv.span(t);
+        let u = kv.knots();
+        let alphas: Vec<f64> = (span - p + 1..=span)
+            .map(|i| {
+                let den = u[i + p] - u[i];
+                if den > 0.0 { (t - u[i]) / den } else { 0.0 }
+            })
+            .collect();
+        let refine = |line: &[DVec4]| -> Vec<DVec4> {
+            let mut out = Vec::with_capacity(line.len() + 1);
+            out.extend_from_slice(&line[..=span - p]);
+            for (k, i) in (span - p + 1..=span).enumerate() {
+                out.push(line[i] * alphas[k] + line[i - 1] * (1.0 - alphas[k]));
+            }
+            out.extend_from_slice(&line[span..]);
+            out
+        };
+        let new_knots = kv.with_inserted(span, t);
+        if along_u {
+            let mut pts = alloc::vec![DVec4::ZERO; (nu + 1) * nv];
+            for j in 0..nv {
+                let col: Vec<DVec4> = (0..nu).map(|i| self.points[i * nv + j]).collect();
+                for (i, x) in refine(&col).into_iter().enumerate() {
+                    pts[i * nv + j] = x;
+                }
+            }
+            Self { ku: new_knots, kv: self.kv.clone(), points: pts, rational: self.rational }
+        } else {
+            let mut pts = Vec::with_capacity(nu * (nv + 1));
+            for i in 0..nu {
+                pts.extend(refine(&self.points[i * nv..(i + 1) * nv]));
+            }
+            Self { ku: self.ku.clone(), kv: new_knots, points: pts, rational: self.rational }
+        }
+    }
+}
+
+impl Surface for NurbsSurface {
+    fn domain(&self) -> [DVec2; 2] {
+        let (u0, u1) = self.ku.domain();
+        let (v0, v1) = self.kv.domain();
+        [DVec2::new(u0, v0), DVec2::new(u1, v1)]
+    }
+
+    fn point(&self, uv: DVec2) -> DVec3 {
+        let a = self.homogeneous_derivs(uv, 0)[0][0];
+        a.truncate() / a.w
+    }
+
+    fn derivs(&self, uv: DVec2) -> SurfaceDerivs {
+        let a = self.homogeneous_derivs(uv, 2);
+        let w = a[0][0].w;
+        let s = a[0][0].truncate() / w;
+        let su = (a[1][0].truncate() - s * a[1][0].w) / w;
+        let sv = (a[0][1].truncate() - s * a[0][1].w) / w;
+        let suu = (a[2][0].truncate() - su * (2.0 * a[1][0].w) - s * a[2][0].w) / w;
+        let svv = (a[0][2].truncate() - sv * (2.0 * a[0][1].w) - s * a[0][2].w) / w;
+        let suv = (a[1][1].truncate() - su * a[0][1].w - sv * a[1][0].w - s * a[1][1].w) / w;
+        SurfaceDerivs { point: s, su, sv, suu, suv, svv }
+    }
+
+    fn breaks(&self, along_u: bool) -> Vec<f64> {
+        if along_u { self.ku.breakpoints() } else { self.kv.breakpoints() }
+    }
+
+    fn bounding_box(&self) -> Aabb {
+        self.bbox()
+    }
+}

@@ -1,0 +1,151 @@
+//! Meshing options: plain struct, documented defaults, validated at every entry.
+
+use core::fmt;
+
+/// How the chordal tolerance is given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tolerance {
+    /// Model units.
+    Absolute(f64),
+    /// Fraction of the model's bounding-box diagonal (of the trimmed geometry).
+    Relative(f64),
+}
+
+/// Options for [`crate::mesh_model`].
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct MeshOptions {
+    /// Largest allowed distance between mesh and exact surface.
+    /// Default: relative 1e-3.
+    pub tolerance: Tolerance,
+    /// Largest normal turn across one triangle and one boundary segment, radians.
+    /// Default 0.5 (OCCT's usual angular deflection).
+    pub angle: f64,
+    /// Longest triangle edge allowed, model units. Default: none.
+    pub max_edge: Option<f64>,
+    /// Edges at or below this length are never split, model units. Default:
+    /// 1e-3 × the absolute tolerance (guards singular points against endless refinement).
+    pub min_edge: Option<f64>,
+    /// Refinement stops (with a warning) once the whole mesh holds this many triangles.
+    /// Default 4,000,000: bounds memory in a browser tab.
+    pub max_triangles: usize,
+    /// Samples per triangle edge used to verify deviation (≥ 2). Default 4:
+    /// vertices, edge points and interior points of a 4-step barycentric grid.
+    pub measure_steps: usize,
+    /// Fraction of the tolerance refinement aims at, so that what lies between
+    /// verification samples stays within the tolerance too. Default 0.8.
+    pub safety: f64,
+}
+
+impl Default for MeshOptions {
+    fn default() -> Self {
+        Self {
+            tolerance: Tolerance::Relative(1e-3),
+            angle: 0.5,
+            max_edge: None,
+            min_edge: None,
+            max_triangles: 4_000_000,
+            measure_steps: 4,
+            safety: 0.8,
+        }
+    }
+}
+
+/// A rejected option value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OptionsError {
+    /// Option name as the CLI spells it.
+    pub option: &'static str,
+    /// What is wrong.
+    pub message: &'static str,
+}
+
+impl fmt::Display for OptionsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "option {}: {}", self.option, self.message)
+    }
+}
+
+impl core::error::Error for OptionsError {}
+
+impl MeshOptions {
+    /// Sets an absolute chordal tolerance.
+    pub fn with_tolerance(mut self, tol: f64) -> Self {
+        self.tolerance = Tolerance::Absolute(tol);
+        self
+    }
+
+    /// Sets a chordal tolerance relative to the model diagonal.
+    pub fn with_relative_tolerance(mut self, rel: f64) -> Self {
+        self.tolerance = Tolerance::Relative(rel);
+        self
+    }
+
+    /// Sets the angle limit (radians).
+    pub fn with_angle(mut self, angle: f64) -> Self {
+        self.angle = angle;
+        self
+    }
+
+    /// Sets the longest edge allowed.
+    pub fn with_max_edge(mut self, max_edge: Option<f64>) -> Self {
+        self.max_edge = max_edge;
+        self
+    }
+
+    /// Sets the shortest edge that may still be split.
+    pub fn with_min_edge(mut self, min_edge: Option<f64>) -> Self {
+        self.min_edge = min_edge;
+        self
+    }
+
+    /// Sets the triangle budget.
+    pub fn with_max_triangles(mut self, n: usize) -> Self {
+        self.max_triangles = n;
+        self
+    }
+
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// The first field out of range.
+    pub fn validate(&self) -> Result<(), OptionsError> {
+        match self.tolerance {
+            Tolerance::Absolute(t) if !(t.is_finite() && t > 0.0) => {
+                return Err(OptionsError { option: "--tol", message: "must be a finite number > 0" })
+            }
+            Tolerance::Relative(t) if !(t.is_finite() && t > 0.0 && t <= 1.0) => {
+                return Err(OptionsError { option: "--tol-rel", message: "must be in (0, 1]" })
+            }
+            _ => {}
+        }
+        if !(self.angle.is_finite() && self.angle > 0.0 && self.angle <= core::f64::consts::PI) {
+            return Err(OptionsError { option: "--angle", message: "must be in (0, pi] radians" });
+        }
+        if let Some(m) = self.max_edge {
+            if !(m.is_finite() && m > 0.0) {
+                return Err(OptionsError { option: "--max-edge", message: "must be a finite number > 0" });
+            }
+        }
+        if let Some(m) = self.min_edge {
+            if !(m.is_finite() && m >= 0.0) {
+                return Err(OptionsError { option: "--min-edge", message: "must be a finite number >= 0" });
+            }
+            if let Some(x) = self.max_edge {
+                if m >= x {
+                    return Err(OptionsError { option: "--min-edge", message: "must be below --max-edge" });
+                }
+            }
+        }
+        if self.max_triangles < 2 {
+            return Err(OptionsError { option: "--max-triangles", message: "must be at least 2" });
+        }
+        if !(2..=16).contains(&self.measure_steps) {
+            return Err(OptionsError { option: "measure_steps", message: "must be in 2..=16" });
+        }
+        if !(self.safety.is_finite() && self.safety > 0.1 && self.safety <= 1.0) {
+            return Err(OptionsError { option: "safety", message: "must be in (0.1, 1]" });
+        }
+        Ok(())
+    }
+}
