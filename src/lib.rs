@@ -18,7 +18,7 @@ mod mesh;
 mod model;
 mod nurbs;
 mod tessellate;
-#[cfg(target_arch = "wasm32")]
+#[cfg(all(target_arch = "wasm32", target_os = "unknown"))]
 mod wasm;
 
 pub use error::Error;

@@ -1,0 +1,6 @@
+//! Native integration tests, one binary.
+
+mod cli;
+mod mesh;
+mod nurbs;
+mod shapes;

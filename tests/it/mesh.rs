@@ -1,0 +1,1 @@
+//! Tests: mesh (to be written).

@@ -1,0 +1,1 @@
+//! Tests: nurbs (to be written).

@@ -1,0 +1,1 @@
+//! Test shapes (to be written).
