@@ -1,6 +1,149 @@
-//! The `surfmesh` command line.
+//! The `surfmesh` command line: reads a model, meshes it, writes the mesh
+//! (STL, OBJ or glTF) and a JSON report. A thin door: all geometry is in the library.
 
-fn main() {
-    eprintln!("surfmesh: not written yet");
-    std::process::exit(2);
+#[path = "surfmesh/args.rs"]
+mod args;
+
+use std::ffi::OsString;
+use std::fs;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use args::{Command, MeshArgs, OutputFormat};
+use surfmesh::{mesh_model, read_model, write_glb, write_obj, write_stl, Error, Format};
+
+fn main() -> ExitCode {
+    match args::parse(std::env::args_os().skip(1).collect()) {
+        Ok(Command::Help) => {
+            print!("{}", args::USAGE);
+            ExitCode::SUCCESS
+        }
+        Ok(Command::Version) => {
+            println!("surfmesh {}", env!("CARGO_PKG_VERSION"));
+            ExitCode::SUCCESS
+        }
+        Ok(Command::Mesh(m)) => match mesh(&m) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(message) => {
+                eprintln!("surfmesh: {}: {}", m.input.display(), one_line(&message));
+                ExitCode::from(1)
+            }
+        },
+        Err(message) => {
+            eprintln!("surfmesh: {}", one_line(&message));
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// The error contract is one line on stderr; flatten any line breaks a message carries.
+fn one_line(message: &str) -> String {
+    message.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// `surfmesh mesh`: everything after the arguments; the error is the message
+/// printed after the input file's name.
+fn mesh(m: &MeshArgs) -> Result<(), String> {
+    let bytes = fs::read(&m.input).map_err(|e| format!("cannot read: {e}"))?;
+    let format = match m.format {
+        Some(f) => f,
+        None => input_format(&m.input, &bytes)?,
+    };
+
+    let start = Instant::now();
+    let model = read_model(&bytes, format).map_err(|e| e.to_string())?;
+    let parse_ms = millis(start);
+    let start = Instant::now();
+    let mut result = mesh_model(&model, &m.options).map_err(|e| e.to_string())?;
+    let report = &mut result.report;
+    report.time_ms = millis(start);
+    report.parse_ms = parse_ms;
+    // Reader warnings first, unless the mesher already copied them.
+    let missing: Vec<String> = model.warnings.iter().filter(|w| !report.warnings.contains(w)).cloned().collect();
+    report.warnings.splice(0..0, missing);
+
+    let report_json = serde_json::to_string_pretty(&result.report)
+        .map_err(|e| Error::Internal(format!("report: {e}")).to_string())?;
+    let mut files: Vec<(&Path, Vec<u8>)> = Vec::new();
+    if let Some((path, kind)) = &m.output {
+        let bytes = match kind {
+            OutputFormat::Stl => write_stl(&result.mesh),
+            OutputFormat::Obj => write_obj(&result.mesh),
+            OutputFormat::Glb => write_glb(&result.mesh),
+        };
+        files.push((path, bytes));
+    }
+    if let Some(path) = &m.report {
+        files.push((path, format!("{report_json}\n").into_bytes()));
+    }
+    write_all_or_nothing(&files)?;
+    if files.is_empty() {
+        println!("{report_json}");
+    }
+
+    let r = &result.report;
+    let verdict = if r.max_deviation <= r.tolerance { "<=" } else { "EXCEEDS" };
+    eprintln!(
+        "surfmesh: {}: {} triangles, max deviation {:.3e} {verdict} tolerance {:.3e} {}, {:.1} ms (parse {:.1} ms)",
+        m.input.display(),
+        r.triangles,
+        r.max_deviation,
+        r.tolerance,
+        model.units,
+        r.time_ms,
+        r.parse_ms
+    );
+    Ok(())
+}
+
+/// Input format from the file's extension, else from its first bytes.
+fn input_format(path: &Path, bytes: &[u8]) -> Result<Format, String> {
+    let by_name = path.extension().and_then(|e| e.to_str()).and_then(|e| Format::from_name(e).ok());
+    by_name
+        .or_else(|| Format::detect(bytes))
+        .ok_or_else(|| Error::Format("cannot tell the input format; give --format json".into()).to_string())
+}
+
+fn millis(start: Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
+}
+
+/// Writes every file to a temporary name in its own directory, then renames
+/// them into place, so that a failure leaves no half-written output behind.
+fn write_all_or_nothing(files: &[(&Path, Vec<u8>)]) -> Result<(), String> {
+    let mut temps: Vec<PathBuf> = Vec::new();
+    let result = (|| {
+        for (path, bytes) in files {
+            let temp = temp_path(path);
+            temps.push(temp.clone());
+            let mut file = fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&temp)
+                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            file.write_all(bytes)
+                .and_then(|()| file.sync_all())
+                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        }
+        for ((path, _), temp) in files.iter().zip(&temps) {
+            fs::rename(temp, path).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        }
+        Ok(())
+    })();
+    if result.is_err() {
+        for temp in &temps {
+            let _ = fs::remove_file(temp);
+        }
+    }
+    result
+}
+
+/// `dir/.name.PID.tmp` next to `path`, so the final rename stays on one file system.
+fn temp_path(path: &Path) -> PathBuf {
+    let mut name = OsString::from(".");
+    name.push(path.file_name().unwrap_or_default());
+    name.push(format!(".{}.tmp", std::process::id()));
+    path.with_file_name(name)
 }

@@ -1,1 +1,510 @@
-//! Tests: cli (to be written).
+//! The JSON reader, the mesh writers and the `surfmesh` command line.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use glam::DVec3;
+use serde_json::Value;
+use surfmesh::{read_json, write_glb, write_obj, write_stl, Error, FaceRange, Mesh, NurbsError};
+
+const BIN: &str = env!("CARGO_BIN_EXE_surfmesh");
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+}
+
+fn read_data(name: &str) -> Result<surfmesh::Model, Error> {
+    read_json(&std::fs::read(data(name)).unwrap())
+}
+
+/// A fresh, empty directory for one test's output files.
+fn scratch(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("surfmesh-it-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn run(args: &[&std::ffi::OsStr]) -> Output {
+    Command::new(BIN).args(args).output().unwrap()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8(out.stderr.clone()).unwrap()
+}
+
+// ---------------------------------------------------------------- reader
+
+#[test]
+fn reader_builds_the_plane() {
+    let model = read_data("plane.json").unwrap();
+    assert_eq!(model.units, "mm");
+    assert_eq!(model.faces.len(), 1);
+    assert_eq!(model.faces[0].name.as_deref(), Some("square plate"));
+    assert!(model.faces[0].loops.is_empty());
+    let surfmesh::FaceSurface::Nurbs(s) = &model.faces[0].surface else { panic!("not a NURBS face") };
+    assert_eq!(s.degree(), [1, 1]);
+    assert_eq!(s.counts(), [2, 2]);
+    assert!(!s.is_rational());
+    // points[1][1] is the corner u = 1, v = 1.
+    use surfmesh::Surface;
+    assert!(s.point(glam::DVec2::new(1.0, 1.0)).distance(DVec3::new(10.0, 10.0, 0.0)) < 1e-12);
+    assert!(s.point(glam::DVec2::new(0.5, 0.25)).distance(DVec3::new(5.0, 2.5, 0.0)) < 1e-12);
+}
+
+#[test]
+fn reader_defaults_units_and_reads_loops_and_weights() {
+    let text = br#"{"faces": [{"surface": {"degree": [1, 1], "knots": [[0,0,2,2],[0,0,1,1]],
+        "points": [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]], "weights": [[1,2],[1,1]]},
+        "loops": [{"curves": [
+          {"degree": 1, "knots": [0,0,1,1], "points": [[0.5,0.2],[1.5,0.2]]},
+          {"degree": 2, "knots": [0,0,0,1,1,1], "points": [[1.5,0.2],[1.5,0.8],[0.5,0.2]], "weights": [1,0.5,1]}
+        ]}]}]}"#;
+    let model = read_json(text).unwrap();
+    assert_eq!(model.units, "mm");
+    let face = &model.faces[0];
+    let surfmesh::FaceSurface::Nurbs(s) = &face.surface else { panic!("not a NURBS face") };
+    assert!(s.is_rational());
+    assert_eq!(face.loops.len(), 1);
+    let curves = &face.loops[0].curves;
+    assert_eq!(curves.len(), 2);
+    assert_eq!(curves[1].degree(), 2);
+    assert!(curves[1].is_rational());
+    let end = curves[1].point(curves[1].domain().1);
+    assert!(end.distance(DVec3::new(0.5, 0.2, 0.0)) < 1e-12, "{end}");
+}
+
+fn location(e: &Error) -> &str {
+    match e {
+        Error::Model { location, .. } | Error::Nurbs { location, .. } => location,
+        other => panic!("expected a located error, got {other:?}"),
+    }
+}
+
+#[test]
+fn reader_reports_malformed_json_with_line_and_column() {
+    let err = read_data("bad_syntax.json").unwrap_err();
+    let Error::Json { line, column, message } = &err else { panic!("{err:?}") };
+    assert_eq!((*line, *column), (3, 37), "{message}");
+    assert!(!message.contains("at line"), "position repeated in {message}");
+}
+
+#[test]
+fn reader_rejects_short_knot_vector() {
+    let err = read_data("bad_knots_short.json").unwrap_err();
+    assert_eq!(location(&err), "face 0 surface knots[0]");
+    assert!(matches!(err, Error::Nurbs { source: NurbsError::TooFewKnots { found: 6, needed: 8 }, .. }));
+}
+
+#[test]
+fn reader_rejects_decreasing_knots_naming_face_and_direction() {
+    let err = read_data("bad_knots_decreasing.json").unwrap_err();
+    assert_eq!(location(&err), "face 1 surface knots[1]");
+    assert!(matches!(err, Error::Nurbs { source: NurbsError::DecreasingKnots { index: 3 }, .. }));
+}
+
+#[test]
+fn reader_rejects_zero_weight() {
+    let err = read_data("bad_weight_zero.json").unwrap_err();
+    assert_eq!(location(&err), "face 0 surface weights[1][0]");
+    assert!(matches!(err, Error::Nurbs { source: NurbsError::BadWeight { .. }, .. }));
+}
+
+#[test]
+fn reader_rejects_out_of_range_number() {
+    let err = read_data("bad_not_finite.json").unwrap_err();
+    assert!(matches!(err, Error::Json { line: 7, .. }), "{err:?}");
+}
+
+#[test]
+fn reader_rejects_open_loop_naming_the_curve() {
+    let err = read_data("bad_loop_open.json").unwrap_err();
+    assert_eq!(location(&err), "face 0 loop 0 curve 2");
+    assert!(err.to_string().contains("does not close"), "{err}");
+}
+
+#[test]
+fn reader_accepts_loop_gaps_below_the_closure_tolerance() {
+    // Parameter range 1000: gaps up to 1e-6 close the loop, larger ones do not.
+    let make = |gap: f64| {
+        format!(
+            r#"{{"faces": [{{"surface": {{"degree": [1, 1], "knots": [[0,0,1000,1000],[0,0,1,1]],
+            "points": [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]]}},
+            "loops": [{{"curves": [
+              {{"degree": 1, "knots": [0,0,1,1], "points": [[100,0.2],[900,0.2]]}},
+              {{"degree": 1, "knots": [0,0,1,1], "points": [[900,0.2],[500,0.8]]}},
+              {{"degree": 1, "knots": [0,0,1,1], "points": [[500,0.8],[{},0.2]]}}
+            ]}}]}}]}}"#,
+            100.0 + gap
+        )
+    };
+    assert!(read_json(make(0.5e-6).as_bytes()).is_ok());
+    let err = read_json(make(2e-6).as_bytes()).unwrap_err();
+    assert_eq!(location(&err), "face 0 loop 0 curve 2");
+}
+
+#[test]
+fn reader_rejects_loop_point_with_three_coordinates() {
+    let err = read_data("bad_loop_point.json").unwrap_err();
+    assert!(matches!(err, Error::Model { .. }), "{err:?}");
+    assert_eq!(location(&err), "face 0 loop 0 curve 1 points[0]");
+}
+
+#[test]
+fn reader_rejects_shape_errors() {
+    let surface = r#""surface": {"degree": [1, 1], "knots": [[0,0,1,1],[0,0,1,1]], "points": [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]]}"#;
+    let cases: Vec<(String, &str)> = vec![
+        (r#"{"faces": []}"#.into(), "faces"),
+        (r#"{"units": "mm"}"#.into(), "faces"),
+        (r#"{"faces": [{"name": "x"}]}"#.into(), "face 0"),
+        (
+            r#"{"faces": [{"surface": {"degree": [1], "knots": [[0,0,1,1]], "points": []}}]}"#.into(),
+            "face 0 surface degree",
+        ),
+        (
+            r#"{"faces": [{"surface": {"degree": [1, 1], "knots": [[0,0,1,1]], "points": []}}]}"#.into(),
+            "face 0 surface knots",
+        ),
+        (
+            r#"{"faces": [{"surface": {"degree": [1, 1], "knots": [[0,0,1,1],[0,0,1,1]], "points": [[[0,0,0],[0,1]],[[1,0,0],[1,1,0]]]}}]}"#.into(),
+            "face 0 surface points[0][1]",
+        ),
+        (
+            r#"{"faces": [{"surface": {"degree": [1, 1], "knots": [[0,0,1,1],[0,0,1,1]], "points": [[[0,0,0],[0,1,0]]]}}]}"#.into(),
+            "face 0 surface points",
+        ),
+        (
+            r#"{"faces": [{"surface": {"degree": [0, 1], "knots": [[0,1],[0,0,1,1]], "points": [[[0,0,0],[0,1,0]]]}}]}"#.into(),
+            "face 0 surface degree[0]",
+        ),
+        (
+            r#"{"faces": [{"surface": {"degree": [1, 1], "knots": [[0,0,1,1],[0,0,1,1]], "points": [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]], "weights": [[1,1]]}}]}"#.into(),
+            "face 0 surface weights",
+        ),
+        (format!(r#"{{"faces": [{{{surface}, "loops": [{{"curves": []}}]}}]}}"#), "face 0 loop 0 curves"),
+        (
+            format!(
+                r#"{{"faces": [{{{surface}}}, {{{surface}, "loops": [{{"curves": [{{"degree": 1, "knots": [0,0,1,1], "points": [[0,0]]}}]}}]}}]}}"#
+            ),
+            "face 1 loop 0 curve 0 points",
+        ),
+        (
+            format!(
+                r#"{{"faces": [{{{surface}, "loops": [{{"curves": [{{"degree": 1, "knots": [0,1,0,1], "points": [[0,0],[1,1]]}}]}}]}}]}}"#
+            ),
+            "face 0 loop 0 curve 0 knots",
+        ),
+        (
+            format!(
+                r#"{{"faces": [{{{surface}, "loops": [{{"curves": [{{"degree": 1, "knots": [0,0,1,1], "points": [[0,0],[1,1]], "weights": [1,-1]}}]}}]}}]}}"#
+            ),
+            "face 0 loop 0 curve 0 weights",
+        ),
+        (
+            r#"{"faces": [{"surface": {"degree": [1, 1], "knots": [[-1e308,-1e308,1e308,1e308],[0,0,1,1]], "points": [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]]}}]}"#.into(),
+            "face 0 surface knots",
+        ),
+    ];
+    for (text, expected) in cases {
+        let err = read_json(text.as_bytes()).unwrap_err();
+        assert_eq!(location(&err), expected, "{text}\n{err}");
+    }
+}
+
+#[test]
+fn reader_rejects_unknown_fields_and_wrong_types() {
+    for text in [
+        r#"{"faces": [], "extra": 1}"#,
+        r#"{"faces": [{"surface": {"degree": [1, 1], "knots": [], "points": [], "weigths": []}}]}"#,
+        r#"{"faces": [{"surface": {"degree": [-1, 1], "knots": [], "points": []}}]}"#,
+        r#"{"faces": {}}"#,
+        "",
+        "{} trailing",
+    ] {
+        let err = read_json(text.as_bytes()).unwrap_err();
+        assert!(matches!(err, Error::Json { line: 1, .. }), "{text}: {err:?}");
+    }
+}
+
+#[test]
+fn reader_limits_the_number_of_faces() {
+    let face = r#"{"surface": {"degree": [1, 1], "knots": [[0,0,1,1],[0,0,1,1]], "points": [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]]}}"#;
+    let text = format!(r#"{{"faces": [{}]}}"#, vec![face; 100_001].join(","));
+    let err = read_json(text.as_bytes()).unwrap_err();
+    assert!(matches!(&err, Error::Limit(m) if m.contains("100000")), "{err}");
+}
+
+#[test]
+fn reader_limits_control_points_per_surface() {
+    // 1001 × 1000 control points, one more row than the limit allows.
+    let row = format!("[{}]", vec!["[0,0,0]"; 1000].join(","));
+    let knots = |n: usize| format!("[0,{},{n}]", (0..n).map(|k| k.to_string()).collect::<Vec<_>>().join(","));
+    let text = format!(
+        r#"{{"faces": [{{"surface": {{"degree": [1, 1], "knots": [{}, {}], "points": [{}]}}}}]}}"#,
+        knots(1000),
+        knots(999),
+        vec![row.as_str(); 1001].join(",")
+    );
+    let err = read_json(text.as_bytes()).unwrap_err();
+    assert!(matches!(&err, Error::Limit(m) if m.contains("face 0") && m.contains("1000000")), "{err}");
+}
+
+// ---------------------------------------------------------------- writers
+
+/// A unit square in the z = 0 plane split into two triangles, one per face,
+/// with +z normals.
+fn square() -> Mesh {
+    Mesh {
+        positions: vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.5),
+        ],
+        normals: vec![DVec3::Z; 4],
+        indices: vec![0, 1, 2, 0, 2, 3],
+        face_ranges: vec![FaceRange { first: 0, count: 1 }, FaceRange { first: 1, count: 1 }],
+    }
+}
+
+fn f32_at(bytes: &[u8], offset: usize) -> f32 {
+    f32::from_le_bytes(bytes[offset..offset + 4].try_into().unwrap())
+}
+
+fn u32_at(bytes: &[u8], offset: usize) -> u32 {
+    u32::from_le_bytes(bytes[offset..offset + 4].try_into().unwrap())
+}
+
+#[test]
+fn stl_has_header_count_and_facets() {
+    let mesh = square();
+    let stl = write_stl(&mesh);
+    assert_eq!(stl.len(), 84 + 50 * 2);
+    assert!(!stl.starts_with(b"solid"), "binary STL must not look like ASCII STL");
+    assert_eq!(u32_at(&stl, 80), 2);
+    // First facet: normal +z, then vertices 0, 1, 2.
+    let facet: Vec<f32> = (0..12).map(|k| f32_at(&stl, 84 + 4 * k)).collect();
+    assert_eq!(facet, [0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0]);
+    assert_eq!(&stl[84 + 48..84 + 50], &[0, 0]);
+    // Second facet's normal is the unit normal of its tilted plane.
+    let n = DVec3::new(1.0, 1.0, 0.0).cross(DVec3::new(0.0, 1.0, 0.5)).normalize();
+    for k in 0..3 {
+        assert!((f64::from(f32_at(&stl, 134 + 4 * k)) - n[k]).abs() < 1e-6);
+    }
+}
+
+#[test]
+fn stl_skips_triangles_with_bad_indices() {
+    let mut mesh = square();
+    mesh.indices.extend([0, 1, 9]);
+    let stl = write_stl(&mesh);
+    assert_eq!(u32_at(&stl, 80), 2);
+    assert_eq!(stl.len(), 84 + 50 * 2);
+}
+
+#[test]
+fn obj_has_vertices_normals_faces_and_groups() {
+    let obj = String::from_utf8(write_obj(&square())).unwrap();
+    let count = |prefix: &str| obj.lines().filter(|l| l.starts_with(prefix)).count();
+    assert_eq!(count("v "), 4);
+    assert_eq!(count("vn "), 4);
+    assert_eq!(count("f "), 2);
+    assert_eq!(count("g "), 2);
+    let faces: Vec<&str> = obj.lines().filter(|l| l.starts_with("f ")).collect();
+    assert_eq!(faces, ["f 1//1 2//2 3//3", "f 1//1 3//3 4//4"]);
+    let last_v = obj.lines().filter(|l| l.starts_with("v ")).nth(3).unwrap();
+    let xyz: Vec<f64> = last_v[2..].split(' ').map(|x| x.parse().unwrap()).collect();
+    assert_eq!(xyz, [0.0, 1.0, 0.5]);
+}
+
+#[test]
+fn obj_without_normals_writes_plain_faces() {
+    let mut mesh = square();
+    mesh.normals.clear();
+    mesh.face_ranges.clear();
+    let obj = String::from_utf8(write_obj(&mesh)).unwrap();
+    assert_eq!(obj.lines().filter(|l| l.starts_with("vn")).count(), 0);
+    assert_eq!(obj.lines().filter(|l| l.starts_with("g ")).count(), 1);
+    assert!(obj.lines().any(|l| l == "f 1 3 4"));
+}
+
+/// Splits a GLB into its JSON document and BIN chunk, checking the container.
+fn open_glb(glb: &[u8]) -> (Value, Vec<u8>) {
+    assert_eq!(&glb[0..4], b"glTF");
+    assert_eq!(u32_at(glb, 4), 2);
+    assert_eq!(u32_at(glb, 8) as usize, glb.len());
+    let json_len = u32_at(glb, 12) as usize;
+    assert_eq!(&glb[16..20], b"JSON");
+    assert_eq!(json_len % 4, 0);
+    let doc: Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    let rest = &glb[20 + json_len..];
+    if rest.is_empty() {
+        return (doc, Vec::new());
+    }
+    let bin_len = u32_at(rest, 0) as usize;
+    assert_eq!(&rest[4..8], b"BIN\0");
+    assert_eq!(bin_len % 4, 0);
+    assert_eq!(rest.len(), 8 + bin_len);
+    (doc, rest[8..].to_vec())
+}
+
+#[test]
+fn glb_is_a_valid_container_with_matching_accessors() {
+    let mesh = square();
+    let (doc, bin) = open_glb(&write_glb(&mesh));
+    assert_eq!(doc["asset"]["version"], "2.0");
+    assert_eq!(doc["buffers"][0]["byteLength"].as_u64().unwrap() as usize, bin.len());
+    let accessors = doc["accessors"].as_array().unwrap();
+    let views = doc["bufferViews"].as_array().unwrap();
+    let prims = doc["meshes"][0]["primitives"].as_array().unwrap();
+    assert_eq!(prims.len(), 2);
+    for view in views {
+        let end = view["byteOffset"].as_u64().unwrap() + view["byteLength"].as_u64().unwrap();
+        assert!(end as usize <= bin.len());
+    }
+    // Positions: count, min/max and the values themselves.
+    let pos = &accessors[prims[0]["attributes"]["POSITION"].as_u64().unwrap() as usize];
+    assert_eq!(pos["count"], 4);
+    assert_eq!(pos["min"], serde_json::json!([0.0, 0.0, 0.0]));
+    assert_eq!(pos["max"], serde_json::json!([1.0, 1.0, 0.5]));
+    let pos_view = &views[pos["bufferView"].as_u64().unwrap() as usize];
+    let start = pos_view["byteOffset"].as_u64().unwrap() as usize;
+    for (k, p) in mesh.positions.iter().enumerate() {
+        for c in 0..3 {
+            assert_eq!(f64::from(f32_at(&bin, start + 12 * k + 4 * c)), p[c]);
+        }
+    }
+    let normal = &accessors[prims[0]["attributes"]["NORMAL"].as_u64().unwrap() as usize];
+    assert_eq!(normal["count"], 4);
+    // Indices: one accessor per face, together the mesh's index list.
+    let mut indices = Vec::new();
+    for prim in prims {
+        let acc = &accessors[prim["indices"].as_u64().unwrap() as usize];
+        assert_eq!(acc["componentType"], 5125);
+        assert_eq!(acc["count"], 3);
+        let view = &views[acc["bufferView"].as_u64().unwrap() as usize];
+        let offset = (view["byteOffset"].as_u64().unwrap() + acc["byteOffset"].as_u64().unwrap()) as usize;
+        assert_eq!(offset % 4, 0);
+        indices.extend((0..3).map(|k| u32_at(&bin, offset + 4 * k)));
+    }
+    assert_eq!(indices, mesh.indices);
+}
+
+#[test]
+fn glb_of_an_empty_mesh_is_valid_and_has_no_buffers() {
+    let (doc, bin) = open_glb(&write_glb(&Mesh::default()));
+    assert!(bin.is_empty());
+    assert_eq!(doc["asset"]["version"], "2.0");
+    assert!(doc.get("buffers").is_none() && doc.get("accessors").is_none());
+}
+
+// ---------------------------------------------------------------- command line
+
+/// Runs `surfmesh mesh` on a bad input with every output requested; checks
+/// exit 1, one stderr line naming the file and `needles`, and no files left.
+fn assert_rejected(input: &str, needles: &[&str]) {
+    let dir = scratch(input);
+    let (out_path, report_path) = (dir.join("out.stl"), dir.join("report.json"));
+    let out = run(&[
+        "mesh".as_ref(),
+        data(input).as_os_str(),
+        "-o".as_ref(),
+        out_path.as_os_str(),
+        "--report".as_ref(),
+        report_path.as_os_str(),
+    ]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.starts_with("surfmesh: ") && err.contains(input), "{err}");
+    for needle in needles {
+        assert!(err.contains(needle), "{needle:?} missing in {err}");
+    }
+    assert!(out.stdout.is_empty());
+    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+    assert!(left.is_empty(), "files left behind: {left:?}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn cli_rejects_malformed_json() {
+    assert_rejected("bad_syntax.json", &["line 3", "column 37"]);
+}
+
+#[test]
+fn cli_rejects_short_knot_vector() {
+    assert_rejected("bad_knots_short.json", &["face 0", "knots[0]", "too short"]);
+}
+
+#[test]
+fn cli_rejects_decreasing_knots() {
+    assert_rejected("bad_knots_decreasing.json", &["face 1", "knots[1]", "decrease"]);
+}
+
+#[test]
+fn cli_rejects_zero_weight() {
+    assert_rejected("bad_weight_zero.json", &["face 0", "weights"]);
+}
+
+#[test]
+fn cli_rejects_out_of_range_number() {
+    assert_rejected("bad_not_finite.json", &["line 7", "out of range"]);
+}
+
+#[test]
+fn cli_rejects_open_loop() {
+    assert_rejected("bad_loop_open.json", &["face 0", "loop 0", "curve 2", "does not close"]);
+}
+
+#[test]
+fn cli_rejects_loop_point_with_three_coordinates() {
+    assert_rejected("bad_loop_point.json", &["face 0", "loop 0", "curve 1", "points[0]"]);
+}
+
+#[test]
+fn cli_names_a_missing_file() {
+    let out = run(&["mesh".as_ref(), data("no_such_file.json").as_os_str()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("no_such_file.json") && err.contains("cannot read"), "{err}");
+}
+
+#[test]
+fn cli_usage_errors_exit_2() {
+    let plane = data("plane.json");
+    let p = plane.to_str().unwrap();
+    for (args, needle) in [
+        (vec![], "no command"),
+        (vec!["frobnicate"], "unknown command"),
+        (vec!["mesh"], "INPUT"),
+        (vec!["mesh", p, "--bogus"], "--bogus"),
+        (vec!["mesh", p, "--tol"], "--tol needs a value"),
+        (vec!["mesh", p, "--tol", "abc"], "not a number"),
+        (vec!["mesh", p, "--tol", "-1"], "--tol"),
+        (vec!["mesh", p, "--tol", "0.1", "--tol-rel", "0.01"], "not both"),
+        (vec!["mesh", p, "--angle", "7"], "--angle"),
+        (vec!["mesh", p, "--mode", "quality"], "not available yet"),
+        (vec!["mesh", p, "--mode", "slow"], "--mode"),
+        (vec!["mesh", p, "--reparam", "force"], "not available yet"),
+        (vec!["mesh", p, "--format", "iges"], "--format"),
+        (vec!["mesh", p, "-o", "out.ply"], ".stl, .obj or .glb"),
+        (vec!["mesh", p, p], "more than one input"),
+    ] {
+        let out = Command::new(BIN).args(&args).output().unwrap();
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(err.starts_with("surfmesh: ") && err.contains(needle), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn cli_help_prints_usage() {
+    let out = Command::new(BIN).arg("--help").output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    for option in ["mesh INPUT", "--tol", "--tol-rel", "--angle", "--max-edge", "-o", "--report"] {
+        assert!(text.contains(option), "{option} missing from usage");
+    }
+}

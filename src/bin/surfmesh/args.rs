@@ -1,0 +1,174 @@
+//! Command-line parsing, by hand: the grammar is small and this keeps the
+//! binary free of extra dependencies.
+
+use std::ffi::OsString;
+use std::path::PathBuf;
+
+use surfmesh::{Format, MeshOptions};
+
+/// What the user asked for.
+pub enum Command {
+    /// Print the usage text.
+    Help,
+    /// Print the version.
+    Version,
+    /// Mesh a model file.
+    Mesh(MeshArgs),
+}
+
+/// Arguments of `surfmesh mesh`.
+pub struct MeshArgs {
+    /// The model file.
+    pub input: PathBuf,
+    /// Input format given by `--format`; otherwise guessed from the file.
+    pub format: Option<Format>,
+    /// Meshing options, validated.
+    pub options: MeshOptions,
+    /// Mesh output file and its format.
+    pub output: Option<(PathBuf, OutputFormat)>,
+    /// Report output file.
+    pub report: Option<PathBuf>,
+}
+
+/// Mesh file formats, chosen by the output file's extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutputFormat {
+    /// Binary STL.
+    Stl,
+    /// Wavefront OBJ.
+    Obj,
+    /// Binary glTF 2.0.
+    Glb,
+}
+
+/// The usage text printed by `--help`.
+pub const USAGE: &str = "\
+surfmesh: triangle meshes of trimmed NURBS surfaces within a verified tolerance
+
+Usage:
+  surfmesh mesh INPUT [options]
+  surfmesh --help | --version
+
+Options of `mesh`:
+  --tol X             absolute chordal tolerance, model units
+  --tol-rel R         tolerance as a fraction of the model's diagonal (default 0.001)
+  --angle A           largest normal turn across a triangle, radians (default 0.5)
+  --max-edge L        longest triangle edge allowed, model units
+  --min-edge L        edges this short are never split, model units
+  --max-triangles N   triangle budget (default 4000000)
+  --mode fast         meshing mode (`quality` is not available yet)
+  --reparam auto|off  re-parameterization of poor surfaces (`force` is not available yet)
+  --format json       input format (default: from the extension, else from the content)
+  -o, --output FILE   write the mesh; .stl, .obj or .glb picks the format
+  --report FILE       write the JSON report (printed to stdout when neither
+                      -o nor --report is given)
+
+Exit status: 0 success, 1 bad input or failed run, 2 usage error.
+";
+
+/// Parses the arguments after the program name.
+///
+/// # Errors
+/// A one-line message for a usage error.
+pub fn parse(args: Vec<OsString>) -> Result<Command, String> {
+    let mut args = args.into_iter();
+    let Some(first) = args.next() else {
+        return Err("no command given; try 'surfmesh --help'".into());
+    };
+    match first.to_str() {
+        Some("-h" | "--help" | "help") => Ok(Command::Help),
+        Some("-V" | "--version") => Ok(Command::Version),
+        Some("mesh") => parse_mesh(args),
+        _ => Err(format!("unknown command '{}'; try 'surfmesh --help'", first.to_string_lossy())),
+    }
+}
+
+fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, String> {
+    let mut input: Option<PathBuf> = None;
+    let mut format = None;
+    let mut options = MeshOptions::default();
+    let (mut tol, mut tol_rel) = (None, None);
+    let mut output = None;
+    let mut report: Option<PathBuf> = None;
+    while let Some(arg) = args.next() {
+        let Some(text) = arg.to_str().filter(|t| t.starts_with('-') && t.len() > 1) else {
+            if input.replace(PathBuf::from(&arg)).is_some() {
+                return Err(format!("more than one input file ('{}')", arg.to_string_lossy()));
+            }
+            continue;
+        };
+        // `--name=value` and `--name value` both work.
+        let (name, inline) = match text.split_once('=') {
+            Some((n, v)) if n.starts_with("--") => (n, Some(OsString::from(v))),
+            _ => (text, None),
+        };
+        let name = name.to_owned();
+        let mut value = || inline.clone().or_else(|| args.next()).ok_or_else(|| format!("{name} needs a value"));
+        match name.as_str() {
+            "-h" | "--help" => return Ok(Command::Help),
+            "--tol" => tol = Some(number(&name, value()?)?),
+            "--tol-rel" => tol_rel = Some(number(&name, value()?)?),
+            "--angle" => options = options.with_angle(number(&name, value()?)?),
+            "--max-edge" => options = options.with_max_edge(Some(number(&name, value()?)?)),
+            "--min-edge" => options = options.with_min_edge(Some(number(&name, value()?)?)),
+            "--max-triangles" => {
+                let v = value()?;
+                let n = v.to_str().and_then(|s| s.parse().ok());
+                let n = n.ok_or_else(|| format!("{name}: '{}' is not a count", v.to_string_lossy()))?;
+                options = options.with_max_triangles(n);
+            }
+            "--mode" => match value()?.to_str() {
+                Some("fast") => {}
+                Some("quality") => return Err("--mode quality is not available yet; use --mode fast".into()),
+                _ => return Err("--mode must be fast (quality is not available yet)".into()),
+            },
+            "--reparam" => match value()?.to_str() {
+                Some("off" | "auto") => {}
+                Some("force") => return Err("--reparam force is not available yet; use auto or off".into()),
+                _ => return Err("--reparam must be auto, off or force".into()),
+            },
+            "--format" => {
+                let v = value()?;
+                format = Some(Format::from_name(&v.to_string_lossy()).map_err(|e| format!("--format: {e}"))?);
+            }
+            "-o" | "--output" => {
+                let path = PathBuf::from(value()?);
+                let kind = output_format(&path)?;
+                output = Some((path, kind));
+            }
+            "--report" => report = Some(PathBuf::from(value()?)),
+            _ => return Err(format!("unknown option '{text}'; try 'surfmesh --help'")),
+        }
+    }
+    let input = input.ok_or("mesh needs an INPUT file; try 'surfmesh --help'")?;
+    options = match (tol, tol_rel) {
+        (Some(_), Some(_)) => return Err("give --tol or --tol-rel, not both".into()),
+        (Some(t), None) => options.with_tolerance(t),
+        (None, Some(r)) => options.with_relative_tolerance(r),
+        (None, None) => options,
+    };
+    options.validate().map_err(|e| e.to_string())?;
+    if let (Some((out, _)), Some(rep)) = (&output, &report) {
+        if out == rep {
+            return Err("-o and --report name the same file".into());
+        }
+    }
+    Ok(Command::Mesh(MeshArgs { input, format, options, output, report }))
+}
+
+fn number(name: &str, value: OsString) -> Result<f64, String> {
+    value
+        .to_str()
+        .and_then(|s| s.parse::<f64>().ok())
+        .ok_or_else(|| format!("{name}: '{}' is not a number", value.to_string_lossy()))
+}
+
+fn output_format(path: &std::path::Path) -> Result<OutputFormat, String> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    match ext.as_str() {
+        "stl" => Ok(OutputFormat::Stl),
+        "obj" => Ok(OutputFormat::Obj),
+        "glb" => Ok(OutputFormat::Glb),
+        _ => Err(format!("-o {}: the file name must end in .stl, .obj or .glb", path.display())),
+    }
+}
