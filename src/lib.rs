@@ -5,6 +5,8 @@
 //! it against the exact surfaces. See `ARCHITECTURE.md` for the data flow.
 #![no_std]
 #![warn(missing_docs)]
+// Numerical kernels index several arrays with one counter, as the textbook algorithms do.
+#![allow(clippy::needless_range_loop)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 extern crate alloc;

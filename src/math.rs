@@ -6,21 +6,6 @@ pub(crate) fn sqrt(x: f64) -> f64 {
 }
 
 #[inline]
-pub(crate) fn sin(x: f64) -> f64 {
-    libm::sin(x)
-}
-
-#[inline]
-pub(crate) fn cos(x: f64) -> f64 {
-    libm::cos(x)
-}
-
-#[inline]
-pub(crate) fn acos(x: f64) -> f64 {
-    libm::acos(x.clamp(-1.0, 1.0))
-}
-
-#[inline]
 pub(crate) fn atan2(y: f64, x: f64) -> f64 {
     libm::atan2(y, x)
 }

@@ -49,7 +49,11 @@ impl Aabb {
 
     /// Length of the diagonal (0 when empty).
     pub fn diagonal(&self) -> f64 {
-        if self.is_empty() { 0.0 } else { (self.max - self.min).length() }
+        if self.is_empty() {
+            0.0
+        } else {
+            (self.max - self.min).length()
+        }
     }
 
     /// Whether `p` lies inside, grown by `margin`.

@@ -42,11 +42,7 @@ impl NurbsCurve {
         let knots = KnotVector::try_new(degree, knots)?;
         let expected = knots.control_count();
         if points.len() != expected {
-            return Err(NurbsError::CountMismatch {
-                what: "control points".into(),
-                found: points.len(),
-                expected,
-            });
+            return Err(NurbsError::CountMismatch { what: "control points".into(), found: points.len(), expected });
         }
         for (i, p) in points.iter().enumerate() {
             if !p.is_finite() {
@@ -198,24 +194,74 @@ impl NurbsCurve {
 
     /// Closest point on the curve to `target`: `(t, point, distance)`.
     ///
-    /// Samples every knot span, then Newton iterations on `C'·(C − P) = 0` with a
-    /// step that may only decrease the distance; never leaves the domain.
+    /// Samples every knot span, then Newton iterations on `C'·(C − P) = 0`
+    /// (a step may only decrease the distance) from up to four of the best
+    /// distinct local minima of the samples (from both sides when one sits on
+    /// an inner knot, where the curve may turn a corner); the closest result
+    /// wins. Never
+    /// leaves the domain; on a closed curve a step across the start continues
+    /// from the end and vice versa.
     pub fn project(&self, target: DVec3) -> (f64, DVec3, f64) {
+        const MAX_STARTS: usize = 4;
         let (a, b) = self.domain();
         let spans = self.knots.breakpoints();
         let per = 4 * self.degree() + 2;
-        let mut best = (a, f64::INFINITY);
-        for w in spans.windows(2) {
-            for s in 0..=per {
+        let mut samples: Vec<(f64, DVec3, f64)> = Vec::new();
+        // Indices of samples at inner breakpoints, where the curve may have a
+        // corner: Newton there sees only the derivative of the span on the right.
+        let mut corners: Vec<usize> = Vec::new();
+        let last_span = spans.len().saturating_sub(2);
+        for (k, w) in spans.windows(2).enumerate() {
+            for s in usize::from(k > 0)..=per {
                 let t = w[0] + (w[1] - w[0]) * s as f64 / per as f64;
-                let d = self.point(t).distance_squared(target);
-                if d < best.1 {
-                    best = (t, d);
+                let p = self.point(t);
+                if s == per && k < last_span {
+                    corners.push(samples.len());
+                }
+                samples.push((t, p, p.distance_squared(target)));
+            }
+        }
+        let n = samples.len();
+        // Indices stay in 0..n.
+        let mut minima: Vec<usize> = (0..n)
+            .filter(|&i| {
+                (i == 0 || samples[i - 1].2 >= samples[i].2) && (i + 1 == n || samples[i + 1].2 >= samples[i].2)
+            })
+            .collect();
+        minima.sort_by(|&i, &j| samples[i].2.total_cmp(&samples[j].2));
+        let (pa, pb) = (self.point(a), self.point(b));
+        let closed = pa.distance(pb) <= 1e-9 * (pa.length().max(pb.length()) + self.bbox().diagonal());
+        let mut best: Option<(f64, DVec3, f64)> = None;
+        let mut used: Vec<DVec3> = Vec::new();
+        for i in minima {
+            if used.len() == MAX_STARTS {
+                break;
+            }
+            let (t0, p0, _) = samples[i];
+            if used.contains(&p0) {
+                continue;
+            }
+            used.push(p0);
+            let r = self.newton(target, t0, closed);
+            if best.is_none_or(|bst| r.2 < bst.2) {
+                best = Some(r);
+            }
+            if i > 0 && corners.contains(&i) {
+                // Also search the span on the left of the corner.
+                let r = self.newton(target, 0.5 * (samples[i - 1].0 + t0), closed);
+                if best.is_none_or(|bst| r.2 < bst.2) {
+                    best = Some(r);
                 }
             }
         }
-        let mut t = best.0;
-        let mut dist = crate::math::sqrt(best.1);
+        best.unwrap_or_else(|| (a, pa, pa.distance(target)))
+    }
+
+    /// Safeguarded Newton iterations from `t` (see [`NurbsCurve::project`]).
+    fn newton(&self, target: DVec3, mut t: f64, closed: bool) -> (f64, DVec3, f64) {
+        let (a, b) = self.domain();
+        let period = b - a;
+        let mut dist = self.point(t).distance(target);
         for _ in 0..32 {
             let c = self.derivs(t);
             let r = c.point - target;
@@ -229,17 +275,28 @@ impl NurbsCurve {
                 // Not a minimum nearby: gradient step instead.
                 step = -f / c.d1.length_squared().max(1e-300);
             }
+            if !step.is_finite() {
+                break;
+            }
+            step = step.clamp(-0.5 * period, 0.5 * period);
             let mut accepted = false;
             for _ in 0..12 {
-                let tn = (t + step).clamp(a, b);
+                let mut tn = t + step;
+                if closed && !(a..=b).contains(&tn) {
+                    tn = if tn < a { tn + period } else { tn - period };
+                }
+                let tn = tn.clamp(a, b);
                 let pn = self.point(tn);
                 let dn = pn.distance(target);
                 if dn <= dist {
-                    let moved = (tn - t).abs();
+                    let mut moved = (tn - t).abs();
+                    if closed {
+                        moved = moved.min(period - moved);
+                    }
                     t = tn;
                     dist = dn;
                     accepted = true;
-                    if moved <= 1e-14 * (b - a).max(1.0) {
+                    if moved <= 1e-14 * period.max(1.0) {
                         return (t, pn, dist);
                     }
                     break;

@@ -142,14 +142,25 @@ impl KnotVector {
     /// Writes `ders[k][j]` = k-th derivative of `N_{span-p+j}` for `k <= nd`,
     /// `j <= p`, and returns the span (Piegl & Tiller, The NURBS Book, A2.3).
     pub fn basis_ders(&self, t: f64, nd: usize, ders: &mut BasisDers) -> usize {
+        self.basis_into(t, nd, &mut ders.0)
+    }
+
+    /// As [`KnotVector::basis_ders`] into scratch sized for the degree class
+    /// (`N > degree`, else nothing is written and the span is still returned):
+    /// zeroing 17×17 tables on every call costs more than the arithmetic for
+    /// low degrees, so hot paths pick a small `N`.
+    pub(crate) fn basis_into<const N: usize>(&self, t: f64, nd: usize, ders: &mut [[f64; N]; MAX_DERIV + 1]) -> usize {
+        if self.degree >= N {
+            return self.span(t);
+        }
         let p = self.degree;
         let t = self.clamp(t);
         let span = self.span(t);
         let u = &self.knots;
         let nd = nd.min(MAX_DERIV);
-        let mut ndu = [[0.0f64; MAX_DEGREE + 1]; MAX_DEGREE + 1];
-        let mut left = [0.0f64; MAX_DEGREE + 1];
-        let mut right = [0.0f64; MAX_DEGREE + 1];
+        let mut ndu = [[0.0f64; N]; N];
+        let mut left = [0.0f64; N];
+        let mut right = [0.0f64; N];
         ndu[0][0] = 1.0;
         for j in 1..=p {
             left[j] = t - u[span + 1 - j];
@@ -164,9 +175,12 @@ impl KnotVector {
             ndu[j][j] = saved;
         }
         for j in 0..=p {
-            ders.0[0][j] = ndu[j][p];
+            ders[0][j] = ndu[j][p];
         }
-        let mut a = [[0.0f64; MAX_DEGREE + 1]; 2];
+        if nd == 0 {
+            return span;
+        }
+        let mut a = [[0.0f64; N]; 2];
         for r in 0..=p {
             let (mut s1, mut s2) = (0usize, 1usize);
             a[0][0] = 1.0;
@@ -175,7 +189,7 @@ impl KnotVector {
                 let rk = r as isize - k as isize;
                 let pk = p - k.min(p);
                 if k > p {
-                    ders.0[k][r] = 0.0;
+                    ders[k][r] = 0.0;
                     continue;
                 }
                 if rk >= 0 {
@@ -197,14 +211,14 @@ impl KnotVector {
                     a[s2][k] = if den != 0.0 { -a[s1][k - 1] / den } else { 0.0 };
                     d += a[s2][k] * ndu[r][pk];
                 }
-                ders.0[k][r] = d;
+                ders[k][r] = d;
                 core::mem::swap(&mut s1, &mut s2);
             }
         }
         let mut factor = p as f64;
         for k in 1..=nd {
             for j in 0..=p {
-                ders.0[k][j] *= factor;
+                ders[k][j] *= factor;
             }
             factor *= (p as f64) - k as f64;
         }

@@ -54,15 +54,13 @@ pub trait Surface {
 
     /// Unit normal `Su × Sv`, defined also where the surface degenerates.
     ///
-    /// At a collapsed edge (sphere pole) `Su × Sv` vanishes; the normal is then
-    /// the limit taken from a point nudged toward the domain's centre, which is
-    /// the direction every nearby facet sees.
+    /// At a collapsed edge (sphere pole) `Su × Sv` vanishes, or is made only of
+    /// rounding noise in the vanishing derivative; the normal is then the limit
+    /// taken from a point nudged toward the domain's centre, which is the
+    /// direction every nearby facet sees.
     fn normal(&self, uv: DVec2) -> DVec3 {
-        let d = self.derivs(uv);
-        let n = d.su.cross(d.sv);
-        let scale = d.su.length() * d.sv.length();
-        if n.length() > 1e-12 * scale && scale > 0.0 {
-            return n.normalize();
+        if let Some(n) = regular_normal(&self.derivs(uv)) {
+            return n;
         }
         let [lo, hi] = self.domain();
         let centre = (lo + hi) * 0.5;
@@ -70,12 +68,22 @@ pub trait Surface {
         for _ in 0..6 {
             f *= 10.0;
             let q = uv + (centre - uv) * f;
-            let d = self.derivs(q);
-            let n = d.su.cross(d.sv);
-            if n.length() > 1e-14 * (d.su.length() * d.sv.length()).max(1e-300) && n.length() > 0.0 {
-                return n.normalize();
+            if let Some(n) = regular_normal(&self.derivs(q)) {
+                return n;
             }
         }
         DVec3::Z
     }
+}
+
+/// `Su × Sv` normalized, or `None` where the surface is degenerate: the cross
+/// product is below `1e-10 (|Su|² + |Sv|²)`, i.e. one derivative is ten
+/// orders of magnitude shorter than the other (a collapsed edge, where what is
+/// left of it is rounding noise pointing anywhere) or the two are parallel.
+fn regular_normal(d: &SurfaceDerivs) -> Option<DVec3> {
+    const DEGENERATE: f64 = 1e-10;
+    let n = d.su.cross(d.sv);
+    let len = n.length();
+    let scale = d.su.length_squared() + d.sv.length_squared();
+    (len.is_finite() && len > 0.0 && len > DEGENERATE * scale).then(|| n / len)
 }

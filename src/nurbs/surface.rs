@@ -3,7 +3,7 @@
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3, DVec4};
 
-use super::knots::{BasisDers, KnotVector};
+use super::knots::KnotVector;
 use super::{Aabb, NurbsError, Surface, SurfaceDerivs};
 
 /// A (possibly rational) tensor-product B-spline surface.
@@ -49,11 +49,19 @@ impl NurbsSurface {
     ) -> Result<Self, NurbsError> {
         let (nu, nv) = (ku.control_count(), kv.control_count());
         if points.len() != nu {
-            return Err(NurbsError::CountMismatch { what: "control point rows (along u)".into(), found: points.len(), expected: nu });
+            return Err(NurbsError::CountMismatch {
+                what: "control point rows (along u)".into(),
+                found: points.len(),
+                expected: nu,
+            });
         }
         if let Some(w) = weights {
             if w.len() != nu {
-                return Err(NurbsError::CountMismatch { what: "weight rows (along u)".into(), found: w.len(), expected: nu });
+                return Err(NurbsError::CountMismatch {
+                    what: "weight rows (along u)".into(),
+                    found: w.len(),
+                    expected: nu,
+                });
             }
         }
         let mut hp = Vec::with_capacity(nu * nv);
@@ -135,26 +143,34 @@ impl NurbsSurface {
 
     /// Homogeneous derivatives `A^{(k,l)}` for `k + l <= order` (order ≤ 2).
     fn homogeneous_derivs(&self, uv: DVec2, order: usize) -> [[DVec4; 3]; 3] {
-        let mut bu = BasisDers::default();
-        let mut bv = BasisDers::default();
-        let su = self.ku.basis_ders(uv.x, order, &mut bu);
-        let sv = self.kv.basis_ders(uv.y, order, &mut bv);
+        match self.ku.degree().max(self.kv.degree()) {
+            0..=3 => self.homogeneous_derivs_n::<4>(uv, order),
+            4..=7 => self.homogeneous_derivs_n::<8>(uv, order),
+            _ => self.homogeneous_derivs_n::<{ super::MAX_DEGREE + 1 }>(uv, order),
+        }
+    }
+
+    fn homogeneous_derivs_n<const N: usize>(&self, uv: DVec2, order: usize) -> [[DVec4; 3]; 3] {
+        let mut bu = [[0.0; N]; 3];
+        let mut bv = [[0.0; N]; 3];
+        let su = self.ku.basis_into(uv.x, order, &mut bu);
+        let sv = self.kv.basis_into(uv.y, order, &mut bv);
         let (p, q) = (self.ku.degree(), self.kv.degree());
         let nv = self.kv.control_count();
         let mut out = [[DVec4::ZERO; 3]; 3];
-        let mut temp = [DVec4::ZERO; super::MAX_DEGREE + 1];
+        let mut temp = [DVec4::ZERO; N];
         for k in 0..=order {
             for (s, t) in temp.iter_mut().enumerate().take(q + 1) {
                 let mut acc = DVec4::ZERO;
                 for r in 0..=p {
-                    acc += self.points[(su - p + r) * nv + sv - q + s] * bu.0[k][r];
+                    acc += self.points[(su - p + r) * nv + sv - q + s] * bu[k][r];
                 }
                 *t = acc;
             }
             for l in 0..=(order - k) {
                 let mut acc = DVec4::ZERO;
                 for (s, t) in temp.iter().enumerate().take(q + 1) {
-                    acc += *t * bv.0[l][s];
+                    acc += *t * bv[l][s];
                 }
                 out[k][l] = acc;
             }
@@ -176,7 +192,11 @@ impl NurbsSurface {
         let alphas: Vec<f64> = (span - p + 1..=span)
             .map(|i| {
                 let den = u[i + p] - u[i];
-                if den > 0.0 { (t - u[i]) / den } else { 0.0 }
+                if den > 0.0 {
+                    (t - u[i]) / den
+                } else {
+                    0.0
+                }
             })
             .collect();
         let refine = |line: &[DVec4]| -> Vec<DVec4> {
@@ -233,7 +253,11 @@ impl Surface for NurbsSurface {
     }
 
     fn breaks(&self, along_u: bool) -> Vec<f64> {
-        if along_u { self.ku.breakpoints() } else { self.kv.breakpoints() }
+        if along_u {
+            self.ku.breakpoints()
+        } else {
+            self.kv.breakpoints()
+        }
     }
 
     fn bounding_box(&self) -> Aabb {

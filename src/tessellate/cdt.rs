@@ -1,0 +1,78 @@
+//! Constrained Delaunay triangulation of a trimmed face's nodes (spade).
+//!
+//! Paper 000 §3.2 walks the trim curve through the grid and joins the kept
+//! quad corners to the trim points; it notes that this breaks on sharp trim
+//! curves and close loops. A CDT of the kept grid nodes plus the loop nodes,
+//! with the loop segments as constraints, is the robust replacement: inside
+//! the region it reproduces the grid, along the loops it fills the band.
+
+use alloc::format;
+use alloc::vec::Vec;
+use glam::DVec2;
+use spade::handles::FixedFaceHandle;
+use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+
+use crate::Error;
+
+/// Triangulates `points` (already scaled so that Delaunay in this plane gives
+/// well-shaped triangles on the surface) with `constraints` as forced edges,
+/// and returns the triangles (counter-clockwise) whose crossing parity of
+/// constraint edges from the hull is odd: the kept region.
+pub(crate) fn triangulate_region(
+    face: usize,
+    points: &[DVec2],
+    constraints: &[[usize; 2]],
+) -> Result<Vec<[u32; 3]>, Error> {
+    let verts: Vec<Point2<f64>> = points.iter().map(|p| Point2::new(p.x, p.y)).collect();
+    let mut conflict = None;
+    let cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(verts, constraints.to_vec(), |e| {
+        conflict = Some(e)
+    })
+    .map_err(|e| Error::Mesh { face, message: format!("triangulation failed: {e:?}") })?;
+    if let Some(e) = conflict {
+        return Err(Error::Mesh { face, message: format!("trim loops cross (segment {} - {})", e[0], e[1]) });
+    }
+    if cdt.num_vertices() != points.len() {
+        return Err(Error::Mesh { face, message: "trim loop nodes coincide".into() });
+    }
+    // Flood fill from the hull: crossing a constraint edge flips inside/outside.
+    let nfaces = cdt.num_inner_faces() + 1;
+    let mut depth: Vec<u32> = alloc::vec![u32::MAX; nfaces];
+    let mut queue: alloc::collections::VecDeque<(FixedFaceHandle<spade::handles::InnerTag>, u32)> =
+        alloc::collections::VecDeque::new();
+    for f in cdt.inner_faces() {
+        for e in f.adjacent_edges() {
+            if e.rev().face().is_outer() {
+                let d = u32::from(e.is_constraint_edge());
+                let idx = f.fix().index();
+                if d < depth[idx] {
+                    depth[idx] = d;
+                    queue.push_back((f.fix(), d));
+                }
+            }
+        }
+    }
+    while let Some((fh, d)) = queue.pop_front() {
+        if depth[fh.index()] < d {
+            continue;
+        }
+        let f = cdt.face(fh);
+        for e in f.adjacent_edges() {
+            let Some(g) = e.rev().face().as_inner() else { continue };
+            let nd = d + u32::from(e.is_constraint_edge());
+            let gi = g.fix().index();
+            if nd < depth[gi] {
+                depth[gi] = nd;
+                queue.push_back((g.fix(), nd));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for f in cdt.inner_faces() {
+        if depth[f.fix().index()] % 2 == 1 {
+            let v = f.vertices();
+            out.push([v[0].fix().index() as u32, v[1].fix().index() as u32, v[2].fix().index() as u32]);
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,200 @@
+//! Parameter lines of the iso-parametric grid (paper 000 §3.1).
+//!
+//! An interval is accepted when, on every tested iso-curve, the points at 1/4,
+//! 2/4 and 3/4 of it lie within the tolerance of the chord (one midpoint alone
+//! misses S-shaped cubic spans), the normal turns less than the angle limit and
+//! the chord is not longer than the edge limit. The paper bisects a failing
+//! interval; we split it into `n` equal parts with `n` estimated from the
+//! measured sag (sag falls as 1/n²), so triangle counts follow the tolerance
+//! smoothly instead of jumping by powers of two. Testing all iso-curves
+//! together (paper §3.1.3: boundaries plus 1/4, 1/2, 3/4 interior lines) gives
+//! one parameter set for both opposite sides, which is the paper's
+//! equalization (§3.1.2) for free.
+
+use alloc::vec::Vec;
+use glam::{DVec2, DVec3};
+
+use crate::math::{ceil, sqrt};
+use crate::nurbs::Surface;
+
+/// Limits one interval must satisfy.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Limits {
+    /// Chordal tolerance for this pass.
+    pub tol: f64,
+    /// Normal (or tangent) turn limit, radians.
+    pub angle: f64,
+    /// Longest chord allowed.
+    pub max_edge: f64,
+    /// Chords at or below this length are accepted.
+    pub min_edge: f64,
+}
+
+/// Most parts one interval is split into at once, and the deepest recursion.
+const MAX_SPLIT: usize = 64;
+const MAX_DEPTH: usize = 24;
+/// Most parameters produced along one direction (guards memory on hostile input).
+pub(crate) const MAX_PARAMS: usize = 20_000;
+
+/// How badly the interval `[a, b]` fails: the factor by which it must be
+/// split (1.0 = accepted). `eval(t)` gives point and unit normal (or tangent).
+fn interval_need(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits) -> (f64, f64) {
+    let (pa, na) = eval(a);
+    let (pb, nb) = eval(b);
+    let chord = pb - pa;
+    let len = chord.length();
+    let mut sag: f64 = 0.0;
+    let mut turn = crate::math::angle_between(na, nb);
+    for f in [0.25, 0.5, 0.75] {
+        let (p, n) = eval(a + (b - a) * f);
+        sag = sag.max(dist_to_segment(p, pa, pb));
+        turn = turn.max(crate::math::angle_between(na, n)).max(crate::math::angle_between(n, nb));
+    }
+    if len <= lim.min_edge {
+        return (1.0, sag);
+    }
+    let mut need: f64 = 1.0;
+    if sag > lim.tol {
+        need = need.max(sqrt(sag / lim.tol));
+    }
+    if turn > lim.angle {
+        need = need.max(turn / lim.angle);
+    }
+    if len > lim.max_edge {
+        need = need.max(len / lim.max_edge);
+    }
+    (need, sag)
+}
+
+/// Distance from `p` to the segment `ab`.
+pub(crate) fn dist_to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let l2 = ab.length_squared();
+    if l2 <= 0.0 {
+        return p.distance(a);
+    }
+    let t = ((p - a).dot(ab) / l2).clamp(0.0, 1.0);
+    p.distance(a + ab * t)
+}
+
+/// Subdivides `[t0, t1]` (already split at `breaks`) until every interval passes
+/// for all curves in `evals`. Returns ascending parameters including both ends,
+/// and the largest sag left in an accepted interval.
+pub(crate) fn subdivide(evals: &[&dyn Fn(f64) -> (DVec3, DVec3)], breaks: &[f64], lim: &Limits) -> (Vec<f64>, f64) {
+    let mut out: Vec<f64> = Vec::new();
+    let mut worst: f64 = 0.0;
+    let Some(&first) = breaks.first() else { return (out, 0.0) };
+    out.push(first);
+    for w in breaks.windows(2) {
+        if w[1] > w[0] {
+            split_rec(evals, w[0], w[1], lim, 0, &mut out, &mut worst);
+        }
+    }
+    (out, worst)
+}
+
+fn split_rec(
+    evals: &[&dyn Fn(f64) -> (DVec3, DVec3)],
+    a: f64,
+    b: f64,
+    lim: &Limits,
+    depth: usize,
+    out: &mut Vec<f64>,
+    worst: &mut f64,
+) {
+    let (need, sag) = need_all(evals, a, b, lim);
+    if need <= 1.0 || depth >= MAX_DEPTH || out.len() >= MAX_PARAMS || b - a <= (a.abs() + b.abs()) * 1e-12 {
+        *worst = worst.max(sag);
+        out.push(b);
+        return;
+    }
+    // Equal parts; when a part still fails, raise the count for the whole
+    // interval by that part's need rather than bisecting just it, so the
+    // interval keeps equal steps and close to the fewest that pass.
+    let mut n = (ceil(need) as usize).clamp(2, MAX_SPLIT);
+    for _ in 0..6 {
+        let mut part_need: f64 = 1.0;
+        let mut part_sag: f64 = 0.0;
+        for k in 0..n {
+            let (t0, t1) = (a + (b - a) * k as f64 / n as f64, a + (b - a) * (k + 1) as f64 / n as f64);
+            let (nk, sk) = need_all(evals, t0, t1, lim);
+            part_need = part_need.max(nk);
+            part_sag = part_sag.max(sk);
+        }
+        if part_need <= 1.0 {
+            for k in 1..=n {
+                out.push(if k == n { b } else { a + (b - a) * k as f64 / n as f64 });
+            }
+            *worst = worst.max(part_sag);
+            return;
+        }
+        if n >= MAX_SPLIT {
+            break;
+        }
+        n = ((ceil(n as f64 * part_need) as usize).max(n + 1)).min(MAX_SPLIT);
+    }
+    let mut prev = a;
+    for k in 1..=n {
+        let t = if k == n { b } else { a + (b - a) * k as f64 / n as f64 };
+        split_rec(evals, prev, t, lim, depth + 1, out, worst);
+        prev = t;
+    }
+}
+
+fn need_all(evals: &[&dyn Fn(f64) -> (DVec3, DVec3)], a: f64, b: f64, lim: &Limits) -> (f64, f64) {
+    let mut need: f64 = 1.0;
+    let mut sag: f64 = 0.0;
+    for e in evals {
+        let (n, s) = interval_need(*e, a, b, lim);
+        need = need.max(n);
+        sag = sag.max(s);
+    }
+    (need, sag)
+}
+
+/// Initial intervals along one direction: the knot breaks inside `[lo, hi]`,
+/// thinned to at most `max_groups` groups so surfaces with hundreds of knot
+/// spans do not force hundreds of rows where they are flat.
+pub(crate) fn initial_breaks(breaks: &[f64], lo: f64, hi: f64, max_groups: usize) -> Vec<f64> {
+    let mut inner: Vec<f64> = breaks.iter().copied().filter(|&t| t > lo && t < hi).collect();
+    if inner.len() + 1 > max_groups {
+        let step = (inner.len() + 1) as f64 / max_groups as f64;
+        let mut thinned = Vec::with_capacity(max_groups);
+        let mut k = 1;
+        while k < max_groups {
+            let idx = (step * k as f64) as usize;
+            if idx >= 1 && idx <= inner.len() {
+                thinned.push(inner[idx - 1]);
+            }
+            k += 1;
+        }
+        thinned.dedup();
+        inner = thinned;
+    }
+    let mut out = Vec::with_capacity(inner.len() + 2);
+    out.push(lo);
+    out.extend(inner);
+    out.push(hi);
+    out
+}
+
+/// Parameters along u (`along_u`) or v over the rectangle `[lo, hi]`, tested on
+/// the two boundary iso-curves and the interior ones at 1/4, 1/2 and 3/4.
+pub(crate) fn grid_params(surface: &dyn Surface, lo: DVec2, hi: DVec2, along_u: bool, lim: &Limits) -> (Vec<f64>, f64) {
+    let (t0, t1, s0, s1) = if along_u { (lo.x, hi.x, lo.y, hi.y) } else { (lo.y, hi.y, lo.x, hi.x) };
+    let fixed: [f64; 5] = [s0, s0 + 0.25 * (s1 - s0), s0 + 0.5 * (s1 - s0), s0 + 0.75 * (s1 - s0), s1];
+    let make = |s: f64| {
+        move |t: f64| {
+            let uv = if along_u { DVec2::new(t, s) } else { DVec2::new(s, t) };
+            (surface.point(uv), surface.normal(uv))
+        }
+    };
+    let c0 = make(fixed[0]);
+    let c1 = make(fixed[1]);
+    let c2 = make(fixed[2]);
+    let c3 = make(fixed[3]);
+    let c4 = make(fixed[4]);
+    let evals: [&dyn Fn(f64) -> (DVec3, DVec3); 5] = [&c0, &c1, &c2, &c3, &c4];
+    let breaks = initial_breaks(&surface.breaks(along_u), t0, t1, 16);
+    subdivide(&evals, &breaks, lim)
+}

@@ -1,0 +1,294 @@
+//! Trim loops: discretization by the chord test, outer/hole classification,
+//! crossing checks and inside tests (paper 000 §3.2).
+
+use alloc::format;
+use alloc::vec::Vec;
+use glam::{DVec2, DVec3};
+
+use super::params::{initial_breaks, subdivide, Limits, MAX_PARAMS};
+use crate::model::TrimLoop;
+use crate::nurbs::Surface;
+use crate::Error;
+
+/// Where a loop node sits on the exact trim geometry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CurveRef {
+    /// Index into [`Loops::curves`].
+    pub curve: u32,
+    /// Curve parameter.
+    pub t: f64,
+}
+
+/// One closed polyline in (u,v); node `i` joins node `i + 1` (cyclically).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Polyline {
+    /// Node parameters.
+    pub uv: Vec<DVec2>,
+    /// Exact place of each node on its curve.
+    pub at: Vec<CurveRef>,
+    /// Segment `i` (node `i` to `i + 1`) follows curve `.0` from parameter `.1` to `.2`.
+    pub seg: Vec<(u32, f64, f64)>,
+}
+
+/// All loops of one face, discretized and oriented: outer counter-clockwise
+/// first, holes clockwise after it.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Loops<'a> {
+    /// Polylines, outer first.
+    pub polys: Vec<Polyline>,
+    /// The trim curves, indexed by [`CurveRef::curve`].
+    pub curves: Vec<&'a crate::NurbsCurve>,
+}
+
+impl Loops<'_> {
+    /// Box around all loop nodes.
+    pub fn bounds(&self) -> (DVec2, DVec2) {
+        let mut lo = DVec2::splat(f64::INFINITY);
+        let mut hi = DVec2::splat(f64::NEG_INFINITY);
+        for p in &self.polys {
+            for &q in &p.uv {
+                lo = lo.min(q);
+                hi = hi.max(q);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Every segment as `(a, b)`.
+    pub fn segments(&self) -> impl Iterator<Item = (DVec2, DVec2)> + '_ {
+        self.polys.iter().flat_map(|p| {
+            let n = p.uv.len();
+            (0..n).map(move |i| (p.uv[i], p.uv[(i + 1) % n]))
+        })
+    }
+
+    /// Even-odd inside test against all loops.
+    pub fn contains(&self, q: DVec2) -> bool {
+        let mut inside = false;
+        for (a, b) in self.segments() {
+            if (a.y > q.y) != (b.y > q.y) {
+                let x = a.x + (q.y - a.y) / (b.y - a.y) * (b.x - a.x);
+                if x > q.x {
+                    inside = !inside;
+                }
+            }
+        }
+        inside
+    }
+}
+
+/// Discretizes, orients and checks the loops of face `face`.
+///
+/// # Errors
+/// A loop too small to enclose anything, a loop that crosses itself or
+/// another loop, or a hole outside the outer loop.
+pub(crate) fn prepare_loops<'a>(
+    face: usize,
+    surface: &dyn Surface,
+    loops: &'a [TrimLoop],
+    lim: &Limits,
+) -> Result<Loops<'a>, Error> {
+    let mut out = Loops::default();
+    let mut areas = Vec::new();
+    for (li, lp) in loops.iter().enumerate() {
+        let mut poly = Polyline::default();
+        for c in &lp.curves {
+            let ci = out.curves.len() as u32;
+            out.curves.push(c);
+            let on_surface = |t: f64| {
+                let d = c.derivs(t);
+                let uv = d.point.truncate();
+                let s = surface.derivs(uv);
+                let tangent = s.su * d.d1.x + s.sv * d.d1.y;
+                (s.point, surface.normal(uv), tangent)
+            };
+            let by_normal = |t: f64| {
+                let (p, n, _) = on_surface(t);
+                (p, n)
+            };
+            let by_tangent = |t: f64| {
+                let (p, _, tg) = on_surface(t);
+                (p, tg)
+            };
+            let (a, b) = c.domain();
+            let breaks = initial_breaks(&c.knots().breakpoints(), a, b, 16);
+            let evals: [&dyn Fn(f64) -> (DVec3, DVec3); 2] = [&by_normal, &by_tangent];
+            let (ts, _) = subdivide(&evals, &breaks, lim);
+            // The last node of each curve is the first of the next: drop it.
+            for &t in &ts[..ts.len().saturating_sub(1)] {
+                poly.uv.push(c.point(t).truncate());
+                poly.at.push(CurveRef { curve: ci, t });
+            }
+            if poly.uv.len() > MAX_PARAMS * 8 {
+                return Err(Error::Limit(format!(
+                    "face {face} loop {li}: more than {} boundary nodes",
+                    MAX_PARAMS * 8
+                )));
+            }
+        }
+        dedup_closed(&mut poly);
+        let n = poly.at.len();
+        poly.seg = (0..n)
+            .map(|i| {
+                let (a, b) = (poly.at[i], poly.at[(i + 1) % n]);
+                let end = out.curves.get(a.curve as usize).map_or(b.t, |c| c.domain().1);
+                let tb = if b.curve == a.curve && b.t > a.t { b.t } else { end };
+                (a.curve, a.t, tb)
+            })
+            .collect();
+        if poly.uv.len() < 3 {
+            return Err(Error::Mesh { face, message: format!("loop {li} encloses no area") });
+        }
+        let area = signed_area(&poly.uv);
+        if area == 0.0 || !area.is_finite() {
+            return Err(Error::Mesh { face, message: format!("loop {li} encloses no area") });
+        }
+        areas.push(area);
+        out.polys.push(poly);
+    }
+    // Outer = largest area; counter-clockwise. Holes clockwise.
+    let outer = (0..areas.len()).max_by(|&i, &j| areas[i].abs().total_cmp(&areas[j].abs())).unwrap_or(0);
+    out.polys.swap(0, outer);
+    areas.swap(0, outer);
+    let mut order: Vec<usize> = (0..loops.len()).collect();
+    order.swap(0, outer);
+    for (k, poly) in out.polys.iter_mut().enumerate() {
+        let want_ccw = k == 0;
+        if (areas[k] > 0.0) != want_ccw {
+            poly.uv.reverse();
+            poly.at.reverse();
+            let n = poly.seg.len();
+            poly.seg = (0..n)
+                .map(|j| {
+                    let (c, ta, tb) = poly.seg[(2 * n - 2 - j) % n];
+                    (c, tb, ta)
+                })
+                .collect();
+        }
+    }
+    check_crossings(face, &out, &order)?;
+    for k in 1..out.polys.len() {
+        let probe = out.polys[k].uv[0];
+        let mut only_outer = Loops { polys: Vec::new(), curves: Vec::new() };
+        only_outer.polys.push(out.polys[0].clone());
+        if !only_outer.contains(probe) {
+            return Err(Error::Mesh {
+                face,
+                message: format!("loop {} lies outside the outer loop {}", order[k], order[0]),
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// Removes consecutive duplicate nodes, including last-equals-first.
+fn dedup_closed(p: &mut Polyline) {
+    let mut uv = Vec::with_capacity(p.uv.len());
+    let mut at = Vec::with_capacity(p.at.len());
+    for (i, &q) in p.uv.iter().enumerate() {
+        if uv.last().is_some_and(|&l: &DVec2| l.distance_squared(q) == 0.0) {
+            continue;
+        }
+        uv.push(q);
+        at.push(p.at[i]);
+    }
+    while uv.len() > 1 && uv.first() == uv.last() {
+        uv.pop();
+        at.pop();
+    }
+    p.uv = uv;
+    p.at = at;
+}
+
+fn signed_area(p: &[DVec2]) -> f64 {
+    let n = p.len();
+    let mut a = 0.0;
+    for i in 0..n {
+        a += p[i].perp_dot(p[(i + 1) % n]);
+    }
+    0.5 * a
+}
+
+fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    (b - a).perp_dot(c - a)
+}
+
+/// Whether closed segments `ab` and `cd` share a point.
+fn segments_meet(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
+    let d1 = orient(c, d, a);
+    let d2 = orient(c, d, b);
+    let d3 = orient(a, b, c);
+    let d4 = orient(a, b, d);
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0)) {
+        return true;
+    }
+    let on = |p: DVec2, q: DVec2, r: DVec2, o: f64| {
+        o == 0.0 && r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
+    };
+    on(c, d, a, d1) || on(c, d, b, d2) || on(a, b, c, d3) || on(a, b, d, d4)
+}
+
+/// Finds a pair of loop segments that cross or touch (other than neighbours
+/// sharing their common node), bucketed on a uniform grid.
+fn check_crossings(face: usize, loops: &Loops<'_>, order: &[usize]) -> Result<(), Error> {
+    struct Seg {
+        a: DVec2,
+        b: DVec2,
+        lp: usize,
+        idx: usize,
+        len: usize,
+    }
+    let mut segs = Vec::new();
+    for (k, p) in loops.polys.iter().enumerate() {
+        let n = p.uv.len();
+        for i in 0..n {
+            segs.push(Seg { a: p.uv[i], b: p.uv[(i + 1) % n], lp: k, idx: i, len: n });
+        }
+    }
+    let (lo, hi) = loops.bounds();
+    let cells = (crate::math::sqrt(segs.len() as f64) as usize).clamp(1, 512);
+    let size = (hi - lo).max(DVec2::splat(1e-300)) / cells as f64;
+    let cell_of = |p: DVec2| {
+        let c = ((p - lo) / size).floor();
+        (c.x.clamp(0.0, (cells - 1) as f64) as usize, c.y.clamp(0.0, (cells - 1) as f64) as usize)
+    };
+    let mut grid: Vec<Vec<u32>> = alloc::vec![Vec::new(); cells * cells];
+    for (s, seg) in segs.iter().enumerate() {
+        let (x0, y0) = cell_of(seg.a.min(seg.b));
+        let (x1, y1) = cell_of(seg.a.max(seg.b));
+        for x in x0..=x1 {
+            for y in y0..=y1 {
+                grid[y * cells + x].push(s as u32);
+            }
+        }
+    }
+    for bucket in &grid {
+        for (ii, &i) in bucket.iter().enumerate() {
+            for &j in &bucket[ii + 1..] {
+                let (s, t) = (&segs[i as usize], &segs[j as usize]);
+                if s.lp == t.lp {
+                    let n = s.len;
+                    let adjacent = (s.idx + 1) % n == t.idx || (t.idx + 1) % n == s.idx;
+                    if adjacent {
+                        // Neighbours share one node; they only conflict if they fold back.
+                        let (shared, p, q) = if (s.idx + 1) % n == t.idx { (s.b, s.a, t.b) } else { (s.a, s.b, t.a) };
+                        let folds = orient(shared, p, q) == 0.0 && (p - shared).dot(q - shared) > 0.0;
+                        if folds && n > 2 {
+                            return Err(Error::Mesh { face, message: format!("loop {} crosses itself", order[s.lp]) });
+                        }
+                        continue;
+                    }
+                }
+                if segments_meet(s.a, s.b, t.a, t.b) {
+                    let message = if s.lp == t.lp {
+                        format!("loop {} crosses itself", order[s.lp])
+                    } else {
+                        format!("loop {} crosses loop {}", order[s.lp.min(t.lp)], order[s.lp.max(t.lp)])
+                    };
+                    return Err(Error::Mesh { face, message });
+                }
+            }
+        }
+    }
+    Ok(())
+}
