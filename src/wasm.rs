@@ -1,0 +1,211 @@
+//! The JavaScript door (wasm-bindgen): JS values in, core types through
+//! [`crate::mesh_model`], typed arrays out. No algorithm lives here.
+//!
+//! Errors are thrown as JS `Error` objects whose message is the
+//! [`crate::Error`] `Display` text, the same line the command line prints.
+//!
+//! `tests/wasm_node.rs` compiles this file a second time (`#[path]`) to call
+//! it from Rust: there `cfg(test)` is set and the exports are left off, so the
+//! two copies do not clash at link time.
+
+use alloc::format;
+use alloc::string::{String, ToString};
+use alloc::vec::Vec;
+
+use js_sys::{Array, Float32Array, Function, Object, Reflect, Uint32Array, JSON};
+use wasm_bindgen::prelude::*;
+
+use crate::{mesh_model, read_model, Error, Format, MeshOptions, MeshResult};
+
+#[cfg_attr(not(test), wasm_bindgen(typescript_custom_section))]
+#[cfg_attr(test, allow(dead_code))]
+const TS_TYPES: &str = r#"
+/** Options of `mesh`; every field is optional. Lengths are in model units, angles in radians. */
+export interface MeshOptions {
+  /** Absolute chordal tolerance (exclusive with toleranceRel). */
+  tolerance?: number;
+  /** Chordal tolerance as a fraction of the model's bounding-box diagonal (default 1e-3). */
+  toleranceRel?: number;
+  /** Largest normal turn across one triangle, radians (default 0.5). */
+  angle?: number;
+  /** Longest triangle edge allowed. */
+  maxEdge?: number;
+  /** Edges at or below this length are never split. */
+  minEdge?: number;
+  /** Triangle budget; refinement stops with a warning past it. */
+  maxTriangles?: number;
+}
+
+/** What `mesh` returns. */
+export interface MeshOutput {
+  /** x, y, z per vertex. */
+  positions: Float32Array;
+  /** Unit surface normal per vertex. */
+  normals: Float32Array;
+  /** Three vertex indices per triangle, counter-clockwise seen from the normal side. */
+  indices: Uint32Array;
+  /** Pairs (first triangle, triangle count), one pair per model face. */
+  faceRanges: Uint32Array;
+  /** The measured report (tolerance, triangles, max_deviation, warnings, ...). */
+  report: Record<string, any>;
+}
+
+/**
+ * Reads `bytes` in `format` ("json", or "" / "auto" to detect it) and meshes the model.
+ * Throws an `Error` whose message names the problem (the CLI's one-line error).
+ */
+export function mesh(bytes: Uint8Array, format: string, options?: MeshOptions): MeshOutput;
+"#;
+
+/// Option names `mesh` accepts, in the order they are read.
+const OPTION_NAMES: [&str; 6] = ["tolerance", "toleranceRel", "angle", "maxEdge", "minEdge", "maxTriangles"];
+
+/// The crate version, so a page can show which mesher produced a mesh.
+#[cfg_attr(not(test), wasm_bindgen)]
+pub fn version() -> String {
+    env!("CARGO_PKG_VERSION").to_string()
+}
+
+/// Reads `bytes` in `format` (`"json"`, or `""`/`"auto"` to detect it) and
+/// meshes the model with `options` (see the `MeshOptions` interface).
+///
+/// # Errors
+/// Throws a JS `Error` whose message is the one-line text of the problem:
+/// a bad option, a parse error with its line, or the face/loop/curve and field
+/// that is invalid.
+#[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
+pub fn mesh(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsError> {
+    let options = read_options(&options).map_err(|e| JsError::new(&e))?;
+    run(bytes, format, &options).map_err(|e| JsError::new(&e.to_string()))
+}
+
+/// Parses, meshes and converts, timing the two stages with the host clock.
+fn run(bytes: &[u8], format: &str, options: &MeshOptions) -> Result<JsValue, Error> {
+    options.validate()?;
+    let format = pick_format(bytes, format)?;
+    let t0 = now_ms();
+    let model = read_model(bytes, format)?;
+    let t1 = now_ms();
+    let mut result = mesh_model(&model, options)?;
+    let t2 = now_ms();
+    if let (Some(t0), Some(t1), Some(t2)) = (t0, t1, t2) {
+        result.report.parse_ms = t1 - t0;
+        result.report.time_ms = t2 - t1;
+    }
+    to_js(&result)
+}
+
+/// `""` and `"auto"` detect the format from the bytes; anything else is a name.
+fn pick_format(bytes: &[u8], name: &str) -> Result<Format, Error> {
+    if name.is_empty() || name.eq_ignore_ascii_case("auto") {
+        Format::detect(bytes)
+            .ok_or_else(|| Error::Format("cannot detect the input format from its first bytes (expected json)".into()))
+    } else {
+        Format::from_name(name)
+    }
+}
+
+/// `performance.now()` when the host has it (browser, worker, Node), else `Date.now()`.
+fn now_ms() -> Option<f64> {
+    let perf = Reflect::get(&js_sys::global(), &JsValue::from_str("performance")).ok()?;
+    if perf.is_object() {
+        let now = Reflect::get(&perf, &JsValue::from_str("now")).ok()?;
+        if let Some(f) = now.dyn_ref::<Function>() {
+            if let Some(t) = f.call0(&perf).ok().and_then(|v| v.as_f64()) {
+                return Some(t);
+            }
+        }
+    }
+    Some(js_sys::Date::now())
+}
+
+/// Reads the JS options object; every key must be known and every value a number.
+fn read_options(value: &JsValue) -> Result<MeshOptions, String> {
+    let mut options = MeshOptions::default();
+    if value.is_undefined() || value.is_null() {
+        return Ok(options);
+    }
+    if !value.is_object() || Array::is_array(value) {
+        return Err(format!("options: expected an object like {{ toleranceRel: 0.001 }}, found {}", type_name(value)));
+    }
+    let object: &Object = value.unchecked_ref();
+    for key in Object::keys(object).iter() {
+        let key = key.as_string().unwrap_or_default();
+        if !OPTION_NAMES.contains(&key.as_str()) {
+            return Err(format!("option {key}: unknown option (known: {})", OPTION_NAMES.join(", ")));
+        }
+    }
+    let absolute = number(object, "tolerance")?;
+    let relative = number(object, "toleranceRel")?;
+    match (absolute, relative) {
+        (Some(_), Some(_)) => return Err("option tolerance: give tolerance or toleranceRel, not both".into()),
+        (Some(t), None) => options = options.with_tolerance(t),
+        (None, Some(r)) => options = options.with_relative_tolerance(r),
+        (None, None) => {}
+    }
+    if let Some(a) = number(object, "angle")? {
+        options = options.with_angle(a);
+    }
+    if let Some(m) = number(object, "maxEdge")? {
+        options = options.with_max_edge(Some(m));
+    }
+    if let Some(m) = number(object, "minEdge")? {
+        options = options.with_min_edge(Some(m));
+    }
+    if let Some(n) = number(object, "maxTriangles")? {
+        if !(n.is_finite() && n >= 0.0 && n.fract() == 0.0 && n <= u32::MAX as f64) {
+            return Err(format!("option maxTriangles: expected a whole number, found {n}"));
+        }
+        options = options.with_max_triangles(n as usize);
+    }
+    Ok(options)
+}
+
+/// A number-valued option: `None` when absent (undefined or null).
+fn number(object: &Object, name: &str) -> Result<Option<f64>, String> {
+    let value = Reflect::get(object, &JsValue::from_str(name)).map_err(|_| format!("option {name}: cannot be read"))?;
+    if value.is_undefined() || value.is_null() {
+        return Ok(None);
+    }
+    match value.as_f64() {
+        Some(x) if x.is_finite() => Ok(Some(x)),
+        Some(x) => Err(format!("option {name}: expected a finite number, found {x}")),
+        None => Err(format!("option {name}: expected a number, found {}", type_name(&value))),
+    }
+}
+
+/// JS `typeof`-style name of a value, for error messages.
+fn type_name(value: &JsValue) -> String {
+    if value.is_null() {
+        "null".into()
+    } else if Array::is_array(value) {
+        "an array".into()
+    } else {
+        value.js_typeof().as_string().unwrap_or_default()
+    }
+}
+
+/// Builds `{ positions, normals, indices, faceRanges, report }`.
+fn to_js(result: &MeshResult) -> Result<JsValue, Error> {
+    let mesh = &result.mesh;
+    let flat =
+        |v: &[glam::DVec3]| -> Vec<f32> { v.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect() };
+    let ranges: Vec<u32> = mesh.face_ranges.iter().flat_map(|r| [r.first, r.count]).collect();
+    let report_json =
+        serde_json::to_string(&result.report).map_err(|e| Error::Internal(format!("report to JSON: {e}")))?;
+    let report = JSON::parse(&report_json).map_err(|_| Error::Internal("report JSON rejected by JSON.parse".into()))?;
+
+    let out = Object::new();
+    let fields: [(&str, JsValue); 5] = [
+        ("positions", Float32Array::from(flat(&mesh.positions).as_slice()).into()),
+        ("normals", Float32Array::from(flat(&mesh.normals).as_slice()).into()),
+        ("indices", Uint32Array::from(mesh.indices.as_slice()).into()),
+        ("faceRanges", Uint32Array::from(ranges.as_slice()).into()),
+        ("report", report),
+    ];
+    for (name, value) in fields {
+        Reflect::set(&out, &JsValue::from_str(name), &value)
+            .map_err(|_| Error::Internal(format!("cannot set result field {name}")))?;
+    }
+    Ok(out.into())
+}

@@ -1,0 +1,352 @@
+//! The JS binding (`src/wasm.rs`) in headless Node, through wasm-bindgen-test:
+//! `cargo test --target wasm32-unknown-unknown --test wasm_node`.
+//!
+//! `src/wasm.rs` is compiled into this test a second time (its module is
+//! private to the library); there `cfg(test)` leaves the JS exports off so the
+//! two copies do not clash. The calls below are the same Rust functions the
+//! exports wrap, returning the same JS values and `Error` objects.
+#![cfg(all(target_arch = "wasm32", target_os = "unknown"))]
+
+extern crate alloc;
+
+// Names `src/wasm.rs` reaches through `crate::`.
+#[allow(unused_imports)]
+use surfmesh::{mesh_model, read_model, Error, Format, MeshOptions, MeshResult};
+
+#[path = "../src/wasm.rs"]
+mod binding;
+
+use js_sys::{Float32Array, Object, Reflect, Uint32Array};
+use wasm_bindgen::{JsCast, JsValue};
+use wasm_bindgen_test::wasm_bindgen_test;
+
+/// The bundled freeform patch (bicubic, non-uniform knots, wavy z), 100 × 100 mm.
+const FREEFORM: &[u8] = include_bytes!("data/js_freeform.json");
+
+/// What `mesh` returned, copied out of the typed arrays.
+struct Output {
+    positions: Vec<f32>,
+    normals: Vec<f32>,
+    indices: Vec<u32>,
+    face_ranges: Vec<u32>,
+    report: JsValue,
+}
+
+impl Output {
+    fn number(&self, field: &str) -> f64 {
+        let v = Reflect::get(&self.report, &field.into()).expect("report field");
+        v.as_f64().unwrap_or_else(|| panic!("report.{field} is not a number: {v:?}"))
+    }
+
+    fn triangles(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    fn vertex(&self, i: u32) -> [f64; 3] {
+        let i = 3 * i as usize;
+        [self.positions[i] as f64, self.positions[i + 1] as f64, self.positions[i + 2] as f64]
+    }
+
+    fn longest_edge(&self) -> f64 {
+        let mut longest: f64 = 0.0;
+        for t in self.indices.chunks(3) {
+            for k in 0..3 {
+                let (a, b) = (self.vertex(t[k]), self.vertex(t[(k + 1) % 3]));
+                let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+                longest = longest.max(d);
+            }
+        }
+        longest
+    }
+
+    fn bbox_diagonal(&self) -> f64 {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in self.positions.chunks(3) {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k] as f64);
+                hi[k] = hi[k].max(p[k] as f64);
+            }
+        }
+        ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
+    }
+}
+
+/// A JS options object from name/value pairs.
+fn options(pairs: &[(&str, JsValue)]) -> JsValue {
+    let o = Object::new();
+    for (k, v) in pairs {
+        Reflect::set(&o, &(*k).into(), v).expect("set option");
+    }
+    o.into()
+}
+
+fn num(x: f64) -> JsValue {
+    JsValue::from_f64(x)
+}
+
+/// Calls the binding; on failure checks that what it throws is a JS `Error` and returns its message.
+fn call(bytes: &[u8], format: &str, opts: JsValue) -> Result<Output, String> {
+    match binding::mesh(bytes, format, opts) {
+        Ok(v) => {
+            let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
+            Ok(Output {
+                positions: get("positions").dyn_into::<Float32Array>().expect("positions").to_vec(),
+                normals: get("normals").dyn_into::<Float32Array>().expect("normals").to_vec(),
+                indices: get("indices").dyn_into::<Uint32Array>().expect("indices").to_vec(),
+                face_ranges: get("faceRanges").dyn_into::<Uint32Array>().expect("faceRanges").to_vec(),
+                report: get("report"),
+            })
+        }
+        Err(e) => {
+            let value = JsValue::from(e);
+            assert!(value.is_instance_of::<js_sys::Error>(), "thrown value is not an Error: {value:?}");
+            Err(value.unchecked_into::<js_sys::Error>().message().into())
+        }
+    }
+}
+
+fn ok(bytes: &[u8], opts: JsValue) -> Output {
+    call(bytes, "json", opts).unwrap_or_else(|m| panic!("mesh failed: {m}"))
+}
+
+fn err(bytes: &[u8], opts: JsValue) -> String {
+    match call(bytes, "auto", opts) {
+        Ok(out) => panic!("expected an error, got {} triangles", out.triangles()),
+        Err(m) => m,
+    }
+}
+
+/// A bicubic dome over 10 × 10 mm (4 × 4 control points, one Bézier patch),
+/// with the u knots, weights and loops given as JSON text.
+fn dome_with(knots_u: &str, weights: Option<&str>, loops: &str) -> Vec<u8> {
+    let mut rows = Vec::new();
+    for i in 0..4 {
+        let row: Vec<String> = (0..4)
+            .map(|j| {
+                let lift = if (1..=2).contains(&i) && (1..=2).contains(&j) { 4.0 } else { 0.0 };
+                format!("[{}, {}, {lift}]", 10.0 * i as f64 / 3.0, 10.0 * j as f64 / 3.0)
+            })
+            .collect();
+        rows.push(format!("[{}]", row.join(", ")));
+    }
+    let weights = weights.map(|w| format!(r#", "weights": {w}"#)).unwrap_or_default();
+    format!(
+        r#"{{ "units": "mm", "faces": [ {{ "name": "dome",
+              "surface": {{ "degree": [3, 3], "knots": [{knots_u}, [0, 0, 0, 0, 1, 1, 1, 1]],
+                            "points": [{}]{weights} }},
+              "loops": {loops} }} ] }}"#,
+        rows.join(", ")
+    )
+    .into_bytes()
+}
+
+const CUBIC_KNOTS: &str = "[0, 0, 0, 0, 1, 1, 1, 1]";
+
+fn dome() -> Vec<u8> {
+    dome_with(CUBIC_KNOTS, None, "[]")
+}
+
+/// A square trim loop of four lines in (u, v); `gap` moves the third line's start.
+fn square_loop(gap: f64) -> String {
+    let line = |a: (f64, f64), b: (f64, f64)| {
+        format!(r#"{{ "degree": 1, "knots": [0, 0, 1, 1], "points": [[{}, {}], [{}, {}]] }}"#, a.0, a.1, b.0, b.1)
+    };
+    format!(
+        r#"[ {{ "curves": [ {}, {}, {}, {} ] }} ]"#,
+        line((0.2, 0.2), (0.8, 0.2)),
+        line((0.8, 0.2), (0.8, 0.8)),
+        line((0.8, 0.8 + gap), (0.2, 0.8)),
+        line((0.2, 0.8), (0.2, 0.2)),
+    )
+}
+
+#[wasm_bindgen_test]
+fn version_is_the_crate_version() {
+    let v = binding::version();
+    assert_eq!(v.split('.').count(), 3, "{v}");
+    assert!(v.split('.').all(|p| p.parse::<u32>().is_ok()), "{v}");
+}
+
+#[wasm_bindgen_test]
+fn malformed_json_names_line_and_column() {
+    let m = err(b"{\n  \"faces\": [\n    { \"surface\": ,\n", JsValue::UNDEFINED);
+    assert!(m.starts_with("JSON line 3 column"), "{m}");
+}
+
+#[wasm_bindgen_test]
+fn truncated_input_is_an_error_not_a_trap() {
+    // Every prefix is invalid JSON; none may trap the module.
+    for cut in (0..FREEFORM.len() - 2).step_by(97) {
+        let m = err(&FREEFORM[..cut], JsValue::UNDEFINED);
+        assert!(m.starts_with("JSON line") || m.starts_with("format:"), "cut at {cut}: {m}");
+    }
+}
+
+#[wasm_bindgen_test]
+fn short_knot_vector_is_named() {
+    let m = err(&dome_with("[0, 0, 1, 1]", None, "[]"), JsValue::UNDEFINED);
+    assert!(m.contains("face 0 surface knots[0]"), "{m}");
+    assert!(m.contains("too short"), "{m}");
+}
+
+#[wasm_bindgen_test]
+fn decreasing_knots_are_named() {
+    let m = err(&dome_with("[0, 0, 0, 0.6, 0.4, 1, 1, 1, 1]", None, "[]"), JsValue::UNDEFINED);
+    assert!(m.contains("face 0 surface knots[0]"), "{m}");
+    assert!(m.contains("decrease"), "{m}");
+}
+
+#[wasm_bindgen_test]
+fn zero_weight_is_named() {
+    let weights = "[[1, 1, 1, 1], [1, 0, 1, 1], [1, 1, 1, 1], [1, 1, 1, 1]]";
+    let m = err(&dome_with(CUBIC_KNOTS, Some(weights), "[]"), JsValue::UNDEFINED);
+    assert!(m.contains("face 0 surface weights[1][1]"), "{m}");
+    assert!(m.contains("weight"), "{m}");
+}
+
+#[wasm_bindgen_test]
+fn open_loop_is_named() {
+    let m = err(&dome_with(CUBIC_KNOTS, None, &square_loop(0.05)), JsValue::UNDEFINED);
+    assert!(m.contains("face 0 loop 0"), "{m}");
+    assert!(m.contains("does not close"), "{m}");
+}
+
+#[wasm_bindgen_test]
+fn bad_options_are_named() {
+    let cases: [(JsValue, &str); 8] = [
+        (options(&[("tolerance", "fine".into())]), "option tolerance: expected a number, found string"),
+        (options(&[("tol", num(0.1))]), "option tol: unknown option"),
+        (options(&[("tolerance", num(0.1)), ("toleranceRel", num(0.01))]), "not both"),
+        (options(&[("angle", num(f64::NAN))]), "option angle: expected a finite number"),
+        (options(&[("maxTriangles", num(2.5))]), "option maxTriangles"),
+        (options(&[("maxEdge", num(-1.0))]), "option --max-edge"),
+        (options(&[("toleranceRel", num(2.0))]), "option --tol-rel"),
+        (num(5.0), "options: expected an object"),
+    ];
+    for (opts, expected) in cases {
+        let m = err(&dome(), opts);
+        assert!(m.contains(expected), "expected {expected:?} in {m:?}");
+    }
+}
+
+#[wasm_bindgen_test]
+fn unknown_format_is_named() {
+    let m = call(&dome(), "step", JsValue::UNDEFINED).err().expect("step is not supported");
+    assert!(m.starts_with("format:") && m.contains("step"), "{m}");
+    let m = err(b"ISO-10303-21;", JsValue::UNDEFINED);
+    assert!(m.starts_with("format:"), "{m}");
+}
+
+#[wasm_bindgen_test]
+fn mesh_arrays_agree_with_the_report() {
+    let out = ok(&dome(), JsValue::UNDEFINED);
+    let vertices = out.number("vertices") as usize;
+    let triangles = out.number("triangles") as usize;
+    assert!(triangles >= 2, "{triangles} triangles");
+    assert_eq!(out.positions.len(), 3 * vertices);
+    assert_eq!(out.normals.len(), 3 * vertices);
+    assert_eq!(out.indices.len(), 3 * triangles);
+    assert!(out.indices.iter().all(|&i| (i as usize) < vertices), "index out of range");
+    for n in out.normals.chunks(3) {
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        assert!((len - 1.0).abs() < 1e-4, "normal of length {len}");
+    }
+    // One (first, count) pair per face, covering every triangle in order.
+    assert_eq!(out.face_ranges.len(), 2 * out.number("faces") as usize);
+    let mut next = 0;
+    for r in out.face_ranges.chunks(2) {
+        assert_eq!(r[0], next);
+        next += r[1];
+    }
+    assert_eq!(next as usize, triangles);
+    // Default tolerance: 1e-3 of the (trimmed) model's diagonal, and the mesh meets it.
+    let tolerance = out.number("tolerance");
+    let expected = 1e-3 * out.bbox_diagonal();
+    assert!((tolerance - expected).abs() <= 0.02 * expected, "tolerance {tolerance}, diagonal says {expected}");
+    assert!(out.number("max_deviation") <= tolerance, "deviation {} > {tolerance}", out.number("max_deviation"));
+    let warnings = Reflect::get(&out.report, &"warnings".into()).expect("warnings");
+    assert!(js_sys::Array::is_array(&warnings));
+}
+
+#[wasm_bindgen_test]
+fn format_detection_matches_the_named_format() {
+    let named = ok(&dome(), JsValue::UNDEFINED);
+    for format in ["", "auto", "JSON", ".json"] {
+        let out = call(&dome(), format, JsValue::UNDEFINED).unwrap_or_else(|m| panic!("format {format:?}: {m}"));
+        assert_eq!(out.indices, named.indices, "format {format:?}");
+    }
+}
+
+#[wasm_bindgen_test]
+fn tighter_tolerance_gives_more_triangles_within_it() {
+    let coarse = ok(FREEFORM, options(&[("tolerance", num(0.5))]));
+    let fine = ok(FREEFORM, options(&[("tolerance", num(0.02))]));
+    for (out, tol) in [(&coarse, 0.5), (&fine, 0.02)] {
+        assert_eq!(out.number("tolerance"), tol);
+        assert!(out.number("max_deviation") <= tol, "deviation {} > {tol}", out.number("max_deviation"));
+    }
+    assert!(
+        fine.triangles() > 2 * coarse.triangles(),
+        "{} triangles at 0.02 vs {} at 0.5",
+        fine.triangles(),
+        coarse.triangles()
+    );
+}
+
+#[wasm_bindgen_test]
+fn relative_tolerance_scales_with_the_model() {
+    let out = ok(FREEFORM, options(&[("toleranceRel", num(2e-3))]));
+    let expected = 2e-3 * out.bbox_diagonal();
+    let tolerance = out.number("tolerance");
+    assert!((tolerance - expected).abs() <= 0.02 * expected, "tolerance {tolerance}, expected about {expected}");
+    assert!(out.number("max_deviation") <= tolerance);
+}
+
+#[wasm_bindgen_test]
+fn max_edge_bounds_every_edge() {
+    let free = ok(FREEFORM, options(&[("tolerance", num(0.5))]));
+    let limit = 6.0;
+    assert!(free.longest_edge() > limit, "without maxEdge the longest edge is {}", free.longest_edge());
+    let bounded = ok(FREEFORM, options(&[("tolerance", num(0.5)), ("maxEdge", num(limit))]));
+    // f32 positions: allow their rounding.
+    assert!(bounded.longest_edge() <= limit * (1.0 + 1e-5), "longest edge {}", bounded.longest_edge());
+    assert!(bounded.triangles() > free.triangles());
+}
+
+#[wasm_bindgen_test]
+fn smaller_angle_gives_more_triangles() {
+    let wide = ok(FREEFORM, options(&[("tolerance", num(1.0)), ("angle", num(1.0))]));
+    let narrow = ok(FREEFORM, options(&[("tolerance", num(1.0)), ("angle", num(0.1))]));
+    assert_eq!(narrow.number("angle"), 0.1);
+    assert!(narrow.triangles() > wide.triangles(), "{} vs {}", narrow.triangles(), wide.triangles());
+}
+
+#[wasm_bindgen_test]
+fn min_edge_stops_refinement() {
+    let free = ok(FREEFORM, options(&[("tolerance", num(0.01))]));
+    let stopped = ok(FREEFORM, options(&[("tolerance", num(0.01)), ("minEdge", num(10.0))]));
+    assert!(stopped.triangles() < free.triangles(), "{} vs {}", stopped.triangles(), free.triangles());
+}
+
+#[wasm_bindgen_test]
+fn trimmed_dome_keeps_only_the_inside() {
+    let out = ok(&dome_with(CUBIC_KNOTS, None, &square_loop(0.0)), JsValue::UNDEFINED);
+    assert!(out.triangles() >= 2);
+    // The loop keeps u, v in [0.2, 0.8]; on this patch x = 10 u and y = 10 v exactly
+    // (linear precision of the evenly spaced control columns).
+    for p in out.positions.chunks(3) {
+        for c in [p[0], p[1]] {
+            assert!((1.999..=8.001).contains(&c), "vertex {p:?} outside the loop");
+        }
+    }
+}
+
+#[wasm_bindgen_test]
+fn module_keeps_working_after_errors() {
+    for bad in [&b"{"[..], b"", b"{\"faces\": 3}"] {
+        assert!(call(bad, "auto", JsValue::UNDEFINED).is_err());
+    }
+    let out = ok(&dome(), options(&[("tolerance", num(0.05))]));
+    assert!(out.triangles() >= 2);
+}
