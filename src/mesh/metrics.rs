@@ -10,9 +10,10 @@ use super::{weld_positions, Mesh};
 pub struct EdgeCounts {
     /// Edges with exactly one triangle.
     pub boundary_edges: usize,
-    /// Boundary edges that face other boundary geometry within the sewing
-    /// distance: two borders lying on each other unconnected, or a T-junction.
-    /// An open sheet's true border is not a crack.
+    /// Boundary edges that run along the border of another face within the
+    /// sewing distance without being connected to it (unwelded borders,
+    /// T-junctions): cracks. A face's border that meets no other face is the
+    /// model's open boundary, not a crack.
     pub free_edges: usize,
     /// Edges with more than two triangles.
     pub nonmanifold_edges: usize,
@@ -31,13 +32,16 @@ pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
     }
     // Directed edge counts keyed by the undirected pair.
     let mut edges: hashbrown::HashMap<(u32, u32), (u32, u32)> = hashbrown::HashMap::new();
-    for t in mesh.indices.chunks_exact(3) {
+    let mut owner: hashbrown::HashMap<(u32, u32), u32> = hashbrown::HashMap::new();
+    let face_of = face_lookup(mesh);
+    for (ti, t) in mesh.indices.chunks_exact(3).enumerate() {
         let v = [map[t[0] as usize], map[t[1] as usize], map[t[2] as usize]];
         if v[0] == v[1] || v[1] == v[2] || v[2] == v[0] {
             continue; // collapsed by welding (pole)
         }
         for k in 0..3 {
             let (a, b) = (v[k], v[(k + 1) % 3]);
+            owner.insert((a.min(b), a.max(b)), face_of(ti));
             let e = edges.entry((a.min(b), a.max(b))).or_insert((0, 0));
             if a < b {
                 e.0 += 1;
@@ -47,10 +51,10 @@ pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
         }
     }
     let mut out = EdgeCounts::default();
-    let mut free: Vec<(u32, u32)> = Vec::new();
+    let mut free: Vec<(u32, u32, u32)> = Vec::new();
     for (&k, &(f, r)) in &edges {
         match f + r {
-            1 => free.push(k),
+            1 => free.push((k.0, k.1, owner.get(&k).copied().unwrap_or(0))),
             2 => {
                 if f != 1 {
                     out.misoriented_edges += 1;
@@ -64,9 +68,18 @@ pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
     out
 }
 
-/// A free edge is a crack when a vertex or midpoint of another free edge lies
-/// within `sew` of its quarter, half or three-quarter point.
-fn count_cracks(free: &[(u32, u32)], pos: &[DVec3], sew: f64) -> usize {
+/// Face index of each triangle, from the mesh's face ranges (0 when absent).
+fn face_lookup(mesh: &Mesh) -> impl Fn(usize) -> u32 + '_ {
+    move |t: usize| {
+        let i = mesh.face_ranges.partition_point(|r| (r.first as usize + r.count as usize) <= t);
+        i.min(mesh.face_ranges.len().saturating_sub(1)) as u32
+    }
+}
+
+/// A free edge is a crack when a vertex or midpoint of a free edge of another
+/// face lies within `sew` (and within a fifth of the edge's length) of its
+/// quarter, half or three-quarter point.
+fn count_cracks(free: &[(u32, u32, u32)], pos: &[DVec3], sew: f64) -> usize {
     if free.is_empty() || !(sew > 0.0 && sew.is_finite()) {
         return 0;
     }
@@ -79,23 +92,25 @@ fn count_cracks(free: &[(u32, u32)], pos: &[DVec3], sew: f64) -> usize {
     #[derive(Clone, Copy)]
     enum Tag {
         Vertex(u32),
-        Mid(usize),
+        Mid,
     }
-    let mut grid: hashbrown::HashMap<(i64, i64, i64), Vec<(DVec3, Tag)>> = hashbrown::HashMap::new();
+    let mut grid: hashbrown::HashMap<(i64, i64, i64), Vec<(DVec3, Tag, u32)>> = hashbrown::HashMap::new();
     let mut seen = hashbrown::HashSet::new();
-    for (i, &(a, b)) in free.iter().enumerate() {
+    for &(a, b, f) in free {
         for v in [a, b] {
-            if seen.insert(v) {
+            if seen.insert((v, f)) {
                 let p = pos[v as usize];
-                grid.entry(key(p)).or_default().push((p, Tag::Vertex(v)));
+                grid.entry(key(p)).or_default().push((p, Tag::Vertex(v), f));
             }
         }
         let m = (pos[a as usize] + pos[b as usize]) * 0.5;
-        grid.entry(key(m)).or_default().push((m, Tag::Mid(i)));
+        grid.entry(key(m)).or_default().push((m, Tag::Mid, f));
     }
     let mut cracks = 0;
-    for (i, &(a, b)) in free.iter().enumerate() {
+    for &(a, b, face) in free {
         let (pa, pb) = (pos[a as usize], pos[b as usize]);
+        // Relative to the edge too: an open border's own neighbours sit half an edge away.
+        let reach = sew.min(0.2 * pa.distance(pb));
         let mut hit = false;
         'probe: for f in [0.25, 0.5, 0.75] {
             let q = pa.lerp(pb, f);
@@ -104,12 +119,13 @@ fn count_cracks(free: &[(u32, u32)], pos: &[DVec3], sew: f64) -> usize {
                 for dy in -1..=1 {
                     for dz in -1..=1 {
                         let Some(list) = grid.get(&(kx + dx, ky + dy, kz + dz)) else { continue };
-                        for &(p, tag) in list {
-                            let other = match tag {
-                                Tag::Vertex(v) => v != a && v != b,
-                                Tag::Mid(j) => j != i,
-                            };
-                            if other && p.distance(q) < sew {
+                        for &(p, tag, f) in list {
+                            let other = f != face
+                                && match tag {
+                                    Tag::Vertex(v) => v != a && v != b,
+                                    Tag::Mid => true,
+                                };
+                            if other && p.distance(q) < reach {
                                 hit = true;
                                 break 'probe;
                             }

@@ -1,1 +1,267 @@
-//! Tests: mesh (to be written).
+//! Meshing acceptance: deviation within tolerance (the project's own
+//! measurement and, for analytic shapes, the exact distance), no inverted
+//! triangles, watertight closed surfaces, trimmed vertices inside the kept
+//! region, triangle counts that follow the tolerance, and errors for bad loops.
+
+use glam::{DVec2, DVec3};
+use surfmesh::{
+    mesh_model, project_to_surface, Error, Face, FaceSurface, Mesh, MeshOptions, MeshResult, Model, NurbsCurve,
+    ProjectionOptions, Surface, TrimLoop,
+};
+
+use crate::shapes;
+
+const RELS: [f64; 3] = [1e-1, 1e-2, 1e-3];
+
+fn mesh(model: &Model, rel: f64) -> MeshResult {
+    mesh_model(model, &MeshOptions::default().with_relative_tolerance(rel)).expect("meshes")
+}
+
+/// Largest exact distance over vertices, edge midpoints and interior points of every triangle.
+fn exact_deviation(m: &Mesh, dist: impl Fn(DVec3) -> f64) -> f64 {
+    let mut worst: f64 = 0.0;
+    let bary = [
+        [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0],
+        [0.5, 0.5, 0.0],
+        [0.0, 0.5, 0.5],
+        [0.5, 0.0, 0.5],
+        [0.6, 0.3, 0.1],
+        [0.1, 0.6, 0.3],
+        [0.3, 0.1, 0.6],
+        [1.0, 0.0, 0.0],
+    ];
+    for t in 0..m.triangle_count() {
+        let p = m.triangle(t);
+        for b in bary {
+            worst = worst.max(dist(p[0] * b[0] + p[1] * b[1] + p[2] * b[2]));
+        }
+    }
+    worst
+}
+
+/// Checks every promise of one mesh result; returns the triangle count.
+fn check_common(name: &str, r: &MeshResult, rel: f64) -> usize {
+    let rep = &r.report;
+    assert!(rep.triangles > 0, "{name} @ {rel}: no triangles");
+    assert!(
+        rep.max_deviation <= rep.tolerance,
+        "{name} @ {rel}: measured deviation {} above tolerance {}",
+        rep.max_deviation,
+        rep.tolerance
+    );
+    assert_eq!(rep.inverted_triangles, 0, "{name} @ {rel}: inverted triangles");
+    assert_eq!(rep.free_edges, 0, "{name} @ {rel}: cracks");
+    assert_eq!(rep.nonmanifold_edges, 0, "{name} @ {rel}: non-manifold edges");
+    assert!(rep.warnings.is_empty(), "{name} @ {rel}: warnings {:?}", rep.warnings);
+    assert_eq!(r.mesh.indices.len(), 3 * rep.triangles);
+    assert_eq!(r.mesh.positions.len(), rep.vertices);
+    assert_eq!(r.mesh.normals.len(), rep.vertices);
+    for n in &r.mesh.normals {
+        assert!((n.length() - 1.0).abs() < 1e-9, "{name}: normal not unit");
+    }
+    // Facets agree with the stored vertex normals (no flipped triangle).
+    for t in 0..r.mesh.triangle_count() {
+        let p = r.mesh.triangle(t);
+        let f = (p[1] - p[0]).cross(p[2] - p[0]);
+        let i = &r.mesh.indices[3 * t..3 * t + 3];
+        let n: DVec3 = i.iter().map(|&k| r.mesh.normals[k as usize]).sum();
+        assert!(f.dot(n) >= 0.0, "{name} @ {rel}: triangle {t} faces against the surface normals");
+    }
+    rep.triangles
+}
+
+fn counts_follow_tolerance(name: &str, counts: &[usize]) {
+    for w in counts.windows(2) {
+        assert!(
+            w[1] as f64 <= 12.0 * w[0] as f64,
+            "{name}: 10x tighter tolerance gave more than 12x the triangles {counts:?}"
+        );
+    }
+}
+
+#[test]
+fn mesh_freeform_within_tolerance() {
+    let model = shapes::freeform();
+    let counts: Vec<usize> = RELS.iter().map(|&rel| check_common("freeform", &mesh(&model, rel), rel)).collect();
+    counts_follow_tolerance("freeform", &counts);
+}
+
+#[test]
+fn mesh_sphere_exact_and_closed() {
+    let model = shapes::sphere(shapes::SPHERE_RADIUS);
+    let mut counts = Vec::new();
+    for rel in RELS {
+        let r = mesh(&model, rel);
+        counts.push(check_common("sphere", &r, rel));
+        assert_eq!(r.report.boundary_edges, 0, "sphere @ {rel}: open edges");
+        let exact = exact_deviation(&r.mesh, shapes::sphere_distance);
+        assert!(exact <= r.report.tolerance, "sphere @ {rel}: exact deviation {exact} > {}", r.report.tolerance);
+    }
+    counts_follow_tolerance("sphere", &counts);
+}
+
+#[test]
+fn mesh_torus_exact_and_closed() {
+    let model = shapes::torus(shapes::TORUS_MAJOR, shapes::TORUS_MINOR);
+    let mut counts = Vec::new();
+    for rel in RELS {
+        let r = mesh(&model, rel);
+        counts.push(check_common("torus", &r, rel));
+        assert_eq!(r.report.boundary_edges, 0, "torus @ {rel}: free edges on a closed surface");
+        let exact = exact_deviation(&r.mesh, shapes::torus_distance);
+        assert!(exact <= r.report.tolerance, "torus @ {rel}: exact deviation {exact} > {}", r.report.tolerance);
+    }
+    counts_follow_tolerance("torus", &counts);
+}
+
+#[test]
+fn mesh_cylinder_exact() {
+    let model = shapes::cylinder();
+    let mut counts = Vec::new();
+    for rel in RELS {
+        let r = mesh(&model, rel);
+        counts.push(check_common("cylinder", &r, rel));
+        let exact = exact_deviation(&r.mesh, shapes::cylinder_distance);
+        assert!(exact <= r.report.tolerance, "cylinder @ {rel}: exact deviation {exact}");
+    }
+    counts_follow_tolerance("cylinder", &counts);
+}
+
+#[test]
+fn mesh_pole_surface() {
+    let model = shapes::pole();
+    let counts: Vec<usize> = RELS.iter().map(|&rel| check_common("pole", &mesh(&model, rel), rel)).collect();
+    counts_follow_tolerance("pole", &counts);
+}
+
+#[test]
+fn mesh_trimmed_two_holes_vertices_inside() {
+    let model = shapes::trimmed_holes();
+    let region = shapes::trimmed_holes_regions();
+    let surface = shapes::first_surface(&model);
+    let mut counts = Vec::new();
+    for rel in RELS {
+        let r = mesh(&model, rel);
+        counts.push(check_common("trimmed_holes", &r, rel));
+        for (i, &p) in r.mesh.positions.iter().enumerate() {
+            let pr = project_to_surface(surface, p, None, &ProjectionOptions::default());
+            assert!(pr.distance < 1e-9 * (1.0 + p.length()), "vertex {i} is off the surface by {}", pr.distance);
+            assert!(
+                region.contains(pr.uv, 1e-7),
+                "trimmed_holes @ {rel}: vertex {i} at {:?} lies {} outside the kept region",
+                pr.uv,
+                region.outside_by(pr.uv)
+            );
+        }
+        // The holes really are holes: no triangle centroid inside either circle.
+        for t in 0..r.mesh.triangle_count() {
+            let p = r.mesh.triangle(t);
+            let c = (p[0] + p[1] + p[2]) / 3.0;
+            let uv = project_to_surface(surface, c, None, &ProjectionOptions::default()).uv;
+            for &(centre, radius) in &region.holes {
+                assert!(uv.distance(centre) > radius * 0.9, "triangle {t} covers a hole");
+            }
+        }
+    }
+    counts_follow_tolerance("trimmed_holes", &counts);
+}
+
+#[test]
+fn mesh_angle_and_max_edge_limits_hold() {
+    let model = shapes::freeform();
+    let coarse = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-2)).expect("meshes");
+    let limited = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-2).with_max_edge(Some(5.0)))
+        .expect("meshes");
+    assert!(limited.report.triangles > coarse.report.triangles);
+    let m = &limited.mesh;
+    for t in 0..m.triangle_count() {
+        let p = m.triangle(t);
+        for k in 0..3 {
+            assert!(p[k].distance(p[(k + 1) % 3]) <= 5.0 + 1e-9, "edge longer than max_edge");
+        }
+    }
+    let tight =
+        mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-1).with_angle(0.1)).expect("meshes");
+    assert!(tight.report.max_normal_turn <= 0.1 + 1e-12, "normal turn {}", tight.report.max_normal_turn);
+}
+
+fn uv_polygon(pts: &[(f64, f64)]) -> TrimLoop {
+    let n = pts.len();
+    let curves = (0..n)
+        .map(|i| {
+            let (a, b) = (pts[i], pts[(i + 1) % n]);
+            NurbsCurve::try_new(
+                1,
+                vec![0.0, 0.0, 1.0, 1.0],
+                vec![DVec3::new(a.0, a.1, 0.0), DVec3::new(b.0, b.1, 0.0)],
+                None,
+            )
+            .expect("segment")
+        })
+        .collect();
+    TrimLoop { curves }
+}
+
+fn face_with_loops(loops: Vec<TrimLoop>) -> Model {
+    let surface = shapes::first_surface(&shapes::freeform()).clone();
+    Model {
+        units: "mm".into(),
+        faces: vec![Face { name: None, surface: FaceSurface::Nurbs(surface), loops }],
+        warnings: vec![],
+    }
+}
+
+#[test]
+fn mesh_rejects_crossing_loops() {
+    let outer = uv_polygon(&[(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9)]);
+    let a = uv_polygon(&[(0.3, 0.3), (0.6, 0.3), (0.6, 0.6), (0.3, 0.6)]);
+    let b = uv_polygon(&[(0.5, 0.5), (0.8, 0.5), (0.8, 0.8), (0.5, 0.8)]);
+    let err = mesh_model(&face_with_loops(vec![outer, a, b]), &MeshOptions::default()).expect_err("loops cross");
+    let msg = err.to_string();
+    assert!(matches!(err, Error::Mesh { face: 0, .. }), "{msg}");
+    assert!(msg.contains("face 0") && msg.contains("crosses"), "{msg}");
+
+    let bow = uv_polygon(&[(0.1, 0.1), (0.9, 0.9), (0.9, 0.1), (0.1, 0.9)]);
+    let msg = mesh_model(&face_with_loops(vec![bow]), &MeshOptions::default()).expect_err("self-crossing").to_string();
+    assert!(msg.contains("crosses itself"), "{msg}");
+}
+
+#[test]
+fn mesh_rejects_bad_options() {
+    let model = shapes::freeform();
+    for opts in [
+        MeshOptions::default().with_tolerance(0.0),
+        MeshOptions::default().with_tolerance(f64::NAN),
+        MeshOptions::default().with_relative_tolerance(2.0),
+        MeshOptions::default().with_angle(-1.0),
+        MeshOptions::default().with_max_edge(Some(0.0)),
+    ] {
+        assert!(matches!(mesh_model(&model, &opts), Err(Error::Options(_))));
+    }
+}
+
+#[test]
+fn mesh_budget_is_respected_with_a_warning() {
+    let model = shapes::freeform();
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-3).with_max_triangles(20));
+    match r {
+        Err(Error::Limit(msg)) => assert!(msg.contains("budget"), "{msg}"),
+        Ok(r) => {
+            assert!(r.report.triangles <= 22, "{}", r.report.triangles);
+            assert!(!r.report.warnings.is_empty());
+        }
+        Err(e) => panic!("unexpected error {e}"),
+    }
+}
+
+#[test]
+fn mesh_uv_hint_helper_agrees_with_surface() {
+    // The sphere's collapsed edge still has a unit normal that points away from the centre.
+    let s = shapes::sphere_surface(shapes::SPHERE_RADIUS);
+    let [lo, hi] = s.domain();
+    for uv in [lo, DVec2::new(hi.x, lo.y), DVec2::new(0.3, lo.y), DVec2::new(0.3, hi.y)] {
+        let p = s.point(uv);
+        let n = s.normal(uv);
+        assert!((n.dot(p.normalize()).abs() - 1.0).abs() < 1e-6, "pole normal {n:?} at {p:?}");
+    }
+}
