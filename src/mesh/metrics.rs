@@ -94,7 +94,8 @@ fn count_cracks(free: &[(u32, u32, u32)], pos: &[DVec3], sew: f64) -> usize {
         Vertex(u32),
         Mid,
     }
-    let mut grid: hashbrown::HashMap<(i64, i64, i64), Vec<(DVec3, Tag, u32)>> = hashbrown::HashMap::new();
+    type Cells = hashbrown::HashMap<(i64, i64, i64), Vec<(DVec3, Tag, u32)>>;
+    let mut grid: Cells = hashbrown::HashMap::new();
     let mut seen = hashbrown::HashSet::new();
     for &(a, b, f) in free {
         for v in [a, b] {
