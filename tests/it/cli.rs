@@ -462,6 +462,18 @@ fn cli_rejects_loop_point_with_three_coordinates() {
 }
 
 #[test]
+fn cli_failure_keeps_an_existing_output() {
+    let dir = scratch("keep");
+    let out_path = dir.join("out.obj");
+    std::fs::write(&out_path, b"previous").unwrap();
+    let out = run(&["mesh".as_ref(), data("bad_weight_zero.json").as_os_str(), "-o".as_ref(), out_path.as_os_str()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(std::fs::read(&out_path).unwrap(), b"previous");
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
 fn cli_names_a_missing_file() {
     let out = run(&["mesh".as_ref(), data("no_such_file.json").as_os_str()]);
     let err = stderr(&out);
@@ -507,4 +519,210 @@ fn cli_help_prints_usage() {
     for option in ["mesh INPUT", "--tol", "--tol-rel", "--angle", "--max-edge", "-o", "--report"] {
         assert!(text.contains(option), "{option} missing from usage");
     }
+}
+
+// ---------------------------------------------------------------- command line, success
+
+const REPORT_FIELDS: [&str; 13] = [
+    "tolerance",
+    "faces",
+    "triangles",
+    "vertices",
+    "max_deviation",
+    "mean_deviation",
+    "min_angle_deg",
+    "free_edges",
+    "nonmanifold_edges",
+    "inverted_triangles",
+    "time_ms",
+    "parse_ms",
+    "warnings",
+];
+
+/// Checks the report has DESIGN.md's fields and a deviation within tolerance; returns it.
+fn check_report(text: &[u8]) -> Value {
+    let report: Value = serde_json::from_slice(text).unwrap();
+    for field in REPORT_FIELDS {
+        assert!(report.get(field).is_some(), "report lacks {field}: {report}");
+    }
+    let num = |f: &str| report[f].as_f64().unwrap();
+    assert!(num("tolerance") > 0.0);
+    assert!(num("max_deviation") <= num("tolerance"), "{report}");
+    assert!(num("mean_deviation") <= num("max_deviation"));
+    assert!(num("triangles") >= 1.0);
+    assert!(num("time_ms") >= 0.0 && num("parse_ms") >= 0.0);
+    assert!(report["warnings"].is_array());
+    report
+}
+
+fn mesh_ok(args: &[&std::ffi::OsStr]) -> Output {
+    let out = run(args);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    out
+}
+
+#[test]
+fn cli_meshes_the_plane_to_every_format() {
+    let dir = scratch("plane");
+    let plane = data("plane.json");
+    let mut triangles = None;
+    for ext in ["stl", "obj", "glb"] {
+        let (out_path, report_path) = (dir.join(format!("plane.{ext}")), dir.join(format!("{ext}.json")));
+        let out = mesh_ok(&[
+            "mesh".as_ref(),
+            plane.as_os_str(),
+            "--tol".as_ref(),
+            "0.01".as_ref(),
+            "-o".as_ref(),
+            out_path.as_os_str(),
+            "--report".as_ref(),
+            report_path.as_os_str(),
+        ]);
+        assert!(out.stdout.is_empty(), "report printed although --report was given");
+        let err = stderr(&out);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains("triangles") && err.contains("plane.json"), "{err}");
+        let report = check_report(&std::fs::read(&report_path).unwrap());
+        assert_eq!(report["tolerance"], 0.01);
+        assert_eq!(report["faces"], 1);
+        assert_eq!(report["free_edges"], 0);
+        assert_eq!(report["nonmanifold_edges"], 0);
+        assert_eq!(report["inverted_triangles"], 0);
+        let n = report["triangles"].as_u64().unwrap() as usize;
+        assert_eq!(*triangles.get_or_insert(n), n, "same input, same mesh");
+        let bytes = std::fs::read(&out_path).unwrap();
+        match ext {
+            "stl" => {
+                assert_eq!(bytes.len(), 84 + 50 * n);
+                assert_eq!(u32_at(&bytes, 80) as usize, n);
+            }
+            "obj" => {
+                let text = String::from_utf8(bytes).unwrap();
+                assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), n);
+                let v = text.lines().filter(|l| l.starts_with("v ")).count();
+                assert_eq!(v as u64, report["vertices"].as_u64().unwrap());
+            }
+            _ => {
+                let (doc, _) = open_glb(&bytes);
+                let accessors = doc["accessors"].as_array().unwrap();
+                let prims = doc["meshes"][0]["primitives"].as_array().unwrap();
+                let indices: u64 = prims
+                    .iter()
+                    .map(|p| accessors[p["indices"].as_u64().unwrap() as usize]["count"].as_u64().unwrap())
+                    .sum();
+                assert_eq!(indices as usize, 3 * n);
+            }
+        }
+    }
+    // Only the requested files, no temporaries left.
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 6);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn cli_prints_the_report_without_outputs_and_honours_tol_rel() {
+    let out = mesh_ok(&["mesh".as_ref(), data("plane.json").as_os_str(), "--tol-rel".as_ref(), "0.001".as_ref()]);
+    let report = check_report(&out.stdout);
+    // The plate is 10 × 10: its diagonal is 10·√2.
+    let expected = 0.001 * 10.0 * 2f64.sqrt();
+    assert!((report["tolerance"].as_f64().unwrap() - expected).abs() < 1e-9 * expected, "{report}");
+}
+
+#[test]
+fn cli_meshes_a_trimmed_face_with_a_hole() {
+    let dir = scratch("twisted");
+    let out_path = dir.join("twisted.obj");
+    let out = mesh_ok(&[
+        "mesh".as_ref(),
+        data("twisted.json").as_os_str(),
+        "--tol".as_ref(),
+        "0.1".as_ref(),
+        "-o".as_ref(),
+        out_path.as_os_str(),
+    ]);
+    assert!(out.stdout.is_empty());
+    // The hole, as a fine polygon in (u,v) from the model's own trim curves.
+    let model = read_data("twisted.json").unwrap();
+    let hole: Vec<glam::DVec2> = model.faces[0].loops[1]
+        .curves
+        .iter()
+        .flat_map(|c| {
+            let (a, b) = c.domain();
+            (0..500).map(move |k| c.point(a + (b - a) * f64::from(k) / 500.0).truncate())
+        })
+        .collect();
+    let obj = String::from_utf8(std::fs::read(&out_path).unwrap()).unwrap();
+    let mut uvs = Vec::new();
+    for line in obj.lines().filter(|l| l.starts_with("v ")) {
+        let p: Vec<f64> = line[2..].split(' ').map(|x| x.parse().unwrap()).collect();
+        // On this patch x = 10u and y = 10v.
+        let uv = glam::DVec2::new(p[0] / 10.0, p[1] / 10.0);
+        assert!(!strictly_inside(&hole, uv, 1e-4), "vertex {p:?} lies in the hole");
+        uvs.push(uv);
+    }
+    // The triangles cover the unit square minus the hole, and not a point deep inside it.
+    let cross = |a: glam::DVec2, b: glam::DVec2| a.perp_dot(b);
+    let probe = glam::DVec2::new(0.6, 0.35);
+    let mut area = 0.0;
+    for line in obj.lines().filter(|l| l.starts_with("f ")) {
+        let t: Vec<glam::DVec2> =
+            line[2..].split(' ').map(|v| uvs[v.split("//").next().unwrap().parse::<usize>().unwrap() - 1]).collect();
+        let twice = cross(t[1] - t[0], t[2] - t[0]);
+        area += twice / 2.0;
+        let sides = [0, 1, 2].map(|k| cross(t[(k + 1) % 3] - t[k], probe - t[k]) * twice.signum());
+        assert!(sides.iter().any(|&s| s < 0.0), "triangle {t:?} covers the hole");
+    }
+    let hole_area: f64 = (0..hole.len()).map(|k| cross(hole[k], hole[(k + 1) % hole.len()]) / 2.0).sum();
+    let expected = 1.0 - hole_area.abs();
+    assert!((area.abs() - expected).abs() < 0.01 * expected, "area {area}, expected {expected}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn cli_detects_the_format_without_an_extension() {
+    let dir = scratch("detect");
+    let input = dir.join("model.data");
+    std::fs::copy(data("plane.json"), &input).unwrap();
+    let out = mesh_ok(&["mesh".as_ref(), input.as_os_str()]);
+    check_report(&out.stdout);
+    let out = mesh_ok(&["mesh".as_ref(), input.as_os_str(), "--format".as_ref(), "json".as_ref()]);
+    check_report(&out.stdout);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn cli_writes_nothing_when_one_output_fails() {
+    let dir = scratch("all-or-nothing");
+    let out_path = dir.join("out.stl");
+    let report_path = dir.join("missing-dir").join("report.json");
+    let out = run(&[
+        "mesh".as_ref(),
+        data("plane.json").as_os_str(),
+        "-o".as_ref(),
+        out_path.as_os_str(),
+        "--report".as_ref(),
+        report_path.as_os_str(),
+    ]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("cannot write") && err.contains("report.json"), "{err}");
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "output written although the report failed");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Whether `p` lies inside the closed polygon and farther than `margin` from its edges.
+fn strictly_inside(polygon: &[glam::DVec2], p: glam::DVec2, margin: f64) -> bool {
+    let mut inside = false;
+    for (k, &a) in polygon.iter().enumerate() {
+        let b = polygon[(k + 1) % polygon.len()];
+        let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+        if p.distance(a + (b - a) * t) <= margin {
+            return false;
+        }
+        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+            inside = !inside;
+        }
+    }
+    inside
 }
