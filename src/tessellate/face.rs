@@ -12,9 +12,11 @@ use crate::nurbs::Surface;
 use crate::Error;
 
 /// A meshed face: its work mesh and what refinement measured.
-pub(crate) struct FaceResult {
+pub(crate) struct FaceResult<'a> {
     pub mesh: WorkMesh,
     pub outcome: Outcome,
+    /// The face's trim curves, as its trim edges index them.
+    pub curves: Vec<&'a crate::NurbsCurve>,
 }
 
 /// Grid parameters in both directions over `[lo, hi]`, sharing the tolerance
@@ -35,13 +37,13 @@ fn grid(surface: &dyn Surface, lo: DVec2, hi: DVec2, lim: &Limits) -> (Vec<f64>,
 }
 
 /// Meshes face `index` within `crit`, using at most `budget` triangles.
-pub(crate) fn mesh_face(
+pub(crate) fn mesh_face<'a>(
     index: usize,
-    face: &Face,
+    face: &'a Face,
     lim: &Limits,
     crit: &Criteria,
     budget: usize,
-) -> Result<FaceResult, Error> {
+) -> Result<FaceResult<'a>, Error> {
     let surface: &dyn Surface = &face.surface;
     let mut wm = WorkMesh::default();
     let curves;
@@ -55,7 +57,7 @@ pub(crate) fn mesh_face(
         curves = trimmed(index, surface, face, lim, budget, &mut wm)?;
     }
     let outcome = wm.refine(surface, &curves, crit, budget);
-    Ok(FaceResult { mesh: wm, outcome })
+    Ok(FaceResult { mesh: wm, outcome, curves })
 }
 
 /// Trimmed face: loops, grid over their box, CDT band; returns the trim curves.

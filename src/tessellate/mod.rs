@@ -7,6 +7,7 @@ mod measure;
 mod options;
 mod params;
 mod refine;
+mod sew;
 #[cfg(feature = "std")]
 mod trim;
 
@@ -56,12 +57,13 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<MeshResult, Er
     let aim = tol * options.safety;
     let lim = params::Limits { tol: aim, angle: options.angle, max_edge, min_edge };
     let crit = refine::Criteria { tol: aim, angle: options.angle, max_edge, min_edge, steps: options.measure_steps };
-    let mut mesh = Mesh::default();
     let mut report = Report { tolerance: tol, angle: options.angle, faces: model.faces.len(), ..Report::default() };
     report.warnings.extend(model.warnings.iter().cloned());
-    let (mut dev_sum, mut dev_count) = (0.0, 0u64);
+    // Mesh every face on its own.
+    let mut works: Vec<sew::FaceWork<'_>> = Vec::with_capacity(model.faces.len());
+    let mut outcomes: Vec<refine::Outcome> = Vec::with_capacity(model.faces.len());
+    let mut used = 0usize;
     for (index, f) in model.faces.iter().enumerate() {
-        let used = mesh.triangle_count();
         let budget = options.max_triangles.saturating_sub(used);
         if budget < 2 {
             report.faces_skipped += 1;
@@ -76,26 +78,8 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<MeshResult, Er
             continue;
         }
         let fr = face::mesh_face(index, f, &lim, &crit, budget)?;
-        let wm = &fr.mesh;
-        let base = mesh.positions.len() as u32;
-        mesh.positions.extend_from_slice(&wm.pos);
-        mesh.normals.extend_from_slice(&wm.normal);
-        for t in &wm.tris {
-            mesh.indices.extend(t.iter().map(|&v| v + base));
-        }
-        mesh.face_ranges.push(FaceRange { first: used as u32, count: wm.tris.len() as u32 });
-        for (t, m) in fr.outcome.measures.iter().enumerate() {
-            report.max_deviation = report.max_deviation.max(m.max);
-            dev_sum += m.sum;
-            dev_count += u64::from(m.count);
-            if wm.inverted(&f.surface, t) {
-                report.inverted_triangles += 1;
-            }
-        }
-        for &turn in &fr.outcome.turns {
-            report.max_normal_turn = report.max_normal_turn.max(turn);
-        }
-        if wm.tris.is_empty() {
+        used += fr.mesh.tris.len();
+        if fr.mesh.tris.is_empty() {
             report.faces_skipped += 1;
             report.warnings.push(format!("face {index}: produced no triangles"));
         }
@@ -106,11 +90,49 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<MeshResult, Er
                 if fr.outcome.budget_hit { "triangle budget reached" } else { "edges at the minimum length" }
             ));
         }
+        works.push(sew::FaceWork { surface: &f.surface, curves: fr.curves, mesh: fr.mesh });
+        outcomes.push(fr.outcome);
+    }
+    // Make shared borders conform, then measure again what sewing touched.
+    let sew_tol = options.sew.unwrap_or_else(|| (0.5 * tol).min(1e-4 * diag.max(tol)));
+    let changed = sew::conform(&mut works, sew_tol, aim + sew_tol);
+    for ((w, out), ch) in works.iter().zip(outcomes.iter_mut()).zip(&changed) {
+        out.measures.resize(w.mesh.tris.len(), Default::default());
+        out.turns.resize(w.mesh.tris.len(), 0.0);
+        for &t in ch {
+            let (m, turn) = w.mesh.measure_one(w.surface, t as usize, &crit);
+            out.measures[t as usize] = m;
+            out.turns[t as usize] = turn;
+        }
+    }
+    let mut mesh = Mesh::default();
+    let (mut dev_sum, mut dev_count) = (0.0, 0u64);
+    for (w, out) in works.iter().zip(&outcomes) {
+        let wm = &w.mesh;
+        let first = mesh.triangle_count() as u32;
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend_from_slice(&wm.pos);
+        mesh.normals.extend_from_slice(&wm.normal);
+        for t in &wm.tris {
+            mesh.indices.extend(t.iter().map(|&v| v + base));
+        }
+        mesh.face_ranges.push(FaceRange { first, count: wm.tris.len() as u32 });
+        for (t, m) in out.measures.iter().enumerate() {
+            report.max_deviation = report.max_deviation.max(m.max);
+            dev_sum += m.sum;
+            dev_count += u64::from(m.count);
+            if wm.inverted(w.surface, t) {
+                report.inverted_triangles += 1;
+            }
+        }
+        for &turn in &out.turns {
+            report.max_normal_turn = report.max_normal_turn.max(turn);
+        }
     }
     report.mean_deviation = if dev_count > 0 { dev_sum / dev_count as f64 } else { 0.0 };
     report.triangles = mesh.triangle_count();
     report.vertices = mesh.positions.len();
-    let edges = edge_counts(&mesh, tol * 1e-3, tol);
+    let edges = edge_counts(&mesh, (tol * 1e-3).min(sew_tol * 0.5), tol);
     report.free_edges = edges.free_edges;
     report.boundary_edges = edges.boundary_edges;
     report.nonmanifold_edges = edges.nonmanifold_edges;

@@ -26,6 +26,10 @@ pub struct MeshOptions {
     /// Edges at or below this length are never split, model units. Default:
     /// 1e-3 × the absolute tolerance (guards singular points against endless refinement).
     pub min_edge: Option<f64>,
+    /// Borders of different faces closer than this are sewn into one edge,
+    /// model units. Default: the smaller of half the tolerance and 1e-4 × the
+    /// model diagonal (CAD files keep their gaps far below either).
+    pub sew: Option<f64>,
     /// Refinement stops (with a warning) once the whole mesh holds this many triangles.
     /// Default 4,000,000: bounds memory in a browser tab.
     pub max_triangles: usize,
@@ -44,6 +48,7 @@ impl Default for MeshOptions {
             angle: 0.5,
             max_edge: None,
             min_edge: None,
+            sew: None,
             max_triangles: 4_000_000,
             measure_steps: 4,
             safety: 0.8,
@@ -99,6 +104,12 @@ impl MeshOptions {
         self
     }
 
+    /// Sets the sewing distance between faces' borders.
+    pub fn with_sew(mut self, sew: Option<f64>) -> Self {
+        self.sew = sew;
+        self
+    }
+
     /// Sets the triangle budget.
     pub fn with_max_triangles(mut self, n: usize) -> Self {
         self.max_triangles = n;
@@ -135,6 +146,11 @@ impl MeshOptions {
                 if m >= x {
                     return Err(OptionsError { option: "--min-edge", message: "must be below --max-edge" });
                 }
+            }
+        }
+        if let Some(s) = self.sew {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(OptionsError { option: "--sew", message: "must be a finite number > 0" });
             }
         }
         if self.max_triangles < 2 {

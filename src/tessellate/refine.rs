@@ -127,16 +127,68 @@ impl WorkMesh {
         best
     }
 
-    /// Splits edge `a-b` and the (one or two) triangles on it; returns the
-    /// triangles that changed or were added.
+    /// Splits edge `a-b` at its middle and the (one or two) triangles on it;
+    /// pushes the triangles that changed or were added to `out`.
     fn split_edge(&mut self, surface: &dyn Surface, curves: &[&NurbsCurve], a: u32, b: u32, out: &mut Vec<u32>) {
-        let Some(&adj) = self.edges.get(&key(a, b)) else { return };
+        self.split_edge_at(surface, curves, a, b, 0.5, None, out);
+    }
+
+    /// The point of the exact boundary under edge `a-b` at fraction `frac`
+    /// (from `a`): on its trim curve when it has one, else on the (u,v)
+    /// segment of its only triangle (an iso-line on an untrimmed border).
+    pub fn boundary_point(
+        &self,
+        surface: &dyn Surface,
+        curves: &[&NurbsCurve],
+        a: u32,
+        b: u32,
+        frac: f64,
+    ) -> Option<(DVec2, DVec3)> {
+        if let Some(te) = self.trim.get(&key(a, b)) {
+            let c = curves.get(te.curve as usize)?;
+            let (ta, tb) = if a < b { (te.t_lo, te.t_hi) } else { (te.t_hi, te.t_lo) };
+            let uv = c.point(ta + (tb - ta) * frac).truncate();
+            return Some((uv, surface.point(uv)));
+        }
+        let adj = self.edges.get(&key(a, b))?;
+        let t = adj[0];
+        let tv = self.tris.get(t as usize)?;
+        let i = (0..3).find(|&k| key(tv[k], tv[(k + 1) % 3]) == key(a, b))?;
+        let tuv = self.uvs[t as usize];
+        let (ua, ub) = if tv[i] == a { (tuv[i], tuv[(i + 1) % 3]) } else { (tuv[(i + 1) % 3], tuv[i]) };
+        let uv = ua.lerp(ub, frac);
+        Some((uv, surface.point(uv)))
+    }
+
+    /// Edges used by exactly one triangle.
+    pub fn boundary_edges(&self) -> Vec<(u32, u32)> {
+        let mut out: Vec<(u32, u32)> = self.edges.iter().filter(|(_, t)| t[1] == NONE).map(|(k, _)| *k).collect();
+        out.sort_unstable();
+        out
+    }
+
+    /// Splits edge `a-b` at fraction `frac` from `a` (on the trim curve for
+    /// trim edges); the new vertex goes to `target` when given (sewing to a
+    /// neighbour's vertex), else onto the surface. Returns the new vertex.
+    #[allow(clippy::too_many_arguments)]
+    pub fn split_edge_at(
+        &mut self,
+        surface: &dyn Surface,
+        curves: &[&NurbsCurve],
+        a: u32,
+        b: u32,
+        frac: f64,
+        target: Option<DVec3>,
+        out: &mut Vec<u32>,
+    ) -> Option<u32> {
+        let adj = *self.edges.get(&key(a, b))?;
         let trim = self.trim.get(&key(a, b)).copied();
-        let mut mid_uv_trim = None;
+        let mut trim_at = None;
         if let Some(te) = trim {
             if let Some(c) = curves.get(te.curve as usize) {
-                let tm = 0.5 * (te.t_lo + te.t_hi);
-                mid_uv_trim = Some((c.point(tm).truncate(), tm));
+                let (ta, tb) = if a < b { (te.t_lo, te.t_hi) } else { (te.t_hi, te.t_lo) };
+                let tm = ta + (tb - ta) * frac;
+                trim_at = Some((c.point(tm).truncate(), ta, tm, tb));
             }
         }
         let m = self.pos.len() as u32;
@@ -147,12 +199,13 @@ impl WorkMesh {
             let Some(i) = (0..3).find(|&k| key(tv[k], tv[(k + 1) % 3]) == key(a, b)) else { continue };
             let (x0, x1, x2) = (tv[i], tv[(i + 1) % 3], tv[(i + 2) % 3]);
             let (u0, u1, u2) = (tuv[i], tuv[(i + 1) % 3], tuv[(i + 2) % 3]);
-            let uv_m = match (mid_uv_trim, m_pos) {
-                (Some((uv, _)), _) => uv,
-                (None, None) => (u0 + u1) * 0.5,
+            let f = if x0 == a { frac } else { 1.0 - frac };
+            let guess = u0.lerp(u1, f);
+            let uv_m = match (trim_at, m_pos.or(target)) {
+                (Some((uv, ..)), _) => uv,
+                (None, None) => guess,
                 (None, Some(p)) => {
-                    // Another chart (seam or pole): find this triangle's (u,v) of the shared point.
-                    let guess = (u0 + u1) * 0.5;
+                    // Another chart (seam or pole), or a sewing target: this triangle's (u,v) of the point.
                     if surface.point(guess).distance(p) <= 1e-12 * (1.0 + p.length()) {
                         guess
                     } else {
@@ -161,7 +214,7 @@ impl WorkMesh {
                 }
             };
             if m_pos.is_none() {
-                let p = surface.point(uv_m);
+                let p = target.unwrap_or_else(|| surface.point(uv_m));
                 m_pos = Some(p);
                 self.pos.push(p);
                 self.normal.push(surface.normal(uv_m));
@@ -182,12 +235,18 @@ impl WorkMesh {
             out.push(t);
             out.push(t2);
         }
-        if let (Some(te), Some((_, tm))) = (trim, mid_uv_trim) {
+        m_pos?;
+        if let (Some(te), Some((_, ta, tm, tb))) = (trim, trim_at) {
             self.trim.remove(&key(a, b));
-            let (ta, tb) = if a < b { (te.t_lo, te.t_hi) } else { (te.t_hi, te.t_lo) };
             self.mark_trim(a, m, te.curve, ta, tm);
             self.mark_trim(m, b, te.curve, tm, tb);
         }
+        Some(m)
+    }
+
+    /// Re-measures triangle `t` (after sewing changed it).
+    pub fn measure_one(&self, surface: &dyn Surface, t: usize, c: &Criteria) -> (TriMeasure, f64) {
+        self.measure(surface, t, c)
     }
 
     /// Measures every triangle and splits the failing ones until all pass or

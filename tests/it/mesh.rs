@@ -265,3 +265,51 @@ fn mesh_uv_hint_helper_agrees_with_surface() {
         assert!((n.dot(p.normalize()).abs() - 1.0).abs() < 1e-6, "pole normal {n:?} at {p:?}");
     }
 }
+
+/// A bicubic Bézier patch from a height function over `[x0, x1] × [0, 10]`.
+fn height_patch(x0: f64, x1: f64, h: impl Fn(f64, f64) -> f64) -> surfmesh::NurbsSurface {
+    let pts: Vec<Vec<DVec3>> = (0..4)
+        .map(|i| {
+            let x = x0 + (x1 - x0) * i as f64 / 3.0;
+            (0..4).map(|j| DVec3::new(x, 10.0 * j as f64 / 3.0, h(x, j as f64 / 3.0))).collect()
+        })
+        .collect();
+    let k = vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+    surfmesh::NurbsSurface::try_new([3, 3], k.clone(), k, &pts, None).expect("patch")
+}
+
+/// Mesh edges on the plane x = 10 used by one triangle only (positions keyed at 1e-6).
+fn open_edges_on_x10(m: &Mesh) -> usize {
+    let mut uses = std::collections::HashMap::new();
+    let key = |p: DVec3| ((p.x * 1e6).round() as i64, (p.y * 1e6).round() as i64, (p.z * 1e6).round() as i64);
+    for t in m.indices.chunks_exact(3) {
+        for k in 0..3 {
+            let (a, b) = (key(m.positions[t[k] as usize]), key(m.positions[t[(k + 1) % 3] as usize]));
+            *uses.entry(if a < b { (a, b) } else { (b, a) }).or_insert(0) += 1;
+        }
+    }
+    let on_seam = |k: &(i64, i64, i64)| (k.0 - 10_000_000).abs() <= 1;
+    uses.iter().filter(|(e, &n)| n == 1 && on_seam(&e.0) && on_seam(&e.1)).count()
+}
+
+#[test]
+fn mesh_two_faces_share_their_border_without_cracks() {
+    // A flat face and a wavy one meet along the straight line x = 10: the wavy
+    // face needs many more border nodes than the flat one.
+    let flat = height_patch(0.0, 10.0, |_, _| 0.0);
+    let wavy = height_patch(10.0, 20.0, |x, t| if x > 10.0 { 8.0 * (t * 6.0).sin() } else { 0.0 });
+    let face = |s| Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] };
+    let model = Model { units: "mm".into(), faces: vec![face(flat), face(wavy)], warnings: vec![] };
+    for rel in RELS {
+        let r = mesh(&model, rel);
+        check_common("two faces", &r, rel);
+        assert_eq!(open_edges_on_x10(&r.mesh), 0, "rel {rel}: open edges on the shared border");
+        // The outer border of the two faces stays open, and is not reported as a crack.
+        assert!(r.report.boundary_edges > 0);
+        // Without sewing the same model has T-junctions there, and they count as cracks.
+        let unsewn = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(rel).with_sew(Some(1e-12)))
+            .expect("meshes");
+        assert!(open_edges_on_x10(&unsewn.mesh) > 0, "rel {rel}: the test shape no longer needs sewing");
+        assert!(unsewn.report.free_edges > 0, "rel {rel}: T-junctions not reported as cracks");
+    }
+}
