@@ -42,7 +42,7 @@ fn cell_of(p: DVec3, inv: f64) -> Cell {
 /// tolerance plus `sew`).
 pub(crate) fn conform(faces: &mut [FaceWork<'_>], sew: f64, reach: f64) -> Vec<Vec<u32>> {
     let mut changed: Vec<Vec<u32>> = faces.iter().map(|_| Vec::new()).collect();
-    if faces.is_empty() || !(sew > 0.0) || !reach.is_finite() {
+    if faces.is_empty() || sew.is_nan() || sew <= 0.0 || !reach.is_finite() {
         return changed;
     }
     // Border vertices of every face, hashed on a grid about one border edge long.
