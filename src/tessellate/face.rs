@@ -24,16 +24,81 @@ pub(crate) struct FaceResult<'a> {
 /// direction when the other turned out (nearly) straight, as on a cylinder.
 fn grid(surface: &dyn Surface, lo: DVec2, hi: DVec2, lim: &Limits) -> (Vec<f64>, Vec<f64>) {
     let half = Limits { tol: lim.tol * 0.5, ..*lim };
-    let (mut pu, su) = grid_params(surface, lo, hi, true, &half);
-    let (mut pv, sv) = grid_params(surface, lo, hi, false, &half);
+    let (mut pu, mut su) = grid_params(surface, lo, hi, true, &half);
+    let (mut pv, mut sv) = grid_params(surface, lo, hi, false, &half);
     if sv < 0.5 * half.tol && su > sv {
         let rest = Limits { tol: (lim.tol - sv).max(half.tol), ..*lim };
-        pu = grid_params(surface, lo, hi, true, &rest).0;
+        (pu, su) = grid_params(surface, lo, hi, true, &rest);
     } else if su < 0.5 * half.tol && sv > su {
         let rest = Limits { tol: (lim.tol - su).max(half.tol), ..*lim };
-        pv = grid_params(surface, lo, hi, false, &rest).0;
+        (pv, sv) = grid_params(surface, lo, hi, false, &rest);
+    }
+    // Where the iso-curves left most of the tolerance unused, a twist may use it.
+    let room = lim.tol - su - sv;
+    if room >= 0.5 * lim.tol {
+        // 0.85: the twist estimate is exact only for bilinear cells.
+        refine_twisted_cells(surface, &mut pu, &mut pv, 0.85 * room);
     }
     (pu, pv)
+}
+
+/// Beyond paper 000: its tests run along iso-curves only, and a twisted
+/// surface (a bilinear saddle, whose iso-curves are all straight) passes them
+/// with a grid far too coarse. A cell's twist `(P00 + P11 − P10 − P01) / 4`,
+/// taken along the surface normal, is how far its two triangles miss the
+/// surface at the centre beyond the iso-curve sags; where it exceeds `room`
+/// (what the sags left of the tolerance), the cell's row and column are split
+/// into equal parts by the square root of the excess (twist falls with the
+/// product of both steps).
+fn refine_twisted_cells(surface: &dyn Surface, pu: &mut Vec<f64>, pv: &mut Vec<f64>, room: f64) {
+    for _ in 0..4 {
+        let (nu, nv) = (pu.len(), pv.len());
+        if nu < 2 || nv < 2 || nu * nv > 4_000_000 {
+            return;
+        }
+        let pts: Vec<DVec3> = (0..nu)
+            .flat_map(|i| pv.iter().map(move |&v| (i, v)))
+            .map(|(i, v)| surface.point(DVec2::new(pu[i], v)))
+            .collect();
+        let mut need_u = alloc::vec![1usize; nu - 1];
+        let mut need_v = alloc::vec![1usize; nv - 1];
+        let mut any = false;
+        for i in 0..nu - 1 {
+            for j in 0..nv - 1 {
+                let p = |a: usize, b: usize| pts[(i + a) * nv + j + b];
+                let twist = (p(0, 0) + p(1, 1) - p(1, 0) - p(0, 1)) * 0.25;
+                if twist.length() <= room {
+                    continue;
+                }
+                let n = surface.normal(DVec2::new(0.5 * (pu[i] + pu[i + 1]), 0.5 * (pv[j] + pv[j + 1])));
+                let e = twist.dot(n).abs();
+                if e > room {
+                    let n = (crate::math::ceil(crate::math::sqrt(e / room)) as usize).clamp(2, 256);
+                    need_u[i] = need_u[i].max(n);
+                    need_v[j] = need_v[j].max(n);
+                    any = true;
+                }
+            }
+        }
+        if !any {
+            return;
+        }
+        *pu = split_by(pu, &need_u);
+        *pv = split_by(pv, &need_v);
+    }
+}
+
+/// Splits interval `k` of `p` into `need[k]` equal parts.
+fn split_by(p: &[f64], need: &[usize]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(p.len() * 2);
+    out.push(p[0]);
+    for (k, w) in p.windows(2).enumerate() {
+        let n = need[k];
+        for s in 1..=n {
+            out.push(if s == n { w[1] } else { w[0] + (w[1] - w[0]) * s as f64 / n as f64 });
+        }
+    }
+    out
 }
 
 /// Meshes face `index` within `crit`, using at most `budget` triangles.

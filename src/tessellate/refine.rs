@@ -133,6 +133,47 @@ impl WorkMesh {
         self.split_edge_at(surface, curves, a, b, 0.5, None, out);
     }
 
+    /// Splits the longest edge of `t` by Rivara's longest-edge propagation:
+    /// while the neighbour across it has a longer edge of its own, that
+    /// neighbour's longest edge is split first. Splitting only terminal edges
+    /// (longest for both triangles) keeps angles bounded away from zero, where
+    /// plain bisection of whatever edge the neighbour shares breeds slivers.
+    fn split_lepp(
+        &mut self,
+        surface: &dyn Surface,
+        curves: &[&NurbsCurve],
+        t: u32,
+        first: (u32, u32),
+        out: &mut Vec<u32>,
+    ) {
+        let target = key(first.0, first.1);
+        for _ in 0..64 {
+            if !self.edges.contains_key(&target) {
+                return; // t's longest edge has been split
+            }
+            // Walk from t across longest edges until an edge is longest on both sides.
+            let (mut a, mut b) = first;
+            let mut cur = t;
+            for _ in 0..64 {
+                let Some(adj) = self.edges.get(&key(a, b)) else { break };
+                let other = if adj[0] == cur { adj[1] } else { adj[0] };
+                if other == NONE {
+                    break;
+                }
+                let (c, d, _) = self.longest_edge(other as usize);
+                if key(c, d) == key(a, b) {
+                    break;
+                }
+                cur = other;
+                (a, b) = (c, d);
+            }
+            self.split_edge(surface, curves, a, b, out);
+            if key(a, b) == target {
+                return;
+            }
+        }
+    }
+
     /// The point of the exact boundary under edge `a-b` at fraction `frac`
     /// (from `a`): on its trim curve when it has one, else on the (u,v)
     /// segment of its only triangle (an iso-line on an untrimmed border).
@@ -273,7 +314,7 @@ impl WorkMesh {
                 continue;
             }
             changed.clear();
-            self.split_edge(surface, curves, a, b, &mut changed);
+            self.split_lepp(surface, curves, t as u32, (a, b), &mut changed);
             measures.resize(self.tris.len(), None);
             for &x in &changed {
                 measures[x as usize] = None;

@@ -313,3 +313,21 @@ fn mesh_two_faces_share_their_border_without_cracks() {
         assert!(unsewn.report.free_edges > 0, "rel {rel}: T-junctions not reported as cracks");
     }
 }
+
+#[test]
+fn mesh_saddle_refines_without_slivers() {
+    // A bilinear saddle: every iso-line is straight, so only refinement sees
+    // the twist. Plain bisection bred slivers here whose facets flipped, and
+    // refinement never ended.
+    let json = br#"{"faces":[{"surface":{"degree":[1,1],"knots":[[0,0,1,1],[0,0,1,1]],
+        "points":[[[0,0,0],[0,10,0]],[[10,0,0],[10,10,4]]]}}]}"#;
+    let model = surfmesh::read_json(json).expect("reads");
+    let mut counts = Vec::new();
+    // (At 0.1 the angle limit, not the tolerance, sets the count.)
+    for tol in [0.01, 0.001] {
+        let r = mesh_model(&model, &MeshOptions::default().with_tolerance(tol)).expect("meshes");
+        counts.push(check_common("saddle", &r, tol));
+        assert!(r.report.min_angle_deg > 10.0, "tol {tol}: min angle {}", r.report.min_angle_deg);
+    }
+    counts_follow_tolerance("saddle", &counts);
+}
