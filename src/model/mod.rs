@@ -15,6 +15,10 @@ pub struct Model {
     pub faces: Vec<Face>,
     /// Things the reader skipped or repaired, for the report.
     pub warnings: Vec<String>,
+    /// The file's own modelling tolerance, model units (IGES global section:
+    /// minimum resolution), when it states one: the gaps its author accepted
+    /// between faces, so sewing reaches at least that far.
+    pub tolerance: Option<f64>,
 }
 
 /// A surface restricted to the region its loops enclose.

@@ -94,7 +94,10 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<MeshResult, Er
         outcomes.push(fr.outcome);
     }
     // Make shared borders conform, then measure again what sewing touched.
-    let sew_tol = options.sew.unwrap_or_else(|| (0.5 * tol).min(1e-4 * diag.max(tol)));
+    let sew_tol = options.sew.unwrap_or_else(|| {
+        let auto = (0.5 * tol).min(1e-4 * diag.max(tol));
+        model.tolerance.filter(|t| t.is_finite() && *t > 0.0).map_or(auto, |t| auto.max(t.min(0.5 * tol)))
+    });
     let changed = sew::conform(&mut works, sew_tol, aim + sew_tol);
     for ((w, out), ch) in works.iter().zip(outcomes.iter_mut()).zip(&changed) {
         out.measures.resize(w.mesh.tris.len(), Default::default());

@@ -208,6 +208,7 @@ fn face_with_loops(loops: Vec<TrimLoop>) -> Model {
         units: "mm".into(),
         faces: vec![Face { name: None, surface: FaceSurface::Nurbs(surface), loops }],
         warnings: vec![],
+        tolerance: None,
     }
 }
 
@@ -299,7 +300,7 @@ fn mesh_two_faces_share_their_border_without_cracks() {
     let flat = height_patch(0.0, 10.0, |_, _| 0.0);
     let wavy = height_patch(10.0, 20.0, |x, t| if x > 10.0 { 8.0 * (t * 6.0).sin() } else { 0.0 });
     let face = |s| Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] };
-    let model = Model { units: "mm".into(), faces: vec![face(flat), face(wavy)], warnings: vec![] };
+    let model = Model { units: "mm".into(), faces: vec![face(flat), face(wavy)], warnings: vec![], tolerance: None };
     for rel in RELS {
         let r = mesh(&model, rel);
         check_common("two faces", &r, rel);
