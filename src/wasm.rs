@@ -76,7 +76,12 @@ pub fn version() -> String {
 #[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
 pub fn mesh(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsError> {
     let options = read_options(&options).map_err(|e| JsError::new(&e))?;
-    run(bytes, format, &options).map_err(|e| JsError::new(&e.to_string()))
+    run(bytes, format, &options).map_err(|e| JsError::new(&one_line(&e.to_string())))
+}
+
+/// The message on one line, as the command line prints it.
+fn one_line(message: &str) -> String {
+    message.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 /// Parses, meshes and converts, timing the two stages with the host clock.
