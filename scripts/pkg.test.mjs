@@ -1,0 +1,127 @@
+// Tests of the built npm package (pkg/, from `npm run build`) through the
+// real wasm-bindgen glue: every target loads and meshes, the package's export
+// map resolves, and a thrown Error carries exactly the command line's message.
+//
+// Run: node --test scripts/pkg.test.mjs   (after `npm run build`)
+
+import assert from 'node:assert/strict';
+import { spawnSync } from 'node:child_process';
+import { mkdirSync, mkdtempSync, readFileSync, rmSync, symlinkSync, writeFileSync } from 'node:fs';
+import { createRequire } from 'node:module';
+import { tmpdir } from 'node:os';
+import { dirname, join } from 'node:path';
+import { after, test } from 'node:test';
+import { fileURLToPath } from 'node:url';
+
+const root = join(dirname(fileURLToPath(import.meta.url)), '..');
+const pkg = join(root, 'pkg');
+const require = createRequire(import.meta.url);
+const surfmesh = require(join(pkg, 'node'));
+const freeform = readFileSync(join(root, 'tests', 'data', 'js_freeform.json'));
+const scratch = mkdtempSync(join(tmpdir(), 'surfmesh-pkg-'));
+after(() => rmSync(scratch, { recursive: true, force: true }));
+
+/** A one-patch model with `patch` merged into its surface and `loops` on its face. */
+function model(patch = {}, loops = []) {
+  const points = [0, 1, 2, 3].map((i) => [0, 1, 2, 3].map((j) => [i, j, i % 3 && j % 3 ? 1 : 0]));
+  const surface = { degree: [3, 3], knots: [[0, 0, 0, 0, 1, 1, 1, 1], [0, 0, 0, 0, 1, 1, 1, 1]], points, ...patch };
+  return JSON.stringify({ units: 'mm', faces: [{ surface, loops }] });
+}
+
+function line(a, b) {
+  return { degree: 1, knots: [0, 0, 1, 1], points: [a, b] };
+}
+
+const badInputs = {
+  'malformed JSON': '{ "faces": [ { "surface": ',
+  'knots too short': model({ knots: [[0, 0, 1, 1], [0, 0, 0, 0, 1, 1, 1, 1]] }),
+  'decreasing knots': model({ knots: [[0, 0, 0, 0.6, 0.4, 1, 1, 1, 1], [0, 0, 0, 0, 1, 1, 1, 1]] }),
+  'zero weight': model({ weights: [[1, 1, 1, 1], [1, 1, 0, 1], [1, 1, 1, 1], [1, 1, 1, 1]] }),
+  'open loop': model({}, [
+    {
+      curves: [
+        line([0.2, 0.2], [0.8, 0.2]),
+        line([0.8, 0.2], [0.8, 0.8]),
+        line([0.8, 0.9], [0.2, 0.8]),
+        line([0.2, 0.8], [0.2, 0.2]),
+      ],
+    },
+  ]),
+};
+
+/** The command line's one-line error for `text` saved as a .json file, without its "surfmesh: FILE: " prefix. */
+function cliError(name, text) {
+  const file = join(scratch, `${name.replace(/\W+/g, '_')}.json`);
+  writeFileSync(file, text);
+  const r = spawnSync('cargo', ['run', '--quiet', '--bin', 'surfmesh', '--', 'mesh', file], { cwd: root, encoding: 'utf8' });
+  assert.notEqual(r.status, 0, `the CLI accepted ${name}`);
+  const lines = r.stderr.trim().split('\n');
+  const last = lines[lines.length - 1];
+  const prefix = `surfmesh: ${file}: `;
+  assert.ok(last.startsWith(prefix), `unexpected CLI error line: ${last}`);
+  return last.slice(prefix.length);
+}
+
+test('the Node build meshes the bundled freeform surface within its tolerance', () => {
+  const out = surfmesh.mesh(freeform, 'auto', { toleranceRel: 1e-3 });
+  assert.ok(out.positions instanceof Float32Array);
+  assert.ok(out.normals instanceof Float32Array);
+  assert.ok(out.indices instanceof Uint32Array);
+  assert.ok(out.faceRanges instanceof Uint32Array);
+  const { report } = out;
+  assert.equal(out.positions.length, 3 * report.vertices);
+  assert.equal(out.indices.length, 3 * report.triangles);
+  assert.deepEqual([...out.faceRanges], [0, report.triangles]);
+  assert.ok(report.max_deviation <= report.tolerance, `${report.max_deviation} > ${report.tolerance}`);
+  assert.ok(report.time_ms > 0 && report.parse_ms >= 0, 'the binding fills in the times');
+  assert.match(surfmesh.version(), /^\d+\.\d+\.\d+$/);
+});
+
+test('thrown errors are Error objects with exactly the command line message', () => {
+  for (const [name, text] of Object.entries(badInputs)) {
+    const expected = cliError(name, text);
+    assert.throws(
+      () => surfmesh.mesh(new TextEncoder().encode(text), 'json', {}),
+      (e) => e instanceof Error && e.message === expected,
+      `${name}: expected ${JSON.stringify(expected)}`,
+    );
+  }
+  assert.throws(() => surfmesh.mesh(freeform, 'json', { maxEdge: 'long' }), /^Error: option maxEdge: expected a number/);
+});
+
+test('the package export map serves the Node build to require and import, and the web build at surfmesh/web', () => {
+  const app = join(scratch, 'app');
+  mkdirSync(join(app, 'node_modules'), { recursive: true });
+  symlinkSync(pkg, join(app, 'node_modules', 'surfmesh'), 'dir');
+  const data = JSON.stringify(join(root, 'tests', 'data', 'js_freeform.json'));
+  const script = `
+    import { readFileSync } from 'node:fs';
+    import { createRequire } from 'node:module';
+    import { mesh } from 'surfmesh';
+    import init, { mesh as webMesh } from 'surfmesh/web';
+    const cjs = createRequire(import.meta.url)('surfmesh');
+    const bytes = readFileSync(${data});
+    await init({ module_or_path: readFileSync(${JSON.stringify(join(pkg, 'web', 'surfmesh_bg.wasm'))}) });
+    const counts = [mesh(bytes, 'json').report.triangles, cjs.mesh(bytes, 'json').report.triangles, webMesh(bytes, 'json').report.triangles];
+    console.log(JSON.stringify({ same: cjs.mesh === mesh, counts }));
+  `;
+  writeFileSync(join(app, 'main.mjs'), script);
+  const r = spawnSync(process.execPath, [join(app, 'main.mjs')], { cwd: app, encoding: 'utf8' });
+  assert.equal(r.status, 0, r.stderr);
+  const { same, counts } = JSON.parse(r.stdout);
+  assert.ok(same, 'require and import should load the same Node module');
+  assert.ok(counts[0] > 0 && counts.every((c) => c === counts[0]), `triangle counts differ: ${counts}`);
+});
+
+test('the bundler build loads as an ES module that imports its .wasm', () => {
+  const script = `
+    import { readFileSync } from 'node:fs';
+    import { mesh } from ${JSON.stringify(join(pkg, 'bundler', 'surfmesh.js'))};
+    console.log(mesh(readFileSync(${JSON.stringify(join(root, 'tests', 'data', 'js_freeform.json'))}), 'json').report.triangles);
+  `;
+  const file = join(scratch, 'bundler.mjs');
+  writeFileSync(file, script);
+  const r = spawnSync(process.execPath, ['--experimental-wasm-modules', '--no-warnings', file], { encoding: 'utf8' });
+  assert.equal(r.status, 0, r.stderr);
+  assert.equal(Number(r.stdout.trim()), surfmesh.mesh(freeform, 'json').report.triangles);
+});
