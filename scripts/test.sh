@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Every test of the project, from a fresh clone: installs what is missing
+# (scripts/setup.sh), then native tests, the no_std build check, docs, the
+# benches' build, the wasm-bindgen-test suite in Node, the npm package build
+# and the package's own tests in Node. Stops at the first failure.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export PATH="$HOME/.cargo/bin:$PATH"
+
+scripts/setup.sh
+
+step() {
+  local name=$1
+  shift
+  printf '\n== test: %s\n+ %s\n' "$name" "$*"
+  local start=$SECONDS
+  "$@"
+  printf '== test: %s: ok (%d s)\n' "$name" $((SECONDS - start))
+}
+
+total=$SECONDS
+step "native tests" cargo test
+step "no-std core (wasm32v1-none)" cargo rustc --lib --no-default-features --target wasm32v1-none --crate-type rlib
+step "docs" env RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --lib
+step "benches build" cargo bench --no-run
+# The wasm suite runs the mesher for real; unoptimized wasm is ~20x slower.
+step "wasm tests in Node" env CARGO_PROFILE_TEST_OPT_LEVEL=2 \
+  cargo test --target wasm32-unknown-unknown --test wasm_node
+step "npm package build" node scripts/build-wasm.mjs
+step "npm package tests in Node" node --test scripts/pkg.test.mjs
+printf '\n== test: all passed (%d s)\n' $((SECONDS - total))
