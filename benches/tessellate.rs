@@ -55,7 +55,7 @@ fn circle(centre: [f64; 2], radius: f64) -> NurbsCurve {
 
 fn model(loops: Vec<TrimLoop>) -> Model {
     let face = Face { name: Some("freeform".into()), surface: FaceSurface::Nurbs(freeform_surface()), loops };
-    Model { units: "mm".into(), faces: vec![face], warnings: Vec::new() }
+    Model { units: "mm".into(), faces: vec![face], ..Model::default() }
 }
 
 /// The patch inside a square loop with a round hole: exercises the trimmed (CDT band) path.
