@@ -47,6 +47,8 @@ pub enum Error {
     },
     /// A limit guarding memory or time was hit.
     Limit(String),
+    /// The caller's progress callback asked to stop.
+    Cancelled,
     /// A bug in surfmesh, not in the input.
     Internal(String),
 }
@@ -61,6 +63,7 @@ impl fmt::Display for Error {
             Self::Format(m) => write!(f, "format: {m}"),
             Self::Mesh { face, message } => write!(f, "face {face}: {message}"),
             Self::Limit(m) => write!(f, "limit: {m}"),
+            Self::Cancelled => write!(f, "cancelled"),
             Self::Internal(m) => write!(f, "internal error (a bug in surfmesh): {m}"),
         }
     }

@@ -31,7 +31,7 @@ pub use nurbs::{
     project_to_surface, Aabb, BasisDers, CurveDerivs, KnotVector, NurbsCurve, NurbsError, NurbsSurface, Projection,
     ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
 };
-pub use tessellate::{mesh_model, MeshOptions, MeshResult, OptionsError, Tolerance};
+pub use tessellate::{mesh_model, mesh_model_with_progress, MeshOptions, MeshResult, OptionsError, Tolerance};
 
 /// Reads `bytes` in `format` and meshes the model: the one call both doors use.
 ///

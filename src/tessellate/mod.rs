@@ -40,6 +40,21 @@ pub struct MeshResult {
 /// Invalid options, an empty model, a face whose loops cross or leave the
 /// domain, or a tolerance that would need more triangles than the budget.
 pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<MeshResult, Error> {
+    mesh_model_with_progress(model, options, &mut |_, _| true)
+}
+
+/// As [`mesh_model`], calling `progress(faces_done, faces_total)` after each
+/// face; when it returns `false` meshing stops with [`Error::Cancelled`].
+/// (The core has no clock or threads: a caller that wants a time limit or a
+/// cancel button decides inside the callback.)
+///
+/// # Errors
+/// As [`mesh_model`], or [`Error::Cancelled`].
+pub fn mesh_model_with_progress(
+    model: &Model,
+    options: &MeshOptions,
+    progress: &mut dyn FnMut(usize, usize) -> bool,
+) -> Result<MeshResult, Error> {
     options.validate()?;
     if model.faces.is_empty() {
         return Err(Error::Model { location: "model".into(), message: "has no faces".into() });
@@ -92,6 +107,9 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<MeshResult, Er
         }
         works.push(sew::FaceWork { surface: &f.surface, curves: fr.curves, mesh: fr.mesh });
         outcomes.push(fr.outcome);
+        if !progress(index + 1, model.faces.len()) {
+            return Err(Error::Cancelled);
+        }
     }
     // Make shared borders conform, then measure again what sewing touched.
     let sew_tol = options.sew.unwrap_or_else(|| {

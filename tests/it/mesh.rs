@@ -332,3 +332,25 @@ fn mesh_saddle_refines_without_slivers() {
     }
     counts_follow_tolerance("saddle", &counts);
 }
+
+#[test]
+fn mesh_reports_progress_and_stops_when_asked() {
+    let flat = height_patch(0.0, 10.0, |_, _| 0.0);
+    let wavy = height_patch(10.0, 20.0, |x, t| if x > 10.0 { 8.0 * (t * 6.0).sin() } else { 0.0 });
+    let face = |s| Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] };
+    let model = Model { units: "mm".into(), faces: vec![face(flat), face(wavy)], warnings: vec![], tolerance: None };
+    let mut seen = Vec::new();
+    let r = surfmesh::mesh_model_with_progress(&model, &MeshOptions::default(), &mut |done, total| {
+        seen.push((done, total));
+        true
+    });
+    assert!(r.is_ok());
+    assert_eq!(seen, vec![(1, 2), (2, 2)]);
+    let mut calls = 0;
+    let r = surfmesh::mesh_model_with_progress(&model, &MeshOptions::default(), &mut |_, _| {
+        calls += 1;
+        false
+    });
+    assert!(matches!(r, Err(Error::Cancelled)));
+    assert_eq!(calls, 1, "meshing went on after the callback said stop");
+}
