@@ -226,6 +226,58 @@ impl NurbsSurface {
             Self { ku: self.ku.clone(), kv: new_knots, points: pts, rational: self.rational }
         }
     }
+
+    /// Splits at parameter `t` along u (`along_u`) or v into the two surfaces
+    /// covering each side (knot insertion up to full multiplicity, then the
+    /// control net is cut). `None` when `t` is not strictly inside the domain.
+    pub fn split(&self, along_u: bool, t: f64) -> Option<(Self, Self)> {
+        let kv = if along_u { &self.ku } else { &self.kv };
+        let (a, b) = kv.domain();
+        if !(t > a && t < b) {
+            return None;
+        }
+        let p = kv.degree();
+        let mut s = self.clone();
+        loop {
+            let k = if along_u { &s.ku } else { &s.kv };
+            if k.multiplicity(t) >= p {
+                break;
+            }
+            let before = s.points.len();
+            s = s.insert_knot(along_u, t);
+            if s.points.len() == before {
+                return None;
+            }
+        }
+        let k = if along_u { s.ku.knots() } else { s.kv.knots() };
+        let first = k.iter().position(|&x| x == t)?;
+        let mut k1: Vec<f64> = k[..first + p].to_vec();
+        k1.push(t);
+        let mut k2: Vec<f64> = alloc::vec![t];
+        k2.extend_from_slice(&k[first..]);
+        let n1 = k1.len() - p - 1;
+        let (nu, nv) = (s.ku.control_count(), s.kv.control_count());
+        let (kn1, kn2) = (KnotVector::try_new(p, k1).ok()?, KnotVector::try_new(p, k2).ok()?);
+        if along_u {
+            let left = s.points[..n1 * nv].to_vec();
+            let right = s.points[(n1 - 1) * nv..].to_vec();
+            Some((
+                Self { ku: kn1, kv: s.kv.clone(), points: left, rational: s.rational },
+                Self { ku: kn2, kv: s.kv.clone(), points: right, rational: s.rational },
+            ))
+        } else {
+            let mut left = Vec::with_capacity(nu * n1);
+            let mut right = Vec::with_capacity(nu * (nv - n1 + 1));
+            for i in 0..nu {
+                left.extend_from_slice(&s.points[i * nv..i * nv + n1]);
+                right.extend_from_slice(&s.points[i * nv + n1 - 1..(i + 1) * nv]);
+            }
+            Some((
+                Self { ku: s.ku.clone(), kv: kn1, points: left, rational: s.rational },
+                Self { ku: s.ku.clone(), kv: kn2, points: right, rational: s.rational },
+            ))
+        }
+    }
 }
 
 impl Surface for NurbsSurface {

@@ -354,3 +354,29 @@ fn mesh_reports_progress_and_stops_when_asked() {
     assert!(matches!(r, Err(Error::Cancelled)));
     assert_eq!(calls, 1, "meshing went on after the callback said stop");
 }
+
+#[test]
+fn mesh_split_surface_halves_reproduce_the_original() {
+    // Splitting (knot insertion to full multiplicity) in both directions keeps
+    // the shape: each half evaluates to the original at the same parameters,
+    // and the halves mesh into one crack-free model.
+    let s = shapes::first_surface(&shapes::sphere(shapes::SPHERE_RADIUS)).clone();
+    for along_u in [true, false] {
+        let (left, right) = s.split(along_u, 0.3).expect("splits");
+        for k in 0..=20 {
+            for l in 0..=20 {
+                let (a, b) = (k as f64 / 20.0, l as f64 / 20.0);
+                let uv = if along_u { DVec2::new(a, b) } else { DVec2::new(b, a) };
+                let half = if (if along_u { uv.x } else { uv.y }) <= 0.3 { &left } else { &right };
+                assert!(half.point(uv).distance(s.point(uv)) < 1e-9, "split changed the surface at {uv:?}");
+            }
+        }
+        let face = |x: surfmesh::NurbsSurface| Face { name: None, surface: FaceSurface::Nurbs(x), loops: vec![] };
+        let model =
+            Model { units: "mm".into(), faces: vec![face(left), face(right)], warnings: vec![], tolerance: None };
+        let r = mesh(&model, 1e-3);
+        check_common("split sphere", &r, 1e-3);
+        assert_eq!(r.report.boundary_edges, 0, "the two halves of a sphere close up");
+    }
+    assert!(s.split(true, 0.0).is_none() && s.split(false, 1.0).is_none());
+}
