@@ -275,11 +275,12 @@ fn build_trimmed(
     // Grid nodes inside the region and not too close to a loop segment.
     let segs: Vec<(DVec2, DVec2)> = loops.segments().collect();
     let near = near_loop_mask(&segs, pu, pv, scale);
+    let inside = loops.contains_grid(pu, pv);
     for (i, &u) in pu.iter().enumerate() {
         for (j, &v) in pv.iter().enumerate() {
-            let q = DVec2::new(u, v);
-            if !near[i * pv.len() + j] && loops.contains(q) {
-                nodes.push(q);
+            let k = i * pv.len() + j;
+            if inside[k] && !near[k] {
+                nodes.push(DVec2::new(u, v));
             }
         }
     }

@@ -62,6 +62,33 @@ impl Loops<'_> {
         })
     }
 
+    /// Inside flags for every node of the grid `pu × pv` (index `i * pv.len() + j`),
+    /// by scanlines: each row `v = pv[j]` is crossed with every segment once,
+    /// instead of testing every node against every segment.
+    pub fn contains_grid(&self, pu: &[f64], pv: &[f64]) -> Vec<bool> {
+        let nv = pv.len();
+        let mut inside = alloc::vec![false; pu.len() * nv];
+        let mut xs: Vec<f64> = Vec::new();
+        for (j, &y) in pv.iter().enumerate() {
+            xs.clear();
+            for (a, b) in self.segments() {
+                if (a.y > y) != (b.y > y) {
+                    xs.push(a.x + (y - a.y) / (b.y - a.y) * (b.x - a.x));
+                }
+            }
+            xs.sort_by(|p, q| p.total_cmp(q));
+            // Node x is inside when an odd number of crossings lie to its right.
+            let mut k = 0;
+            for (i, &x) in pu.iter().enumerate() {
+                while k < xs.len() && xs[k] <= x {
+                    k += 1;
+                }
+                inside[i * nv + j] = (xs.len() - k) % 2 == 1;
+            }
+        }
+        inside
+    }
+
     /// Even-odd inside test against all loops.
     pub fn contains(&self, q: DVec2) -> bool {
         let mut inside = false;
