@@ -462,6 +462,11 @@ fn cli_rejects_loop_point_with_three_coordinates() {
 }
 
 #[test]
+fn cli_rejects_crossing_loops() {
+    assert_rejected("bad_loops_cross.json", &["face 0", "loop 1 crosses loop 2"]);
+}
+
+#[test]
 fn cli_failure_keeps_an_existing_output() {
     let dir = scratch("keep");
     let out_path = dir.join("out.obj");
