@@ -175,8 +175,9 @@ fn on_border(f: &FaceWork<'_>, a: u32, b: u32, q: DVec3, sew: f64, reach: f64) -
     (d <= sew && s > 1e-9 && s < 1.0 - 1e-9).then_some(s)
 }
 
-/// Snaps border vertices of different faces that lie within `sew` of each
-/// other to one position (the first face's), so welding joins them exactly.
+/// Snaps border vertices that lie within `sew` of each other to one position
+/// (the first one's), so welding joins them exactly: across faces, and within
+/// one face along a seam its loop runs up on one side and down on the other.
 fn snap(faces: &mut [FaceWork<'_>], sew: f64, changed: &mut [Vec<u32>]) {
     let inv = 1.0 / sew;
     let mut grid: HashMap<Cell, Vec<(u32, u32)>> = HashMap::new();
@@ -195,7 +196,7 @@ fn snap(faces: &mut [FaceWork<'_>], sew: f64, changed: &mut [Vec<u32>]) {
                     for dz in -1..=1 {
                         let Some(list) = grid.get(&(kx + dx, ky + dy, kz + dz)) else { continue };
                         for &(g, w) in list {
-                            if g as usize != fi {
+                            if g as usize != fi || w != v {
                                 let q = faces[g as usize].mesh.pos[w as usize];
                                 if q.distance(p) <= sew {
                                     target = Some(q);
