@@ -3,18 +3,25 @@
 // cdylib for wasm32-unknown-unknown, then per target `wasm-bindgen` (the CLI
 // version pinned in Cargo.lock) and `wasm-opt` from the npm package
 // `binaryen` (Debian's binaryen writes modules that do not load). Prints the
-// size of every .wasm, raw and gzipped.
+// size of every .wasm, raw and gzipped. The plain-JS helpers in js/ (the
+// three.js adapter) are copied beside the targets and exported as subpaths.
 //
 // Usage: node scripts/build-wasm.mjs [--target web|bundler|nodejs ...] [--no-opt]
 
 import { spawnSync } from 'node:child_process';
-import { existsSync, mkdirSync, readFileSync, rmSync, statSync, writeFileSync } from 'node:fs';
+import { copyFileSync, existsSync, mkdirSync, readFileSync, rmSync, statSync, writeFileSync } from 'node:fs';
 import { dirname, join, relative } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { gzipSync } from 'node:zlib';
 import { parse as parseToml } from 'smol-toml';
 
 const root = join(dirname(fileURLToPath(import.meta.url)), '..');
+
+/**
+ * Plain-JS helpers copied from js/ into the package root: the export subpath,
+ * the module and its types, and the optional peer dependency it imports.
+ */
+const HELPERS = [{ export: './three', file: 'three.mjs', types: 'three.d.mts', peer: ['three', '>=0.150.0'] }];
 
 function fail(message) {
   console.error(`build-wasm: ${message}`);
@@ -117,14 +124,17 @@ function packageManifest(cargo, config, built) {
     const slot = (exports[t.export] ??= {});
     slot[t.condition] = { types: `./${t.out_dir}/${config.outName}.d.ts`, default: `./${t.out_dir}/${config.outName}.js` };
   }
+  for (const h of HELPERS) exports[h.export] = { types: `./${h.types}`, default: `./${h.file}` };
   exports['./package.json'] = './package.json';
   return {
     name: cargo.name,
     version: cargo.version,
     description: cargo.description,
     license: cargo.license,
-    files: built.map((name) => `${config.targets[name].out_dir}/`),
+    files: [...built.map((name) => `${config.targets[name].out_dir}/`), ...HELPERS.flatMap((h) => [h.file, h.types])],
     exports,
+    peerDependencies: Object.fromEntries(HELPERS.map((h) => h.peer)),
+    peerDependenciesMeta: Object.fromEntries(HELPERS.map((h) => [h.peer[0], { optional: true }])),
   };
 }
 
@@ -157,6 +167,9 @@ function main() {
     if (optimize) run(wasmOpt, [...(config.opt.args ?? ['-Oz']), wasm, '-o', wasm]);
     writeFileSync(join(out, 'package.json'), `${JSON.stringify(targetManifest(name, cargo, config.outName), null, 2)}\n`);
     sizes.push({ name, path: relative(root, wasm), raw: statSync(wasm).size, gzip: gzipSize(wasm) });
+  }
+  for (const h of HELPERS) {
+    for (const file of [h.file, h.types]) copyFileSync(join(root, 'js', file), join(config.packageDir, file));
   }
   const manifest = packageManifest(cargo, config, names);
   writeFileSync(join(config.packageDir, 'package.json'), `${JSON.stringify(manifest, null, 2)}\n`);

@@ -28,4 +28,5 @@ step "wasm tests in Node" env CARGO_PROFILE_TEST_OPT_LEVEL=2 \
   cargo test --target wasm32-unknown-unknown --test wasm_node
 step "npm package build" node scripts/build-wasm.mjs
 step "npm package tests in Node" node --test scripts/pkg.test.mjs
+step "browser tests (page, Vite and Node consumers)" node --test --test-concurrency=1 tests/browser/page.test.mjs tests/browser/consumer.test.mjs
 printf '\n== test: all passed (%d s)\n' $((SECONDS - total))

@@ -15,7 +15,13 @@ use alloc::vec::Vec;
 use js_sys::{Array, Float32Array, Function, Object, Reflect, Uint32Array, JSON};
 use wasm_bindgen::prelude::*;
 
-use crate::{mesh_model, read_model, Error, Format, MeshOptions, MeshResult};
+use crate::{read_model, Error, Format, MeshOptions, MeshResult};
+// `tests/wasm_node.rs` compiles this file into a crate where `crate::` is the
+// test itself, which does not import this name; take it from the library there.
+#[cfg(not(test))]
+use crate::mesh_model_with_progress;
+#[cfg(test)]
+use surfmesh::mesh_model_with_progress;
 
 #[cfg_attr(not(test), wasm_bindgen(typescript_custom_section))]
 #[cfg_attr(test, allow(dead_code))]
@@ -55,6 +61,18 @@ export interface MeshOutput {
  * Throws an `Error` whose message names the problem (the CLI's one-line error).
  */
 export function mesh(bytes: Uint8Array, format: string, options?: MeshOptions): MeshOutput;
+
+/**
+ * As `mesh`, calling `progress(facesDone, facesTotal)` after each face is meshed (sewing and
+ * measuring follow the last call). Returning `false` stops meshing, which then throws an Error
+ * whose message is "cancelled"; an exception thrown by `progress` stops it and is rethrown.
+ */
+export function meshWithProgress(
+  bytes: Uint8Array,
+  format: string,
+  options: MeshOptions | undefined,
+  progress: (facesDone: number, facesTotal: number) => boolean | void,
+): MeshOutput;
 "#;
 
 /// Option names `mesh` accepts, in the order they are read.
@@ -76,7 +94,41 @@ pub fn version() -> String {
 #[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
 pub fn mesh(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsError> {
     let options = read_options(&options).map_err(|e| JsError::new(&e))?;
-    run(bytes, format, &options).map_err(|e| JsError::new(&one_line(&e.to_string())))
+    run(bytes, format, &options, &mut |_, _| true).map_err(|e| JsError::new(&one_line(&e.to_string())))
+}
+
+/// As [`mesh`], calling the JS function `progress(faces_done, faces_total)`
+/// after each face, so a Web Worker can post progress events; the function
+/// returning `false` stops meshing with the error "cancelled".
+///
+/// # Errors
+/// As [`mesh`]; an exception thrown by `progress` stops meshing and is
+/// rethrown as it is.
+#[cfg_attr(not(test), wasm_bindgen(js_name = meshWithProgress, skip_typescript))]
+#[cfg_attr(test, allow(dead_code))]
+pub fn mesh_with_progress(
+    bytes: &[u8],
+    format: &str,
+    options: JsValue,
+    progress: &Function,
+) -> Result<JsValue, JsValue> {
+    let options = read_options(&options).map_err(|e| JsValue::from(JsError::new(&e)))?;
+    let mut thrown: Option<JsValue> = None;
+    let mut call = |done: usize, total: usize| -> bool {
+        match progress.call2(&JsValue::NULL, &JsValue::from(done as f64), &JsValue::from(total as f64)) {
+            Ok(answer) => answer.as_bool() != Some(false),
+            Err(e) => {
+                thrown = Some(e);
+                false
+            }
+        }
+    };
+    let result = run(bytes, format, &options, &mut call);
+    match (result, thrown) {
+        (_, Some(e)) => Err(e),
+        (Ok(out), None) => Ok(out),
+        (Err(e), None) => Err(JsError::new(&one_line(&e.to_string())).into()),
+    }
 }
 
 /// The message on one line, as the command line prints it.
@@ -84,14 +136,20 @@ fn one_line(message: &str) -> String {
     message.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
-/// Parses, meshes and converts, timing the two stages with the host clock.
-fn run(bytes: &[u8], format: &str, options: &MeshOptions) -> Result<JsValue, Error> {
+/// Parses, meshes (reporting each face to `progress`) and converts, timing
+/// the two stages with the host clock.
+fn run(
+    bytes: &[u8],
+    format: &str,
+    options: &MeshOptions,
+    progress: &mut dyn FnMut(usize, usize) -> bool,
+) -> Result<JsValue, Error> {
     options.validate()?;
     let format = pick_format(bytes, format)?;
     let t0 = now_ms();
     let model = read_model(bytes, format)?;
     let t1 = now_ms();
-    let mut result = mesh_model(&model, options)?;
+    let mut result = mesh_model_with_progress(&model, options, progress)?;
     let t2 = now_ms();
     if let (Some(t0), Some(t1), Some(t2)) = (t0, t1, t2) {
         result.report.parse_ms = t1 - t0;

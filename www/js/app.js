@@ -1,0 +1,411 @@
+// The page: wires the controls to the worker pool and the viewer.
+//
+// Loading a model runs two jobs side by side: a coarse mesh at relative
+// tolerance 1e-2 (shown as soon as it is ready, so a big part shows something
+// at once) and the mesh at the requested tolerance, which replaces it.
+// Changing a setting re-meshes with the current mesh left on screen until the
+// new one is ready. Cancel stops the work at once (the worker is terminated
+// and respawned). Timings are left on <body> as data attributes
+// (data-first-mesh-ms: first mesh on screen, from navigation start;
+// data-final-mesh-ms; data-cancel-ms: cancel click to a ready pool).
+
+import { MeshPool } from './pool.js';
+import { Viewer, PALETTE } from './viewer.js';
+import { toGlb, toObj, toStl } from './export.js';
+
+const $ = (id) => document.getElementById(id);
+const body = document.body;
+const COARSE_REL = 1e-2;
+const DEFAULT_ANGLE_DEG = ((0.5 * 180) / Math.PI).toFixed(2);
+
+performance.mark('surfmesh:app-start');
+const boot = window.surfmeshBoot ?? { sample: 'grid50', workers: [] };
+const pool = new MeshPool({
+  size: 2,
+  module: boot.module,
+  wasmUrl: new URL('../pkg/web/surfmesh_bg.wasm', import.meta.url),
+  workerUrl: new URL('./worker.js', import.meta.url),
+  workers: boot.workers,
+});
+const viewer = new Viewer($('canvas'));
+body.dataset.renderer = viewer.software ? 'software' : 'gpu';
+
+const state = {
+  model: null, // { name, bytes, format }
+  shown: null, // { result, lines, quality }
+  run: 0, // bumped by every new request and by cancel; stale answers are dropped
+  diagonal: null, // bounding-box diagonal of the current model, once a relative run tells it
+};
+
+// ---------------------------------------------------------------- status
+
+let settled = 0;
+/** The page state on <body data-state>; data-settled counts the runs that ended (ready, error, cancelled). */
+function setState(name) {
+  body.dataset.state = name;
+  if (name !== 'meshing') body.dataset.settled = String(++settled);
+}
+
+function status(text) {
+  $('status').textContent = text;
+}
+
+function showProgress(done, total) {
+  $('progress').hidden = false;
+  if (total === 0) {
+    $('progress-bar').style.width = '0%';
+    $('progress-label').textContent = 'Reading…';
+  } else if (done < total) {
+    $('progress-bar').style.width = `${(100 * done) / total}%`;
+    $('progress-label').textContent = `Meshing face ${done + 1} of ${total}`;
+  } else {
+    $('progress-bar').style.width = '100%';
+    $('progress-label').textContent = `Sewing and measuring ${total} faces…`;
+  }
+}
+
+function hideProgress() {
+  $('progress').hidden = true;
+}
+
+function showError(file, message) {
+  $('error-file').textContent = file;
+  $('error-message').textContent = message;
+  $('error').hidden = false;
+  status(`Error: ${message}`);
+}
+
+function hideError() {
+  $('error').hidden = true;
+}
+
+// ---------------------------------------------------------------- stats
+
+const fmt = (x) => (x === 0 ? '0' : Math.abs(x) >= 1e-3 && Math.abs(x) < 1e5 ? x.toPrecision(4) : x.toExponential(2));
+const count = (n) => n.toLocaleString('en-US');
+
+function setStat(id, text, cls = '') {
+  const el = $(id);
+  el.textContent = text;
+  el.className = cls;
+}
+
+function showStats(report, quality) {
+  setStat('stat-faces', report.faces_skipped ? `${report.faces} (${report.faces_skipped} skipped)` : count(report.faces));
+  setStat('stat-triangles', count(report.triangles));
+  setStat('stat-vertices', count(report.vertices));
+  setStat('stat-tolerance', fmt(report.tolerance));
+  const within = report.max_deviation <= report.tolerance;
+  setStat('stat-max-deviation', `${fmt(report.max_deviation)} ${within ? '✓' : '✗'}`, within ? 'ok' : 'bad');
+  setStat('stat-mean-deviation', fmt(report.mean_deviation));
+  setStat('stat-min-angle', `${report.min_angle_deg.toFixed(1)}° (1%: ${report.p1_angle_deg.toFixed(1)}°)`);
+  setStat('stat-free-edges', count(report.free_edges), report.free_edges === 0 ? 'ok' : 'bad');
+  setStat('stat-open-edges', count(report.boundary_edges));
+  setStat('stat-nonmanifold', count(report.nonmanifold_edges), report.nonmanifold_edges === 0 ? '' : 'bad');
+  setStat('stat-time', `${report.parse_ms.toFixed(1)} / ${report.time_ms.toFixed(1)} ms`);
+  const badge = $('quality');
+  badge.hidden = false;
+  badge.textContent = quality === 'final' ? 'final' : 'coarse preview';
+  badge.className = `badge ${quality}`;
+  const list = $('warnings');
+  list.replaceChildren();
+  for (const w of report.warnings) {
+    const li = document.createElement('li');
+    li.textContent = w;
+    list.append(li);
+  }
+  if (report.warnings.length === 0) {
+    const li = document.createElement('li');
+    li.className = 'muted';
+    li.textContent = 'none';
+    list.append(li);
+  }
+  $('warning-count').textContent = report.warnings.length ? String(report.warnings.length) : '';
+}
+
+function clearStats() {
+  for (const el of $('stats').querySelectorAll('dd')) {
+    el.textContent = '—';
+    el.className = '';
+  }
+  $('quality').hidden = true;
+  $('warnings').innerHTML = '<li class="muted">none</li>';
+  $('warning-count').textContent = '';
+}
+
+// ---------------------------------------------------------------- options
+
+function tolKind() {
+  return document.querySelector('input[name="tol-kind"]:checked').value;
+}
+
+/** The mesher options the controls ask for; the module validates them. */
+function readOptions() {
+  const value = Number($('tol-value').value);
+  const options = tolKind() === 'rel' ? { toleranceRel: value } : { tolerance: value };
+  const angle = $('angle').value.trim();
+  if (angle !== '' && angle !== DEFAULT_ANGLE_DEG) options.angle = (Number(angle) * Math.PI) / 180;
+  const maxEdge = $('max-edge').value.trim();
+  if (maxEdge !== '') options.maxEdge = Number(maxEdge);
+  return options;
+}
+
+function syncSlider() {
+  const value = Number($('tol-value').value);
+  const rel = tolKind() === 'rel' ? value : state.diagonal ? value / state.diagonal : NaN;
+  if (rel > 0) $('tol-slider').value = String(Math.log10(rel));
+}
+
+function sliderToValue() {
+  const rel = 10 ** Number($('tol-slider').value);
+  const value = tolKind() === 'rel' ? rel : state.diagonal ? rel * state.diagonal : NaN;
+  if (value > 0) $('tol-value').value = String(Number(value.toPrecision(3)));
+}
+
+// ---------------------------------------------------------------- meshing
+
+function formatOf(name) {
+  const ext = name.toLowerCase().split('.').pop();
+  if (ext === 'json') return 'json';
+  if (ext === 'igs' || ext === 'iges') return 'iges';
+  if (ext === 'stp' || ext === 'step') return 'step';
+  return 'auto';
+}
+
+function load(name, bytes) {
+  state.model = { name, bytes, format: formatOf(name) };
+  state.diagonal = null;
+  $('model-name').textContent = name;
+  remesh({ fresh: true });
+}
+
+let timer = 0;
+function remeshSoon() {
+  clearTimeout(timer);
+  timer = setTimeout(() => remesh(), 250);
+}
+
+function remesh({ fresh = false } = {}) {
+  clearTimeout(timer);
+  if (!state.model) return;
+  pool.cancelAll();
+  const run = ++state.run;
+  const { name, bytes, format } = state.model;
+  const options = readOptions();
+  hideError();
+  setState('meshing');
+  showProgress(0, 0);
+  if (fresh) {
+    state.shown = null;
+    viewer.clear();
+    clearStats();
+    setExport(false);
+  }
+  status(`Meshing ${name}…`);
+  let finished = false;
+  performance.mark('surfmesh:mesh-requested');
+  const fine = pool.mesh(bytes, format, options, (done, total) => {
+    if (run === state.run) showProgress(done, total);
+  });
+  const coarseRel = options.toleranceRel === undefined || options.toleranceRel < COARSE_REL;
+  if (fresh && coarseRel) {
+    pool.mesh(bytes, format, { toleranceRel: COARSE_REL }).promise.then(
+      ({ result, lines }) => {
+        performance.mark('surfmesh:coarse-result', { detail: result.report.time_ms });
+        if (run !== state.run || finished) return;
+        learnDiagonal(result.report, COARSE_REL);
+        display(result, lines, 'coarse', { fit: true });
+        status(`Coarse preview (relative ${COARSE_REL}) shown; meshing at the requested tolerance…`);
+      },
+      () => {}, // the requested run reports the same error
+    );
+  }
+  fine.promise.then(
+    ({ result, lines }) => {
+      performance.mark('surfmesh:final-result');
+      if (run !== state.run) return;
+      finished = true;
+      pool.cancelAll();
+      learnDiagonal(result.report, options.toleranceRel);
+      display(result, lines, 'final', { fit: fresh && state.shown?.quality !== 'coarse' });
+      hideProgress();
+      setState('ready');
+      const r = result.report;
+      status(
+        `${count(r.triangles)} triangles · max deviation ${fmt(r.max_deviation)} ≤ ${fmt(r.tolerance)} · ` +
+          `${r.time_ms.toFixed(0)} ms`,
+      );
+    },
+    (error) => {
+      if (run !== state.run) return;
+      finished = true;
+      pool.cancelAll();
+      hideProgress();
+      setState('error');
+      showError(name, error.message);
+    },
+  );
+}
+
+function learnDiagonal(report, rel) {
+  if (rel > 0 && report.tolerance > 0) state.diagonal = report.tolerance / rel;
+}
+
+let firstShown = false;
+let finalShown = false;
+function display(result, lines, quality, { fit }) {
+  state.shown = { result, lines, quality };
+  body.dataset.quality = quality;
+  // On screen: the frame after the one that drew the mesh has begun.
+  viewer.onRendered = () => {
+    viewer.onRendered = null;
+    requestAnimationFrame(() => {
+      const t = performance.now().toFixed(0);
+      if (!firstShown) {
+        firstShown = true;
+        body.dataset.firstMeshMs = t;
+      }
+      if (quality === 'final' && !finalShown) {
+        finalShown = true;
+        body.dataset.finalMeshMs = t;
+      }
+    });
+  };
+  viewer.show(result, lines, { fit });
+  showStats(result.report, quality);
+  setExport(true);
+}
+
+function cancel() {
+  const start = performance.now();
+  state.run++;
+  pool.cancelAll();
+  hideProgress();
+  setState('cancelled');
+  status(state.shown ? 'Cancelled; the mesh shown is the previous one' : 'Cancelled');
+  pool.ready().then(() => {
+    body.dataset.cancelMs = (performance.now() - start).toFixed(0);
+  });
+}
+
+// ---------------------------------------------------------------- export
+
+function setExport(enabled) {
+  for (const id of ['export-stl', 'export-obj', 'export-glb']) $(id).disabled = !enabled;
+}
+
+function download(blob, filename) {
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(blob);
+  a.download = filename;
+  document.body.append(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(a.href), 30000);
+}
+
+function stem() {
+  return (state.model?.name ?? 'mesh').replace(/\.[^.]*$/, '');
+}
+
+$('export-stl').onclick = () => state.shown && download(toStl(state.shown.result, `surfmesh ${stem()}`), `${stem()}.stl`);
+$('export-obj').onclick = () => state.shown && download(toObj(state.shown.result, `surfmesh ${stem()}`), `${stem()}.obj`);
+$('export-glb').onclick = () => state.shown && download(toGlb(state.shown.result, PALETTE), `${stem()}.glb`);
+
+// ---------------------------------------------------------------- controls
+
+$('angle').value = DEFAULT_ANGLE_DEG;
+$('cancel').onclick = cancel;
+$('error-close').onclick = hideError;
+$('fit').onclick = () => viewer.fit();
+viewer.canvas.addEventListener('dblclick', () => viewer.fit());
+
+$('tol-value').addEventListener('change', () => {
+  syncSlider();
+  remesh();
+});
+$('tol-slider').addEventListener('input', () => {
+  sliderToValue();
+  remeshSoon();
+});
+for (const id of ['angle', 'max-edge']) $(id).addEventListener('change', () => remesh());
+for (const radio of document.querySelectorAll('input[name="tol-kind"]')) {
+  radio.addEventListener('change', () => {
+    const abs = tolKind() === 'abs';
+    $('tol-label').textContent = abs ? 'Chordal, model units' : 'Chordal, × bounding-box diagonal';
+    const value = Number($('tol-value').value);
+    if (state.diagonal && value > 0) {
+      const converted = abs ? value * state.diagonal : value / state.diagonal;
+      $('tol-value').value = String(Number(converted.toPrecision(3)));
+    }
+    syncSlider();
+    remesh();
+  });
+}
+
+const toggles = { 'show-colors': 'faceColors', 'show-wire': 'wireframe', 'show-borders': 'borders', 'show-open': 'openEdges' };
+for (const [id, key] of Object.entries(toggles)) {
+  $(id).addEventListener('change', () => viewer.set({ [key]: $(id).checked }));
+}
+
+$('file-input').addEventListener('change', (event) => {
+  const file = event.target.files?.[0];
+  event.target.value = '';
+  if (file) openFile(file);
+});
+
+async function openFile(file) {
+  $('sample').value = '';
+  load(file.name, await file.arrayBuffer());
+}
+
+$('sample').addEventListener('change', () => loadSample($('sample').value));
+
+async function loadSample(name, bytes) {
+  $('sample').value = name;
+  try {
+    const data = await (bytes ?? fetch(`samples/${name}.json`).then((r) => (r.ok ? r.arrayBuffer() : Promise.reject(new Error(`HTTP ${r.status}`)))));
+    load(`${name}.json`, data);
+  } catch (e) {
+    setState('error');
+    showError(`${name}.json`, `cannot fetch the sample: ${e.message}`);
+  }
+}
+
+const view = $('view');
+let dragDepth = 0;
+view.addEventListener('dragenter', (e) => {
+  e.preventDefault();
+  dragDepth++;
+  $('drop').hidden = false;
+});
+view.addEventListener('dragleave', () => {
+  dragDepth = Math.max(0, dragDepth - 1);
+  if (dragDepth === 0) $('drop').hidden = true;
+});
+view.addEventListener('dragover', (e) => e.preventDefault());
+view.addEventListener('drop', (e) => {
+  e.preventDefault();
+  dragDepth = 0;
+  $('drop').hidden = true;
+  const file = e.dataTransfer?.files?.[0];
+  if (file) openFile(file);
+});
+window.addEventListener('keydown', (e) => {
+  if (e.key === 'f' && !(e.target instanceof HTMLInputElement)) viewer.fit();
+  if (e.key === 'Escape' && !$('progress').hidden) cancel();
+});
+
+pool.ready().then(
+  () => {
+    performance.mark('surfmesh:pool-ready');
+    $('version').textContent = `surfmesh ${pool.version}`;
+  },
+  (e) => {
+    setState('error');
+    showError('the mesher', e.message);
+  },
+);
+
+// The default sample's jobs go out first; the shaders compile while the workers mesh.
+loadSample(boot.sample, boot.bytes).then(() => viewer.warmUp());

@@ -1,0 +1,226 @@
+// The three.js viewer: a shaded mesh with one colour per model face (groups
+// from surfmesh/three), a wireframe overlay, face borders and open edges as
+// line sets, orbit controls and fit-to-view. Renders on demand (after a
+// change or a camera move), so an idle page costs nothing.
+
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { toBufferGeometry } from 'surfmesh/three';
+
+/** Face colours: muted, told apart at a glance, none close to the open-edge orange. */
+export const PALETTE = [
+  0x6d9dc5, 0xc9a66b, 0x8fbf8a, 0xc98b9f, 0x9b8fcf, 0x6bb8b0, 0xd0c27a, 0xa3a8b0, 0x86a9d8, 0xbf9a84, 0x7fae6e,
+  0xb88fc0,
+];
+const NEUTRAL = 0xaeb4bc;
+
+export class Viewer {
+  constructor(canvas) {
+    // Multisampling when a GPU draws; with software GL (headless browsers,
+    // virtual machines) it would cost more than the mesh itself, so there the
+    // canvas is replaced by a fresh one with a context without it.
+    const attributes = { alpha: true, depth: true, stencil: false, premultipliedAlpha: true };
+    let gl = canvas.getContext('webgl2', { ...attributes, antialias: true });
+    this.software = gl !== null && isSoftware(gl);
+    if (this.software) {
+      gl.getExtension('WEBGL_lose_context')?.loseContext();
+      const fresh = canvas.cloneNode(false);
+      canvas.replaceWith(fresh);
+      canvas = fresh;
+      gl = canvas.getContext('webgl2', { ...attributes, antialias: false });
+    }
+    this.canvas = canvas;
+    this.renderer = new THREE.WebGLRenderer({ canvas, context: gl ?? undefined, ...attributes });
+    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+    this.renderer.setClearColor(0x000000, 0);
+    this.scene = new THREE.Scene();
+    this.camera = new THREE.PerspectiveCamera(35, 1, 0.1, 1000);
+    this.camera.up.set(0, 0, 1);
+    this.camera.position.set(1, -1.4, 1);
+    this.scene.add(this.camera);
+    this.scene.add(new THREE.HemisphereLight(0xe8eef6, 0x30343a, 1.4));
+    const key = new THREE.DirectionalLight(0xffffff, 1.6);
+    key.position.set(0.5, 0.8, 1);
+    this.camera.add(key); // a head light: the lit side follows the view
+
+    this.controls = new OrbitControls(this.camera, canvas);
+    this.controls.addEventListener('change', () => this.requestRender());
+
+    this.faceMaterials = PALETTE.map((color) => this.#shaded(color));
+    this.plainMaterial = this.#shaded(NEUTRAL);
+    this.wireMaterial = new THREE.MeshBasicMaterial({
+      color: 0x12161c,
+      wireframe: true,
+      transparent: true,
+      opacity: 0.35,
+    });
+    this.borderMaterial = new THREE.LineBasicMaterial({ color: 0x0b0d10 });
+    this.openMaterial = new THREE.LineBasicMaterial({ color: 0xff7a1a, depthTest: false });
+
+    this.group = new THREE.Group();
+    this.scene.add(this.group);
+    this.parts = null;
+    this.options = { faceColors: true, wireframe: true, borders: true, openEdges: true };
+    this.pending = false;
+    this.empty = true; // nothing drawn yet: a fresh canvas is already clear
+    this.onRendered = null;
+    new ResizeObserver(() => this.resize()).observe(canvas.parentElement);
+    this.resize();
+  }
+
+  /**
+   * Draws every material once, on degenerate geometry that covers no pixel, so
+   * that shader compilation (slow with software GL) happens before the first
+   * mesh arrives rather than when it is drawn.
+   */
+  warmUp() {
+    const geometry = toBufferGeometry({
+      positions: new Float32Array(9),
+      normals: new Float32Array([0, 0, 1, 0, 0, 1, 0, 0, 1]),
+      indices: new Uint32Array([0, 1, 2]),
+      faceRanges: new Uint32Array([0, 1]),
+    });
+    const parts = [
+      new THREE.Mesh(geometry, this.faceMaterials),
+      new THREE.Mesh(geometry, this.plainMaterial),
+      new THREE.Mesh(geometry, this.wireMaterial),
+      segments(new Float32Array(6), this.borderMaterial),
+      segments(new Float32Array(6), this.openMaterial),
+    ];
+    for (const part of parts) part.frustumCulled = false;
+    this.scene.add(...parts);
+    this.renderer.render(this.scene, this.camera);
+    this.scene.remove(...parts);
+    geometry.dispose();
+    parts[3].geometry.dispose();
+    parts[4].geometry.dispose();
+    performance.mark('surfmesh:shaders-compiled');
+  }
+
+  #shaded(color) {
+    return new THREE.MeshPhongMaterial({
+      color,
+      specular: 0x2a2a2a,
+      shininess: 40,
+      side: THREE.DoubleSide,
+      polygonOffset: true,
+      polygonOffsetFactor: 1,
+      polygonOffsetUnits: 1,
+    });
+  }
+
+  /** Shows a mesh result and its line sets; `fit` re-frames the camera. */
+  show(result, lines, { fit = false } = {}) {
+    this.clear();
+    const geometry = toBufferGeometry(result, { materialCount: PALETTE.length });
+    const shaded = new THREE.Mesh(geometry, this.faceMaterials);
+    const wire = new THREE.Mesh(geometry, this.wireMaterial);
+    const borders = segments(lines.borders, this.borderMaterial);
+    const open = segments(lines.open, this.openMaterial);
+    open.renderOrder = 2;
+    this.parts = { geometry, shaded, wire, borders, open };
+    this.group.add(shaded, wire, borders, open);
+    this.apply();
+    if (fit) this.fit();
+    this.requestRender();
+  }
+
+  /** Removes the shown mesh and frees its GPU buffers. */
+  clear() {
+    if (!this.parts) return;
+    for (const part of [this.parts.shaded, this.parts.wire, this.parts.borders, this.parts.open]) {
+      this.group.remove(part);
+    }
+    this.parts.geometry.dispose();
+    this.parts.borders.geometry.dispose();
+    this.parts.open.geometry.dispose();
+    this.parts = null;
+    this.empty = false;
+    this.requestRender();
+  }
+
+  /** Display toggles: faceColors, wireframe, borders, openEdges (booleans). */
+  set(options) {
+    Object.assign(this.options, options);
+    this.apply();
+  }
+
+  apply() {
+    if (!this.parts) return;
+    const o = this.options;
+    this.parts.shaded.material = o.faceColors ? this.faceMaterials : this.plainMaterial;
+    this.parts.wire.visible = o.wireframe;
+    this.parts.borders.visible = o.borders;
+    this.parts.open.visible = o.openEdges;
+    this.requestRender();
+  }
+
+  /** Frames the mesh: looks from the front-right-top, close enough that its bounding box just fits. */
+  fit() {
+    if (!this.parts) return;
+    const box = this.parts.geometry.boundingBox;
+    const center = box.getCenter(new THREE.Vector3());
+    const dir = new THREE.Vector3(0.5, -0.9, 0.65).normalize();
+    // Camera axes for that direction (z up).
+    const forward = dir.clone().negate();
+    const right = new THREE.Vector3().crossVectors(forward, this.camera.up).normalize();
+    const up = new THREE.Vector3().crossVectors(right, forward);
+    const tanV = Math.tan(THREE.MathUtils.degToRad(this.camera.fov) / 2) * 0.9;
+    const tanH = tanV * this.camera.aspect;
+    let distance = 0;
+    let depth = 0;
+    for (let i = 0; i < 8; i++) {
+      const corner = new THREE.Vector3(
+        i & 1 ? box.max.x : box.min.x,
+        i & 2 ? box.max.y : box.min.y,
+        i & 4 ? box.max.z : box.min.z,
+      ).sub(center);
+      const z = corner.dot(forward);
+      distance = Math.max(distance, Math.abs(corner.dot(right)) / tanH + z, Math.abs(corner.dot(up)) / tanV + z);
+      depth = Math.max(depth, corner.length());
+    }
+    distance = Math.max(distance, 1e-6);
+    this.controls.target.copy(center);
+    this.camera.position.copy(center).addScaledVector(dir, distance);
+    this.camera.near = Math.max(distance - depth, distance / 1000) / 2;
+    this.camera.far = (distance + depth) * 4;
+    this.camera.updateProjectionMatrix();
+    this.controls.update();
+    this.requestRender();
+  }
+
+  resize() {
+    const box = this.canvas.parentElement.getBoundingClientRect();
+    const width = Math.max(1, Math.floor(box.width));
+    const height = Math.max(1, Math.floor(box.height));
+    this.renderer.setSize(width, height, false);
+    this.camera.aspect = width / height;
+    this.camera.updateProjectionMatrix();
+    this.requestRender();
+  }
+
+  /** Draws at the next frame; an empty view is cleared once, then left alone. */
+  requestRender() {
+    if (this.pending || (!this.parts && this.empty)) return;
+    this.pending = true;
+    requestAnimationFrame(() => {
+      this.pending = false;
+      this.renderer.render(this.scene, this.camera);
+      this.empty = !this.parts;
+      if (this.onRendered) this.onRendered();
+    });
+  }
+}
+
+/** Whether the context is drawn by a software rasterizer (SwiftShader, llvmpipe, ...). */
+function isSoftware(gl) {
+  const info = gl.getExtension('WEBGL_debug_renderer_info');
+  const name = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+  return /swiftshader|llvmpipe|softpipe|software|basic render/i.test(name);
+}
+
+function segments(array, material) {
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(array, 3));
+  return new THREE.LineSegments(geometry, material);
+}

@@ -1,0 +1,113 @@
+// The meshing worker: loads the wasm module (compiled once by the page and
+// posted here, so a respawn after cancel() only instantiates it), meshes one
+// model per request with progress events, and posts the arrays back as
+// transferred buffers (no copy). It also derives the line sets the viewer
+// draws, so the page's thread only uploads buffers:
+//   borders: segments where a model face ends (edges of one triangle of that face),
+//   open:    edges with one triangle after welding coincident vertices across
+//            faces — the model's open border plus any crack.
+//
+// Messages in:  { type: 'init', module } then { type: 'mesh', id, bytes, format, options }
+// Messages out: { type: 'ready' } | { type: 'fatal', message }
+//               { type: 'progress', id, done, total }
+//               { type: 'result', id, result, lines: { borders, open } }
+//               { type: 'error', id, message }
+
+import init, { meshWithProgress, version } from '../pkg/web/surfmesh.js';
+
+// Settles when the module is loaded: to null, or to the reason it could not load.
+// A request that arrives first waits for it.
+let settleLoad;
+const loaded = new Promise((resolve) => {
+  settleLoad = resolve;
+});
+
+self.onmessage = async (event) => {
+  const msg = event.data;
+  if (msg.type === 'init') {
+    init({ module_or_path: msg.module }).then(
+      () => {
+        self.postMessage({ type: 'ready', version: version() });
+        settleLoad(null);
+      },
+      (e) => {
+        const message = `cannot load the wasm module: ${e.message ?? e}`;
+        self.postMessage({ type: 'fatal', message });
+        settleLoad(message);
+      },
+    );
+    return;
+  }
+  if (msg.type !== 'mesh') return;
+  const { id } = msg;
+  const failure = await loaded;
+  if (failure) {
+    self.postMessage({ type: 'error', id, message: failure });
+    return;
+  }
+  let result;
+  try {
+    result = meshWithProgress(new Uint8Array(msg.bytes), msg.format, msg.options, (done, total) => {
+      self.postMessage({ type: 'progress', id, done, total });
+    });
+  } catch (e) {
+    self.postMessage({ type: 'error', id, message: e instanceof Error ? e.message : String(e) });
+    return;
+  }
+  const lines = edgeLines(result);
+  const buffers = [result.positions, result.normals, result.indices, result.faceRanges, lines.borders, lines.open];
+  self.postMessage(
+    { type: 'result', id, result, lines },
+    buffers.map((a) => a.buffer),
+  );
+};
+
+/** Face-border and open-edge segments (x, y, z pairs) of a mesh. */
+function edgeLines({ positions, indices, faceRanges }) {
+  // Weld: one id per distinct position (sewing makes shared borders coincide exactly).
+  const weld = new Uint32Array(positions.length / 3);
+  const ids = new Map();
+  for (let v = 0; v < weld.length; v++) {
+    const key = `${positions[3 * v]},${positions[3 * v + 1]},${positions[3 * v + 2]}`;
+    let id = ids.get(key);
+    if (id === undefined) {
+      id = ids.size;
+      ids.set(key, id);
+    }
+    weld[v] = id;
+  }
+  const n = ids.size;
+  const faceOf = new Uint32Array(indices.length / 3);
+  for (let f = 0; 2 * f + 1 < faceRanges.length; f++) {
+    faceOf.fill(f, faceRanges[2 * f], faceRanges[2 * f] + faceRanges[2 * f + 1]);
+  }
+  // Per welded edge: how many triangles use it, the first user's face, whether
+  // two different faces use it, and one (unwelded) vertex pair to draw.
+  const edges = new Map();
+  for (let t = 0; t < indices.length / 3; t++) {
+    for (let k = 0; k < 3; k++) {
+      const a = indices[3 * t + k];
+      const b = indices[3 * t + ((k + 1) % 3)];
+      const wa = weld[a];
+      const wb = weld[b];
+      const key = wa < wb ? wa * n + wb : wb * n + wa;
+      const e = edges.get(key);
+      if (e === undefined) edges.set(key, { uses: 1, face: faceOf[t], faces: 1, a, b });
+      else {
+        e.uses++;
+        if (e.face !== faceOf[t]) e.faces = 2;
+      }
+    }
+  }
+  const borders = [];
+  const open = [];
+  const push = (out, a, b) => {
+    out.push(positions[3 * a], positions[3 * a + 1], positions[3 * a + 2]);
+    out.push(positions[3 * b], positions[3 * b + 1], positions[3 * b + 2]);
+  };
+  for (const e of edges.values()) {
+    if (e.uses === 1) push(open, e.a, e.b);
+    if (e.uses === 1 || e.faces > 1) push(borders, e.a, e.b);
+  }
+  return { borders: new Float32Array(borders), open: new Float32Array(open) };
+}
