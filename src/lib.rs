@@ -16,6 +16,7 @@ extern crate std;
 mod error;
 mod io;
 mod math;
+mod measure;
 mod mesh;
 mod model;
 mod nurbs;
@@ -25,6 +26,7 @@ mod wasm;
 
 pub use error::Error;
 pub use io::{read_json, read_model, write_glb, write_obj, write_stl, Format};
+pub use measure::{measure_mesh, MeasureOptions, MeshMeasure};
 pub use mesh::{angle_stats, edge_counts, weld_positions, AngleStats, EdgeCounts, FaceRange, Mesh, Report};
 pub use model::{Face, FaceSurface, Model, TrimLoop};
 pub use nurbs::{
