@@ -350,3 +350,67 @@ fn module_keeps_working_after_errors() {
     let out = ok(&dome(), options(&[("tolerance", num(0.05))]));
     assert!(out.triangles() >= 2);
 }
+
+/// Two domes side by side, sharing the edge x = 10: a two-face model.
+fn two_domes() -> Vec<u8> {
+    let one: serde_json::Value = serde_json::from_slice(&dome()).expect("dome JSON");
+    let mut second = one["faces"][0].clone();
+    for row in second["surface"]["points"].as_array_mut().expect("points") {
+        for p in row.as_array_mut().expect("row") {
+            p[0] = (p[0].as_f64().expect("x") + 10.0).into();
+        }
+    }
+    let mut two = one.clone();
+    two["faces"].as_array_mut().expect("faces").push(second);
+    serde_json::to_vec(&two).expect("two domes JSON")
+}
+
+/// Calls `mesh_with_progress` with a JS callback built from `body` (arguments `done`, `total`),
+/// which also records every call in `globalThis.__surfmeshCalls`.
+fn mesh_with_progress_js(bytes: &[u8], body: &str) -> (Result<JsValue, JsValue>, Vec<(f64, f64)>) {
+    let calls = js_sys::Array::new();
+    Reflect::set(&js_sys::global(), &"__surfmeshCalls".into(), &calls).expect("set global");
+    let source = format!("globalThis.__surfmeshCalls.push([done, total]); {body}");
+    let progress = js_sys::Function::new_with_args("done, total", &source);
+    let result = binding::mesh_with_progress(bytes, "json", JsValue::UNDEFINED, &progress);
+    let seen = calls
+        .iter()
+        .map(|c| {
+            let c: js_sys::Array = c.unchecked_into();
+            (c.get(0).as_f64().expect("done"), c.get(1).as_f64().expect("total"))
+        })
+        .collect();
+    (result, seen)
+}
+
+#[wasm_bindgen_test]
+fn progress_is_reported_once_per_face() {
+    let (result, calls) = mesh_with_progress_js(&two_domes(), "");
+    let value = result.unwrap_or_else(|e| panic!("meshing failed: {e:?}"));
+    assert_eq!(calls, vec![(1.0, 2.0), (2.0, 2.0)]);
+    let ranges: Uint32Array = Reflect::get(&value, &"faceRanges".into()).expect("faceRanges").unchecked_into();
+    assert_eq!(ranges.length(), 4, "two faces, two (first, count) pairs");
+    // Without a callback the same model gives the same mesh.
+    let plain = ok(&two_domes(), JsValue::UNDEFINED);
+    assert_eq!(plain.face_ranges, ranges.to_vec());
+}
+
+#[wasm_bindgen_test]
+fn progress_returning_false_cancels() {
+    let (result, calls) = mesh_with_progress_js(&two_domes(), "return false;");
+    let e = result.expect_err("cancelled");
+    assert!(e.is_instance_of::<js_sys::Error>());
+    assert_eq!(String::from(e.unchecked_into::<js_sys::Error>().message()), "cancelled");
+    assert_eq!(calls, vec![(1.0, 2.0)], "meshing stops after the face in hand");
+}
+
+#[wasm_bindgen_test]
+fn progress_exception_is_rethrown_as_it_is() {
+    let (result, calls) = mesh_with_progress_js(&two_domes(), "throw new RangeError('stop ' + done);");
+    let e = result.expect_err("the callback threw");
+    assert!(e.is_instance_of::<js_sys::RangeError>(), "{e:?}");
+    assert_eq!(String::from(e.unchecked_into::<js_sys::Error>().message()), "stop 1");
+    assert_eq!(calls.len(), 1);
+    // The module is still usable afterwards.
+    assert!(ok(&dome(), JsValue::UNDEFINED).triangles() >= 2);
+}
