@@ -20,6 +20,7 @@ const DEFAULT_ANGLE_DEG = ((0.5 * 180) / Math.PI).toFixed(2);
 
 performance.mark('surfmesh:app-start');
 const boot = window.surfmeshBoot ?? { sample: 'grid50', workers: [] };
+boot.adopted = true;
 const pool = new MeshPool({
   size: 2,
   module: boot.module,
@@ -172,8 +173,8 @@ function formatOf(name) {
   return 'auto';
 }
 
-function load(name, bytes) {
-  state.model = { name, bytes, format: formatOf(name) };
+function load(name, bytes, { prestarted = false } = {}) {
+  state.model = { name, bytes, format: formatOf(name), prestarted };
   state.diagonal = null;
   $('model-name').textContent = name;
   remesh({ fresh: true });
@@ -188,10 +189,14 @@ function remeshSoon() {
 function remesh({ fresh = false } = {}) {
   clearTimeout(timer);
   if (!state.model) return;
-  pool.cancelAll();
-  const run = ++state.run;
   const { name, bytes, format } = state.model;
   const options = readOptions();
+  // The page's first load may find the default sample already sent to the workers.
+  const pre = fresh && state.model.prestarted ? pool.takePrestarted() : [];
+  const adopt = (opts) => pre.find((p) => JSON.stringify(p.options) === JSON.stringify(opts))?.job;
+  for (const p of pre) if (p.job !== adopt(options) && p.job !== adopt({ toleranceRel: COARSE_REL })) p.job.cancel();
+  if (pre.length === 0) pool.cancelAll();
+  const run = ++state.run;
   hideError();
   setState('meshing');
   showProgress(0, 0);
@@ -204,12 +209,15 @@ function remesh({ fresh = false } = {}) {
   status(`Meshing ${name}…`);
   let finished = false;
   performance.mark('surfmesh:mesh-requested');
-  const fine = pool.mesh(bytes, format, options, (done, total) => {
+  const onProgress = (done, total) => {
     if (run === state.run) showProgress(done, total);
-  });
+  };
+  const fine = adopt(options) ?? pool.mesh(bytes, format, options, onProgress);
+  fine.onProgress = onProgress;
   const coarseRel = options.toleranceRel === undefined || options.toleranceRel < COARSE_REL;
   if (fresh && coarseRel) {
-    pool.mesh(bytes, format, { toleranceRel: COARSE_REL }).promise.then(
+    const coarse = adopt({ toleranceRel: COARSE_REL }) ?? pool.mesh(bytes, format, { toleranceRel: COARSE_REL });
+    coarse.promise.then(
       ({ result, lines }) => {
         performance.mark('surfmesh:coarse-result', { detail: result.report.time_ms });
         if (run !== state.run || finished) return;
@@ -319,6 +327,17 @@ $('cancel').onclick = cancel;
 $('error-close').onclick = hideError;
 $('fit').onclick = () => viewer.fit();
 viewer.canvas.addEventListener('dblclick', () => viewer.fit());
+// A click (not a drag) picks a face: highlighted, and named in the status line.
+let down = null;
+viewer.canvas.addEventListener('pointerdown', (e) => {
+  down = { x: e.clientX, y: e.clientY };
+});
+viewer.canvas.addEventListener('pointerup', (e) => {
+  if (!down || Math.hypot(e.clientX - down.x, e.clientY - down.y) > 4 || !state.shown) return;
+  const face = viewer.pick(e.clientX, e.clientY);
+  const ranges = state.shown.result.faceRanges;
+  if (face >= 0) status(`Face ${face} of ${ranges.length / 2}: ${count(ranges[2 * face + 1])} triangles`);
+});
 
 $('tol-value').addEventListener('change', () => {
   syncSlider();
@@ -365,7 +384,7 @@ async function loadSample(name, bytes) {
   $('sample').value = name;
   try {
     const data = await (bytes ?? fetch(`samples/${name}.json`).then((r) => (r.ok ? r.arrayBuffer() : Promise.reject(new Error(`HTTP ${r.status}`)))));
-    load(`${name}.json`, data);
+    load(`${name}.json`, data, { prestarted: bytes !== undefined });
   } catch (e) {
     setState('error');
     showError(`${name}.json`, `cannot fetch the sample: ${e.message}`);

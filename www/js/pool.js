@@ -18,8 +18,9 @@ export class MeshPool {
    * @param {URL|string} [o.wasmUrl] the package's surfmesh_bg.wasm
    * @param {Promise<WebAssembly.Module>} [o.module] the module, already compiling (else from wasmUrl)
    * @param {URL|string} o.workerUrl worker.js
-   * @param {{ worker: Worker, early: object[] }[]} [o.workers] workers already started (and sent
-   *   the module) by the page, with the messages they posted before the pool took them over
+   * @param {{ worker: Worker, early: object[], job?: { id: number, options: object } }[]} [o.workers]
+   *   workers already started (and sent the module) by the page, with the messages they posted
+   *   before the pool took them over and the job each was already sent (negative ids), if any
    */
   constructor({ size = 2, wasmUrl, module, workerUrl, workers = [] }) {
     this.size = Math.max(1, size, workers.length);
@@ -29,8 +30,17 @@ export class MeshPool {
     this.queue = [];
     this.nextId = 1;
     this.version = null;
-    for (const { worker, early } of workers) this.slots.push(this.#adopt(worker, early));
+    this.prestarted = [];
+    for (const { worker, early, job } of workers) this.slots.push(this.#adopt(worker, early, job));
     while (this.slots.length < this.size) this.slots.push(this.#spawn());
+  }
+
+  /**
+   * The jobs the page started before the pool existed, as { options, job } with job like
+   * mesh() returns; each is handed out once.
+   */
+  takePrestarted() {
+    return this.prestarted.splice(0);
   }
 
   /** Resolves once every current worker has loaded the module (rejects if one cannot). */
@@ -48,14 +58,21 @@ export class MeshPool {
    * `onProgress(done, total)` follows the faces. Returns { promise, cancel }.
    */
   mesh(bytes, format, options, onProgress = () => {}) {
-    const job = { id: this.nextId++, bytes, format, options, onProgress, slot: null, settled: false };
+    const job = this.#job(this.nextId++, options, onProgress);
+    job.bytes = bytes;
+    job.format = format;
+    this.queue.push(job);
+    this.#dispatch();
+    return job;
+  }
+
+  #job(id, options, onProgress) {
+    const job = { id, options, onProgress, slot: null, settled: false };
     job.promise = new Promise((resolve, reject) => {
       job.resolve = resolve;
       job.reject = reject;
     });
     job.cancel = () => this.#cancel(job);
-    this.queue.push(job);
-    this.#dispatch();
     return job;
   }
 
@@ -74,9 +91,15 @@ export class MeshPool {
     return slot;
   }
 
-  /** A slot for `worker`, replaying the messages it posted before it had a handler. */
-  #adopt(worker, early) {
+  /** A slot for `worker` (busy with `started` if given), replaying the messages it posted before it had a handler. */
+  #adopt(worker, early, started) {
     const slot = { worker, job: null, ready: null };
+    if (started) {
+      const job = this.#job(started.id, started.options, () => {});
+      job.slot = slot;
+      slot.job = job;
+      this.prestarted.push({ options: started.options, job });
+    }
     slot.ready = new Promise((resolve, reject) => {
       slot.onReady = resolve;
       slot.onFatal = reject;

@@ -5,7 +5,7 @@
 
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { toBufferGeometry } from 'surfmesh/three';
+import { faceOfTriangle, toBufferGeometry } from 'surfmesh/three';
 
 /** Face colours: muted, told apart at a glance, none close to the open-edge orange. */
 export const PALETTE = [
@@ -13,6 +13,7 @@ export const PALETTE = [
   0xb88fc0,
 ];
 const NEUTRAL = 0xaeb4bc;
+const HIGHLIGHT = 0xffd24a;
 
 export class Viewer {
   constructor(canvas) {
@@ -46,8 +47,10 @@ export class Viewer {
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.addEventListener('change', () => this.requestRender());
 
-    this.faceMaterials = PALETTE.map((color) => this.#shaded(color));
-    this.plainMaterial = this.#shaded(NEUTRAL);
+    // The palette, then the highlight of a picked face (last index).
+    this.faceMaterials = [...PALETTE, HIGHLIGHT].map((color) => this.#shaded(color));
+    const plain = this.#shaded(NEUTRAL);
+    this.plainMaterials = [...PALETTE.map(() => plain), this.faceMaterials[PALETTE.length]];
     this.wireMaterial = new THREE.MeshBasicMaterial({
       color: 0x12161c,
       wireframe: true,
@@ -82,7 +85,7 @@ export class Viewer {
     });
     const parts = [
       new THREE.Mesh(geometry, this.faceMaterials),
-      new THREE.Mesh(geometry, this.plainMaterial),
+      new THREE.Mesh(geometry, this.plainMaterials),
       new THREE.Mesh(geometry, this.wireMaterial),
       segments(new Float32Array(6), this.borderMaterial),
       segments(new Float32Array(6), this.openMaterial),
@@ -118,10 +121,39 @@ export class Viewer {
     const borders = segments(lines.borders, this.borderMaterial);
     const open = segments(lines.open, this.openMaterial);
     open.renderOrder = 2;
-    this.parts = { geometry, shaded, wire, borders, open };
+    this.parts = { geometry, shaded, wire, borders, open, faceRanges: result.faceRanges, picked: -1 };
     this.group.add(shaded, wire, borders, open);
     this.apply();
     if (fit) this.fit();
+    this.requestRender();
+  }
+
+  /**
+   * The model face under the canvas point (x, y) in CSS pixels, or -1; with
+   * `highlight`, that face is drawn in the highlight colour (and the previous one restored).
+   */
+  pick(x, y, { highlight = true } = {}) {
+    if (!this.parts) return -1;
+    const rect = this.canvas.getBoundingClientRect();
+    const ndc = new THREE.Vector2(((x - rect.left) / rect.width) * 2 - 1, -((y - rect.top) / rect.height) * 2 + 1);
+    const ray = new THREE.Raycaster();
+    ray.setFromCamera(ndc, this.camera);
+    const hit = ray.intersectObject(this.parts.shaded, false)[0];
+    const face = hit ? faceOfTriangle(this.parts.faceRanges, hit.faceIndex) : -1;
+    if (highlight) this.highlight(face);
+    return face;
+  }
+
+  /** Draws model face `face` in the highlight colour (-1: none). */
+  highlight(face) {
+    if (!this.parts) return;
+    const groups = this.parts.geometry.groups;
+    const ranges = this.parts.faceRanges;
+    for (const g of groups) {
+      const f = faceOfTriangle(ranges, g.start / 3);
+      g.materialIndex = f === face ? PALETTE.length : f % PALETTE.length;
+    }
+    this.parts.picked = face;
     this.requestRender();
   }
 
@@ -148,7 +180,7 @@ export class Viewer {
   apply() {
     if (!this.parts) return;
     const o = this.options;
-    this.parts.shaded.material = o.faceColors ? this.faceMaterials : this.plainMaterial;
+    this.parts.shaded.material = o.faceColors ? this.faceMaterials : this.plainMaterials;
     this.parts.wire.visible = o.wireframe;
     this.parts.borders.visible = o.borders;
     this.parts.open.visible = o.openEdges;

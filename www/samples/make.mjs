@@ -11,6 +11,9 @@
 //               caps trimmed to circles, sewn into one watertight shell.
 // freeform.json a copy of tests/data/js_freeform.json (one bicubic patch with
 //               non-uniform knots, the benchmarks' surface).
+// can.igs       the same can as IGES 5.3: four B-spline surfaces (entity 128)
+//               and two trimmed surfaces (144) bounded by curves on surface
+//               (142) whose parameter-space circles are rational B-splines (126).
 
 import { copyFileSync, writeFileSync } from 'node:fs';
 import { dirname, join } from 'node:path';
@@ -163,8 +166,113 @@ function can() {
   return { units: 'mm', faces };
 }
 
+// ---------------------------------------------------------------- IGES
+
+/**
+ * IGES 5.3 fixed-format text for `entities` ({ type, params, form?, dependent? }); entity i has
+ * directory number 2i + 1. Parameters: numbers are written as reals, strings as they are (integers).
+ */
+function iges(entities, fileName) {
+  const pad = (text, width) => text.padEnd(width).slice(0, width);
+  const field = (v) => String(v).padStart(8);
+  const seq = (letter, n) => `${letter}${String(n).padStart(7)}`;
+  const hollerith = (t) => `${t.length}H${t}`;
+  const num = (x) => (Number.isInteger(x) ? `${x}.` : String(x));
+  const wrap = (tokens, width) => {
+    const lines = [];
+    let line = '';
+    for (const t of tokens) {
+      if (line.length + t.length > width) {
+        lines.push(line);
+        line = '';
+      }
+      line += t;
+    }
+    if (line) lines.push(line);
+    return lines;
+  };
+  const start = [`surfmesh sample ${fileName}, written by www/samples/make.mjs`];
+  const global = [
+    '1H,', '1H;', hollerith('surfmesh'), hollerith(fileName), hollerith('surfmesh make.mjs'), hollerith('1'),
+    '32', '38', '6', '308', '15', hollerith('surfmesh'), '1.', '2', hollerith('MM'), '1', '0.', hollerith('20260101.000000'),
+    '1.E-06', '100.', hollerith('surfmesh'), hollerith('surfmesh'), '11', '0',
+  ];
+  const gLines = wrap(global.map((t, i) => `${t}${i === global.length - 1 ? ';' : ','}`), 72);
+  const dLines = [];
+  const pLines = [];
+  entities.forEach((e, i) => {
+    const de = 2 * i + 1;
+    const tokens = [String(e.type), ...e.params.map((x) => (typeof x === 'string' ? x : num(x)))];
+    const body = wrap(tokens.map((t, k) => `${t}${k === tokens.length - 1 ? ';' : ','}`), 64);
+    const first = pLines.length + 1;
+    for (const line of body) pLines.push(`${pad(line, 64)}${String(de).padStart(8)}${seq('P', pLines.length + 1)}`);
+    const status = e.dependent ? '00010000' : '00000000';
+    const one = [e.type, first, 0, 0, 0, 0, 0, 0].map(field).join('') + status;
+    const two = [e.type, 0, 0, body.length, e.form ?? 0, '', '', '', 0].map(field).join('');
+    dLines.push(`${one}${seq('D', de)}`, `${two}${seq('D', de + 1)}`);
+  });
+  const out = [
+    ...start.map((l, i) => `${pad(l, 72)}${seq('S', i + 1)}`),
+    ...gLines.map((l, i) => `${pad(l, 72)}${seq('G', i + 1)}`),
+    ...dLines,
+    ...pLines,
+  ];
+  const counts = `${seq('S', start.length)}${seq('G', gLines.length)}${seq('D', dLines.length)}${seq('P', pLines.length)}`;
+  out.push(`${pad(counts, 72)}${seq('T', 1)}`);
+  return `${out.join('\n')}\n`;
+}
+
+/** Entity 128 from a JSON surface ({ degree, knots, points[i][j], weights? }). */
+function bspline128(surface) {
+  const [p, q] = surface.degree;
+  const nu = surface.points.length;
+  const nv = surface.points[0].length;
+  const w = (i, j) => (surface.weights ? surface.weights[i][j] : 1);
+  const params = [nu - 1, nv - 1, p, q, 0, 0, surface.weights ? 0 : 1, 0, 0].map(String);
+  params.push(...surface.knots[0], ...surface.knots[1]);
+  for (let j = 0; j < nv; j++) for (let i = 0; i < nu; i++) params.push(w(i, j));
+  for (let j = 0; j < nv; j++) for (let i = 0; i < nu; i++) params.push(...surface.points[i][j]);
+  const u = surface.knots[0];
+  const v = surface.knots[1];
+  params.push(u[p], u[u.length - 1 - p], v[q], v[v.length - 1 - q]);
+  return { type: 128, params };
+}
+
+/** Entity 126: a whole circle in (u, v) as one rational quadratic, nine control points. */
+function circle126(cu, cv, r) {
+  const knots = [0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1];
+  const corners = [[1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1], [1, -1], [1, 0]];
+  const weights = corners.map((_, k) => (k % 2 ? W : 1));
+  const params = ['8', '2', '1', '1', '0', '0', ...knots, ...weights];
+  for (const [x, y] of corners) params.push(cu + r * x, cv + r * y, 0);
+  params.push(0, 1, 0, 0, 1);
+  return { type: 126, params, dependent: true };
+}
+
+function canIges() {
+  const model = can();
+  const entities = [];
+  const de = () => 2 * entities.length + 1;
+  for (const face of model.faces) {
+    if (!face.loops) {
+      entities.push(bspline128(face.surface));
+      continue;
+    }
+    const surface = de();
+    entities.push({ ...bspline128(face.surface), dependent: true });
+    const curve = de();
+    entities.push(circle126(0.5, 0.5, face.loops[0].curves[0].points[0][0] - 0.5));
+    const onSurface = de();
+    entities.push({ type: 142, params: ['0', String(surface), String(curve), '0', '1'], dependent: true });
+    entities.push({ type: 144, params: [String(surface), '1', '0', String(onSurface)] });
+  }
+  return iges(entities, 'can.igs');
+}
+
 save('grid50.json', grid50());
 save('plate.json', plate());
 save('can.json', can());
 copyFileSync(join(here, '..', '..', 'tests', 'data', 'js_freeform.json'), join(here, 'freeform.json'));
 console.log('copied freeform.json');
+writeFileSync(join(here, 'can.igs'), canIges());
+console.log('wrote can.igs');
