@@ -110,6 +110,27 @@ test('a tighter tolerance gives more triangles, still within it', async () => {
   assert.equal(await stat('stat-triangles'), coarse);
 });
 
+test('switching to an absolute tolerance keeps its size; the mesh uses the value given', async () => {
+  const relTolerance = await stat('stat-tolerance');
+  const state = await settle(() => page.click('.segmented label:has-text("Absolute")'));
+  assert.equal(state, 'ready');
+  const shown = Number(await page.inputValue('#tol-value'));
+  assert.ok(Math.abs(shown - relTolerance) <= 5e-3 * relTolerance, `field ${shown}, tolerance was ${relTolerance}`);
+  await settle(async () => {
+    await page.fill('#tol-value', '0.05');
+    await page.press('#tol-value', 'Enter');
+  });
+  assert.equal(await stat('stat-tolerance'), 0.05);
+  assert.ok((await stat('stat-max-deviation')) <= 0.05);
+  await settle(() => page.click('.segmented label:has-text("Relative")'));
+  assert.equal(Number(await page.inputValue('#tol-value')), Number((0.05 / (relTolerance / 1e-3)).toPrecision(3)));
+  await settle(async () => {
+    await page.fill('#tol-value', '0.001');
+    await page.press('#tol-value', 'Enter');
+  });
+  assert.equal(await stat('stat-tolerance'), relTolerance);
+});
+
 test('a corrupted file shows a clear error; a good file then meshes', async () => {
   const broken = grid50.subarray(0, Math.floor(grid50.length / 2));
   const state = await settle(() =>
