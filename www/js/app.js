@@ -191,6 +191,7 @@ function remesh({ fresh = false } = {}) {
   if (!state.model) return;
   const { name, bytes, format } = state.model;
   const options = readOptions();
+  syncSlider();
   // The page's first load may find the default sample already sent to the workers.
   const pre = fresh && state.model.prestarted ? pool.takePrestarted() : [];
   const adopt = (opts) => pre.find((p) => JSON.stringify(p.options) === JSON.stringify(opts))?.job;

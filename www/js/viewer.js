@@ -51,12 +51,7 @@ export class Viewer {
     this.faceMaterials = [...PALETTE, HIGHLIGHT].map((color) => this.#shaded(color));
     const plain = this.#shaded(NEUTRAL);
     this.plainMaterials = [...PALETTE.map(() => plain), this.faceMaterials[PALETTE.length]];
-    this.wireMaterial = new THREE.MeshBasicMaterial({
-      color: 0x12161c,
-      wireframe: true,
-      transparent: true,
-      opacity: 0.35,
-    });
+    this.wireMaterial = new THREE.LineBasicMaterial({ color: 0x12161c, transparent: true, opacity: 0.35 });
     this.borderMaterial = new THREE.LineBasicMaterial({ color: 0x0b0d10 });
     this.openMaterial = new THREE.LineBasicMaterial({ color: 0xff7a1a, depthTest: false });
 
@@ -86,7 +81,7 @@ export class Viewer {
     const parts = [
       new THREE.Mesh(geometry, this.faceMaterials),
       new THREE.Mesh(geometry, this.plainMaterials),
-      new THREE.Mesh(geometry, this.wireMaterial),
+      segments(new Float32Array(6), this.wireMaterial),
       segments(new Float32Array(6), this.borderMaterial),
       segments(new Float32Array(6), this.openMaterial),
     ];
@@ -95,8 +90,7 @@ export class Viewer {
     this.renderer.render(this.scene, this.camera);
     this.scene.remove(...parts);
     geometry.dispose();
-    parts[3].geometry.dispose();
-    parts[4].geometry.dispose();
+    for (const part of parts.slice(2)) part.geometry.dispose();
     performance.mark('surfmesh:shaders-compiled');
   }
 
@@ -117,7 +111,11 @@ export class Viewer {
     this.clear();
     const geometry = toBufferGeometry(result, { materialCount: PALETTE.length });
     const shaded = new THREE.Mesh(geometry, this.faceMaterials);
-    const wire = new THREE.Mesh(geometry, this.wireMaterial);
+    // The wireframe: the worker's edge list over the same vertex buffer (one line per edge).
+    const wireGeometry = new THREE.BufferGeometry();
+    wireGeometry.setAttribute('position', geometry.getAttribute('position'));
+    wireGeometry.setIndex(new THREE.BufferAttribute(lines.wire, 1));
+    const wire = new THREE.LineSegments(wireGeometry, this.wireMaterial);
     const borders = segments(lines.borders, this.borderMaterial);
     const open = segments(lines.open, this.openMaterial);
     open.renderOrder = 2;
@@ -164,6 +162,7 @@ export class Viewer {
       this.group.remove(part);
     }
     this.parts.geometry.dispose();
+    this.parts.wire.geometry.dispose();
     this.parts.borders.geometry.dispose();
     this.parts.open.geometry.dispose();
     this.parts = null;

@@ -3,6 +3,7 @@
 // model per request with progress events, and posts the arrays back as
 // transferred buffers (no copy). It also derives the line sets the viewer
 // draws, so the page's thread only uploads buffers:
+//   wire:    vertex index pairs, one per mesh edge (the wireframe overlay),
 //   borders: segments where a model face ends (edges of one triangle of that face),
 //   open:    edges with one triangle after welding coincident vertices across
 //            faces — the model's open border plus any crack.
@@ -10,7 +11,7 @@
 // Messages in:  { type: 'init', module } then { type: 'mesh', id, bytes, format, options }
 // Messages out: { type: 'ready' } | { type: 'fatal', message }
 //               { type: 'progress', id, done, total }
-//               { type: 'result', id, result, lines: { borders, open } }
+//               { type: 'result', id, result, lines: { wire, borders, open } }
 //               { type: 'error', id, message }
 
 import init, { meshWithProgress, version } from '../pkg/web/surfmesh.js';
@@ -55,14 +56,14 @@ self.onmessage = async (event) => {
     return;
   }
   const lines = edgeLines(result);
-  const buffers = [result.positions, result.normals, result.indices, result.faceRanges, lines.borders, lines.open];
+  const buffers = [result.positions, result.normals, result.indices, result.faceRanges, lines.wire, lines.borders, lines.open];
   self.postMessage(
     { type: 'result', id, result, lines },
     buffers.map((a) => a.buffer),
   );
 };
 
-/** Face-border and open-edge segments (x, y, z pairs) of a mesh. */
+/** Wireframe index pairs, and face-border and open-edge segments (x, y, z pairs), of a mesh. */
 function edgeLines({ positions, indices, faceRanges }) {
   // Weld: one id per distinct position (sewing makes shared borders coincide exactly).
   const weld = new Uint32Array(positions.length / 3);
@@ -99,15 +100,19 @@ function edgeLines({ positions, indices, faceRanges }) {
       }
     }
   }
+  const wire = new Uint32Array(2 * edges.size);
   const borders = [];
   const open = [];
+  let w = 0;
   const push = (out, a, b) => {
     out.push(positions[3 * a], positions[3 * a + 1], positions[3 * a + 2]);
     out.push(positions[3 * b], positions[3 * b + 1], positions[3 * b + 2]);
   };
   for (const e of edges.values()) {
+    wire[w++] = e.a;
+    wire[w++] = e.b;
     if (e.uses === 1) push(open, e.a, e.b);
     if (e.uses === 1 || e.faces > 1) push(borders, e.a, e.b);
   }
-  return { borders: new Float32Array(borders), open: new Float32Array(open) };
+  return { wire, borders: new Float32Array(borders), open: new Float32Array(open) };
 }
