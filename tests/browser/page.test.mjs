@@ -186,7 +186,7 @@ test('IGES and STEP files go to the module, which meshes them or says why not', 
 });
 
 test('STL, OBJ and GLB exports hold the triangles the page shows', async () => {
-  await settle(() => page.selectOption('#sample', 'can'));
+  await settle(() => page.selectOption('#sample', 'can.json'));
   assert.equal(await page.getAttribute('body', 'data-state'), 'ready');
   const triangles = await stat('stat-triangles');
   const vertices = await stat('stat-vertices');
@@ -252,7 +252,7 @@ test('display toggles change the picture; fit to view frames the part', async ()
 });
 
 test('cancel stops a long run at once; the page keeps the last mesh and keeps working', async () => {
-  await settle(() => page.selectOption('#sample', 'grid50'));
+  await settle(() => page.selectOption('#sample', 'grid50.json'));
   const before = await stat('stat-triangles');
   await page.fill('#tol-value', '0.00001');
   await page.press('#tol-value', 'Enter');

@@ -19,7 +19,7 @@ const COARSE_REL = 1e-2;
 const DEFAULT_ANGLE_DEG = ((0.5 * 180) / Math.PI).toFixed(2);
 
 performance.mark('surfmesh:app-start');
-const boot = window.surfmeshBoot ?? { sample: 'grid50', workers: [] };
+const boot = window.surfmeshBoot ?? { sample: 'grid50.json', workers: [] };
 boot.adopted = true;
 const pool = new MeshPool({
   size: 2,
@@ -381,14 +381,19 @@ async function openFile(file) {
 
 $('sample').addEventListener('change', () => loadSample($('sample').value));
 
-async function loadSample(name, bytes) {
-  $('sample').value = name;
+/** Loads samples/`file` (or `bytes` already fetched for it). */
+async function loadSample(file, bytes) {
+  $('sample').value = file;
   try {
-    const data = await (bytes ?? fetch(`samples/${name}.json`).then((r) => (r.ok ? r.arrayBuffer() : Promise.reject(new Error(`HTTP ${r.status}`)))));
-    load(`${name}.json`, data, { prestarted: bytes !== undefined });
+    const fetched = () =>
+      fetch(`samples/${encodeURIComponent(file)}`).then((r) =>
+        r.ok ? r.arrayBuffer() : Promise.reject(new Error(`HTTP ${r.status}`)),
+      );
+    const data = await (bytes ?? fetched());
+    load(file, data, { prestarted: bytes !== undefined });
   } catch (e) {
     setState('error');
-    showError(`${name}.json`, `cannot fetch the sample: ${e.message}`);
+    showError(file, `cannot fetch the sample: ${e.message}`);
   }
 }
 
