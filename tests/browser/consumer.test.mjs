@@ -56,7 +56,7 @@ test('a Vite-built page meshes the same sample on its thread and in a worker', a
   const page = await open(env.browser, `${env.url}consumer/`, { width: 800, height: 500 });
   await page.waitForSelector('#result[data-state="done"], #result[data-state="error"]', { timeout: 30000 });
   const text = await page.textContent('#result');
-  await shot(page, '10-vite-consumer');
+  await shot(page, '11-vite-consumer');
   assert.equal(await page.getAttribute('#result', 'data-state'), 'done', text);
   const s = JSON.parse(text);
   assert.equal(s.faces, 50);

@@ -138,7 +138,7 @@ test('a corrupted file shows a clear error; a good file then meshes', async () =
   );
   assert.equal(state, 'error');
   assert.ok(await page.isVisible('#error'));
-  assert.match(await page.textContent('#error-file'), /broken\.json/);
+  assert.equal(await page.textContent('#error-title'), 'Could not mesh broken.json');
   const message = await page.textContent('#error-message');
   assert.match(message, /^JSON line \d+ column \d+: /, `error shown: ${message}`);
   assert.equal(await page.textContent('#stat-triangles'), '—', 'no stale numbers under an error');
@@ -249,6 +249,19 @@ test('display toggles change the picture; fit to view frames the part', async ()
   await page.waitForTimeout(100);
   assert.ok(!(await canvas.screenshot()).equals(shaded), 'the picked face is highlighted');
   await shot(page, '08-picked-face');
+});
+
+test('a page whose wasm cannot load says so instead of waiting forever', async () => {
+  const context = await env.browser.newContext();
+  await context.route('**/surfmesh_bg.wasm', (route) => route.fulfill({ status: 404, body: 'gone' }));
+  const broken = await context.newPage();
+  await broken.goto(env.url);
+  await broken.waitForSelector('body[data-state="error"]', { timeout: 15000 });
+  assert.ok(await broken.isVisible('#error'));
+  assert.equal(await broken.textContent('#error-title'), 'The mesher could not start');
+  assert.match(await broken.textContent('#error-message'), /wasm/i);
+  await shot(broken, '10-wasm-missing');
+  await context.close();
 });
 
 test('cancel stops a long run at once; the page keeps the last mesh and keeps working', async () => {

@@ -69,8 +69,9 @@ function hideProgress() {
   $('progress').hidden = true;
 }
 
-function showError(file, message) {
-  $('error-file').textContent = file;
+/** Shows `message` under `title` over the view (and in the status line). */
+function showError(title, message) {
+  $('error-title').textContent = title;
   $('error-message').textContent = message;
   $('error').hidden = false;
   status(`Error: ${message}`);
@@ -251,7 +252,7 @@ function remesh({ fresh = false } = {}) {
       pool.cancelAll();
       hideProgress();
       setState('error');
-      showError(name, error.message);
+      showError(`Could not mesh ${name}`, error.message);
     },
   );
 }
@@ -393,7 +394,7 @@ async function loadSample(file, bytes) {
     load(file, data, { prestarted: bytes !== undefined });
   } catch (e) {
     setState('error');
-    showError(file, `cannot fetch the sample: ${e.message}`);
+    showError(`Could not open ${file}`, `cannot fetch the sample: ${e.message}`);
   }
 }
 
@@ -428,7 +429,7 @@ pool.ready().then(
   },
   (e) => {
     setState('error');
-    showError('the mesher', e.message);
+    showError('The mesher could not start', e.message);
   },
 );
 

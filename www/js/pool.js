@@ -138,8 +138,10 @@ export class MeshPool {
     this.#dispatch();
   }
 
+  /** A worker that cannot mesh: its job and the queue fail with `error`, and it gets no more jobs. */
   #fail(slot, error) {
     slot.onFatal(error);
+    slot.error = error;
     const job = slot.job;
     slot.job = null;
     if (job && !job.settled) {
@@ -153,8 +155,15 @@ export class MeshPool {
   }
 
   #dispatch() {
+    const broken = this.slots.find((s) => s.error);
+    if (broken && this.slots.every((s) => s.error)) {
+      for (const queued of this.queue.splice(0)) {
+        queued.settled = true;
+        queued.reject(broken.error);
+      }
+    }
     for (const slot of this.slots) {
-      if (slot.job || this.queue.length === 0) continue;
+      if (slot.job || slot.error || this.queue.length === 0) continue;
       const job = this.queue.shift();
       slot.job = job;
       job.slot = slot;
