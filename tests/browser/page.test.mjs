@@ -217,6 +217,22 @@ test('STL, OBJ and GLB exports hold the triangles the page shows', async () => {
   const indexCount = json.meshes[0].primitives.reduce((sum, p) => sum + json.accessors[p.indices].count, 0);
   assert.equal(indexCount, 3 * triangles);
   assert.equal(json.accessors[0].count, vertices);
+  // And a glTF reader takes it: three.js's GLTFLoader, in the page.
+  const loaded = await page.evaluate(async (b64) => {
+    const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
+    const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
+    const gltf = await new GLTFLoader().parseAsync(bytes.buffer, '');
+    let tris = 0;
+    let meshes = 0;
+    gltf.scene.traverse((o) => {
+      if (o.isMesh) {
+        meshes++;
+        tris += o.geometry.index.count / 3;
+      }
+    });
+    return { tris, meshes };
+  }, glb.toString('base64'));
+  assert.deepEqual(loaded, { tris: triangles, meshes: await stat('stat-faces') });
   await shot(page, '06-closed-can');
 });
 
