@@ -117,6 +117,18 @@ impl NurbsCurve {
     pub fn derivs(&self, t: f64) -> CurveDerivs {
         let mut b = BasisDers::default();
         let span = self.knots.basis_ders(t, 2, &mut b);
+        self.derivs_from(span, &b)
+    }
+
+    /// As [`NurbsCurve::derivs`] with the polynomial piece of knot span
+    /// `span`, also at its ends (one-sided limits at the knots).
+    fn derivs_in(&self, span: usize, t: f64) -> CurveDerivs {
+        let mut b = BasisDers::default();
+        self.knots.basis_in_span(span, t, 2, &mut b.0);
+        self.derivs_from(span, &b)
+    }
+
+    fn derivs_from(&self, span: usize, b: &BasisDers) -> CurveDerivs {
         let p = self.degree();
         let mut h = [DVec4::ZERO; 3];
         for (k, hk) in h.iter_mut().enumerate() {
@@ -194,110 +206,128 @@ impl NurbsCurve {
 
     /// Closest point on the curve to `target`: `(t, point, distance)`.
     ///
-    /// Samples every knot span, then Newton iterations on `C'·(C − P) = 0`
-    /// (a step may only decrease the distance) from up to four of the best
-    /// distinct local minima of the samples (from both sides when one sits on
-    /// an inner knot, where the curve may turn a corner); the closest result
-    /// wins. Never
-    /// leaves the domain; on a closed curve a step across the start continues
-    /// from the end and vice versa.
+    /// Branch and bound over Bézier pieces: every knot span is converted to
+    /// its Bézier form, and a piece lies in the box of its control points
+    /// (convex hull property, weights positive), whose distance to `target`
+    /// bounds the piece's from below. The piece with the lowest bound is
+    /// split in two until it is ruled out by the best distance found so far
+    /// or is 1/256 of its span, where Newton iterations on `C'·(C − P) = 0`
+    /// (a step may only decrease the distance) finish it. So sharp turns
+    /// of rational spans, corners at knots and seams of closed curves are all
+    /// searched; the work is capped at a few thousand pieces. Never leaves
+    /// the domain.
     pub fn project(&self, target: DVec3) -> (f64, DVec3, f64) {
-        const MAX_STARTS: usize = 4;
-        let (a, b) = self.domain();
-        let spans = self.knots.breakpoints();
-        let per = 4 * self.degree() + 2;
-        let mut samples: Vec<(f64, DVec3, f64)> = Vec::new();
-        // Indices of samples at inner breakpoints, where the curve may have a
-        // corner: Newton there sees only the derivative of the span on the right.
-        let mut corners: Vec<usize> = Vec::new();
-        let last_span = spans.len().saturating_sub(2);
-        for (k, w) in spans.windows(2).enumerate() {
-            for s in usize::from(k > 0)..=per {
-                let t = w[0] + (w[1] - w[0]) * s as f64 / per as f64;
-                let p = self.point(t);
-                if s == per && k < last_span {
-                    corners.push(samples.len());
+        let (a, _) = self.domain();
+        let p = self.degree();
+        let pa = self.point(a);
+        // (t, point, distance, span).
+        let mut best = (a, pa, pa.distance(target), self.knots.span(a));
+        let mut pieces: Vec<Piece> = Vec::new();
+        for w in self.knots.breakpoints().windows(2) {
+            let span = self.knots.span(0.5 * (w[0] + w[1]));
+            let ctrl = self.bezier_of_span(span);
+            let piece = Piece::new(ctrl, span, w[0], w[1], w[0], w[1], target);
+            for (t, h) in [(w[0], piece.ctrl[0]), (w[1], piece.ctrl[p])] {
+                let q = h.truncate() / h.w;
+                let d = q.distance(target);
+                if d < best.2 {
+                    best = (t, q, d, span);
                 }
-                samples.push((t, p, p.distance_squared(target)));
             }
+            pieces.push(piece);
         }
-        let n = samples.len();
-        // Indices stay in 0..n.
-        let mut minima: Vec<usize> = (0..n)
-            .filter(|&i| {
-                (i == 0 || samples[i - 1].2 >= samples[i].2) && (i + 1 == n || samples[i + 1].2 >= samples[i].2)
-            })
-            .collect();
-        minima.sort_by(|&i, &j| samples[i].2.total_cmp(&samples[j].2));
-        let (pa, pb) = (self.point(a), self.point(b));
-        let closed = pa.distance(pb) <= 1e-9 * (pa.length().max(pb.length()) + self.bbox().diagonal());
-        let mut best: Option<(f64, DVec3, f64)> = None;
-        let mut used: Vec<DVec3> = Vec::new();
-        for i in minima {
-            if used.len() == MAX_STARTS {
+        let mut examined = 0;
+        while examined < MAX_PIECES {
+            let Some(k) = (0..pieces.len()).min_by(|&i, &j| pieces[i].bound.total_cmp(&pieces[j].bound)) else {
+                break;
+            };
+            if pieces[k].bound >= best.2 * best.2 {
                 break;
             }
-            let (t0, p0, _) = samples[i];
-            if used.contains(&p0) {
+            let piece = pieces.swap_remove(k);
+            examined += 1;
+            if piece.t1 - piece.t0 <= LEAF * (piece.span_hi - piece.span_lo) {
+                let mid = 0.5 * (piece.t0 + piece.t1);
+                let r = self.newton_in_span(target, piece.span, piece.t0, piece.t1, mid);
+                if r.2 < best.2 {
+                    best = (r.0, r.1, r.2, piece.span);
+                }
                 continue;
             }
-            used.push(p0);
-            let r = self.newton(target, t0, closed);
-            if best.is_none_or(|bst| r.2 < bst.2) {
-                best = Some(r);
+            let (left, right) = piece.split(target);
+            let h = right.ctrl[0];
+            let q = h.truncate() / h.w;
+            let d = q.distance(target);
+            if d < best.2 {
+                best = (right.t0, q, d, right.span);
             }
-            if i > 0 && corners.contains(&i) {
-                // Also search the span on the left of the corner.
-                let r = self.newton(target, 0.5 * (samples[i - 1].0 + t0), closed);
-                if best.is_none_or(|bst| r.2 < bst.2) {
-                    best = Some(r);
-                }
-            }
+            pieces.push(left);
+            pieces.push(right);
         }
-        best.unwrap_or_else(|| (a, pa, pa.distance(target)))
+        // Polish within the span (a best found at a piece's end, or after the cap).
+        let (lo, hi) = (self.knots.knots()[best.3], self.knots.knots()[best.3 + 1]);
+        let r = self.newton_in_span(target, best.3, lo, hi, best.0);
+        if r.2 < best.2 {
+            r
+        } else {
+            (best.0, best.1, best.2)
+        }
     }
 
-    /// Safeguarded Newton iterations from `t` (see [`NurbsCurve::project`]).
-    fn newton(&self, target: DVec3, mut t: f64, closed: bool) -> (f64, DVec3, f64) {
-        let (a, b) = self.domain();
-        let period = b - a;
-        let mut dist = self.point(t).distance(target);
+    /// Homogeneous Bézier control points of knot span `span` (which must
+    /// satisfy `degree <= span < control_count()`), by blossoming: point `k`
+    /// is the blossom at `(a, …, a, b, …, b)` with `k` copies of the span's
+    /// end `b` (The NURBS Book §5.6; de Boor's recursion with one argument per level).
+    fn bezier_of_span(&self, span: usize) -> Vec<DVec4> {
+        let p = self.degree();
+        let u = self.knots.knots();
+        let (a, b) = (u[span], u[span + 1]);
+        (0..=p)
+            .map(|k| {
+                let mut d = [DVec4::ZERO; super::MAX_DEGREE + 1];
+                d[..=p].copy_from_slice(&self.points[span - p..=span]);
+                for r in 1..=p {
+                    let t = if r <= p - k { a } else { b };
+                    for j in (r..=p).rev() {
+                        let g = span - p + j;
+                        let den = u[g + p + 1 - r] - u[g];
+                        let alpha = if den > 0.0 { (t - u[g]) / den } else { 0.0 };
+                        d[j] = d[j - 1] * (1.0 - alpha) + d[j] * alpha;
+                    }
+                }
+                d[p]
+            })
+            .collect()
+    }
+
+    /// Safeguarded Newton iterations from `t` on the polynomial piece of
+    /// `span`, staying inside its parameter range `[lo, hi]`.
+    fn newton_in_span(&self, target: DVec3, span: usize, lo: f64, hi: f64, mut t: f64) -> (f64, DVec3, f64) {
+        let mut point = self.derivs_in(span, t).point;
+        let mut dist = point.distance(target);
         for _ in 0..32 {
-            let c = self.derivs(t);
+            let c = self.derivs_in(span, t);
             let r = c.point - target;
             let f = c.d1.dot(r);
             let df = c.d1.length_squared() + c.d2.dot(r);
-            if df.abs() < 1e-300 {
-                break;
-            }
-            let mut step = -f / df;
-            if df < 0.0 {
-                // Not a minimum nearby: gradient step instead.
-                step = -f / c.d1.length_squared().max(1e-300);
-            }
+            // Newton where the model has a minimum, a gradient step elsewhere.
+            let mut step = if df > 0.0 { -f / df } else { -f / c.d1.length_squared().max(1e-300) };
             if !step.is_finite() {
                 break;
             }
-            step = step.clamp(-0.5 * period, 0.5 * period);
             let mut accepted = false;
             for _ in 0..12 {
-                let mut tn = t + step;
-                if closed && !(a..=b).contains(&tn) {
-                    tn = if tn < a { tn + period } else { tn - period };
-                }
-                let tn = tn.clamp(a, b);
-                let pn = self.point(tn);
+                let tn = (t + step).clamp(lo, hi);
+                let pn = self.derivs_in(span, tn).point;
                 let dn = pn.distance(target);
                 if dn <= dist {
-                    let mut moved = (tn - t).abs();
-                    if closed {
-                        moved = moved.min(period - moved);
-                    }
+                    let moved = (tn - t).abs();
                     t = tn;
+                    point = pn;
                     dist = dn;
                     accepted = true;
-                    if moved <= 1e-14 * period.max(1.0) {
-                        return (t, pn, dist);
+                    if moved <= 1e-14 * (hi - lo).max(1.0) {
+                        return (t, point, dist);
                     }
                     break;
                 }
@@ -307,7 +337,55 @@ impl NurbsCurve {
                 break;
             }
         }
-        let p = self.point(t);
-        (t, p, p.distance(target))
+        (t, point, dist)
+    }
+}
+
+/// Most Bézier pieces [`NurbsCurve::project`] examines (bounds its time).
+const MAX_PIECES: usize = 2048;
+
+/// A piece this fraction of its knot span long is finished by Newton, not split.
+const LEAF: f64 = 1.0 / 256.0;
+
+/// A Bézier piece of one knot span, with the lower bound of its squared
+/// distance to the target.
+struct Piece {
+    ctrl: Vec<DVec4>,
+    span: usize,
+    span_lo: f64,
+    span_hi: f64,
+    t0: f64,
+    t1: f64,
+    bound: f64,
+}
+
+impl Piece {
+    fn new(ctrl: Vec<DVec4>, span: usize, span_lo: f64, span_hi: f64, t0: f64, t1: f64, target: DVec3) -> Self {
+        let hull = Aabb::from_points(ctrl.iter().map(|h| h.truncate() / h.w));
+        let gap = (hull.min - target).max(target - hull.max).max(DVec3::ZERO);
+        Self { ctrl, span, span_lo, span_hi, t0, t1, bound: gap.length_squared() }
+    }
+
+    /// Halves by de Casteljau in homogeneous coordinates.
+    fn split(self, target: DVec3) -> (Self, Self) {
+        let n = self.ctrl.len();
+        let mut left = Vec::with_capacity(n);
+        let mut right = Vec::with_capacity(n);
+        let mut work = self.ctrl;
+        left.push(work[0]);
+        right.push(work[n - 1]);
+        for r in 1..n {
+            for j in 0..n - r {
+                work[j] = (work[j] + work[j + 1]) * 0.5;
+            }
+            left.push(work[0]);
+            right.push(work[n - 1 - r]);
+        }
+        right.reverse();
+        let mid = 0.5 * (self.t0 + self.t1);
+        (
+            Self::new(left, self.span, self.span_lo, self.span_hi, self.t0, mid, target),
+            Self::new(right, self.span, self.span_lo, self.span_hi, mid, self.t1, target),
+        )
     }
 }

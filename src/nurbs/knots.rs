@@ -150,12 +150,27 @@ impl KnotVector {
     /// zeroing 17×17 tables on every call costs more than the arithmetic for
     /// low degrees, so hot paths pick a small `N`.
     pub(crate) fn basis_into<const N: usize>(&self, t: f64, nd: usize, ders: &mut [[f64; N]; MAX_DERIV + 1]) -> usize {
+        let t = self.clamp(t);
+        let span = self.span(t);
+        self.basis_in_span(span, t, nd, ders);
+        span
+    }
+
+    /// As [`KnotVector::basis_into`] with the polynomial piece of span `span`
+    /// (clamped to `degree..control_count()`) instead of the span holding `t`.
+    pub(crate) fn basis_in_span<const N: usize>(
+        &self,
+        span: usize,
+        t: f64,
+        nd: usize,
+        ders: &mut [[f64; N]; MAX_DERIV + 1],
+    ) {
         if self.degree >= N {
-            return self.span(t);
+            return;
         }
         let p = self.degree;
         let t = self.clamp(t);
-        let span = self.span(t);
+        let span = span.clamp(p, self.control_count() - 1);
         let u = &self.knots;
         let nd = nd.min(MAX_DERIV);
         let mut ndu = [[0.0f64; N]; N];
@@ -178,7 +193,7 @@ impl KnotVector {
             ders[0][j] = ndu[j][p];
         }
         if nd == 0 {
-            return span;
+            return;
         }
         let mut a = [[0.0f64; N]; 2];
         for r in 0..=p {
@@ -222,7 +237,6 @@ impl KnotVector {
             }
             factor *= (p as f64) - k as f64;
         }
-        span
     }
 
     /// Inserts knot `t` once (no validation of multiplicity beyond the degree);

@@ -3,7 +3,7 @@
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
-use super::Surface;
+use super::{Surface, SurfaceDerivs};
 
 /// Settings for [`project_to_surface`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,6 +37,9 @@ pub struct Projection {
 /// Newton runs at most from the coarse search (its best distinct local minima).
 const MAX_STARTS: usize = 4;
 
+/// Parameters this fraction of the domain from a knot line are on it.
+const KNOT_SNAP: f64 = 1e-12;
+
 /// Closest point of `surface` to `target`, starting from `hint` (or a coarse
 /// grid search over the domain when `hint` is `None`).
 ///
@@ -48,8 +51,12 @@ const MAX_STARTS: usize = 4;
 /// Without a hint, Newton runs from up to four of the grid's distinct local
 /// minima (plus the best sample off a collapsed edge when a start lies on one,
 /// so that the direction out of a pole is found) and the closest result wins.
-/// On a closed surface (equal points along opposite edges) a step across
-/// the seam continues on the other side instead of stopping at the edge.
+/// Steps stop at knot lines. On a closed surface (equal points along
+/// opposite edges) a step out through the seam continues from the other side
+/// instead of stopping at the edge; on an open edge the step continues along
+/// the edge. A result near a collapsed edge (pole) is retried from around
+/// the pole, in the best direction, and one near a crease (C0 knot line)
+/// from the other side of the crease.
 pub fn project_to_surface(
     surface: &dyn Surface,
     target: DVec3,
@@ -58,34 +65,138 @@ pub fn project_to_surface(
 ) -> Projection {
     let [lo, hi] = surface.domain();
     let mut seams = Seams::default();
+    let breaks = [surface.breaks(true), surface.breaks(false)];
     let starts = match hint {
         Some(h) if h.is_finite() => Starts::one(h.clamp(lo, hi)),
         _ => coarse_search(surface, target, options.search_samples.max(2)),
     };
     let mut best: Option<Projection> = None;
     for &uv in &starts.uv[..starts.len] {
-        let pr = newton(surface, target, uv, options, &mut seams);
+        let pr = newton(surface, target, uv, options, &mut seams, &breaks);
         if best.is_none_or(|b| pr.distance < b.distance) {
             best = Some(pr);
         }
     }
-    best.unwrap_or_else(|| {
+    let best = best.unwrap_or_else(|| {
         let point = surface.point(lo);
         Projection { uv: lo, point, distance: point.distance(target) }
-    })
+    });
+    let mut best = best;
+    let retries =
+        off_collapsed_edge(surface, target, best.uv).into_iter().chain(across_creases(surface, best.uv, &breaks));
+    for uv in retries {
+        let pr = newton(surface, target, uv, options, &mut seams, &breaks);
+        if pr.distance < best.distance {
+            best = pr;
+        }
+    }
+    best
+}
+
+/// A crease (C0 knot line) splits the distance into two basins, one per
+/// side, that can sit closer together than any search grid resolves. For
+/// each inner knot line within 5% of the domain from `uv` where the surface
+/// turns a corner, returns `uv` mirrored to the other side of it, as a new start.
+fn across_creases(surface: &dyn Surface, uv: DVec2, breaks: &[Vec<f64>; 2]) -> impl Iterator<Item = DVec2> {
+    let [lo, hi] = surface.domain();
+    let size = hi - lo;
+    let mut out = [None, None];
+    for axis in 0..2 {
+        let x = uv[axis];
+        let Some(k) = breaks[axis]
+            .iter()
+            .copied()
+            .filter(|&k| k > lo[axis] && k < hi[axis])
+            .min_by(|a, b| (a - x).abs().total_cmp(&(b - x).abs()))
+        else {
+            continue;
+        };
+        if (k - x).abs() > 0.05 * size[axis] {
+            continue;
+        }
+        let eps = 1e-9 * size[axis];
+        let mut below = uv;
+        below[axis] = k - eps;
+        let mut above = uv;
+        above[axis] = k + eps;
+        let (db, da) = (surface.derivs(below), surface.derivs(above));
+        let (tb, ta) = if axis == 0 { (db.su, da.su) } else { (db.sv, da.sv) };
+        let scale = tb.length().max(ta.length());
+        // No jump (or a NaN from a broken surface): not a crease.
+        let jump = tb.distance(ta);
+        if jump.is_nan() || jump <= 1e-6 * scale {
+            continue;
+        }
+        let mut q = uv;
+        let gap = (k - x).abs().max(1e-6 * size[axis]);
+        q[axis] = if x < k { k + gap } else { k - gap };
+        out[axis] = Some(q.clamp(lo, hi));
+    }
+    out.into_iter().flatten()
+}
+
+/// Near a collapsed edge (a pole: the point does not move along the edge)
+/// the parameters are polar-like and Newton, started on the wrong side, stalls
+/// or stops on the edge. When `uv` lies within 5% of the domain of such an
+/// edge, returns the best of a few parameters around the pole at the same
+/// distance from the edge (just off it when `uv` is on it), as a new start.
+fn off_collapsed_edge(surface: &dyn Surface, target: DVec3, uv: DVec2) -> Option<DVec2> {
+    const SAMPLES: usize = 16;
+    const BAND: f64 = 0.05;
+    let [lo, hi] = surface.domain();
+    let size = hi - lo;
+    let mut best: Option<(f64, DVec2)> = None;
+    for axis in [1usize, 0] {
+        let along = 1 - axis;
+        for (bound, inward) in [(lo[axis], 1.0), (hi[axis], -1.0)] {
+            let gap = (uv[axis] - bound).abs();
+            if gap.is_nan() || gap > BAND * size[axis] {
+                continue;
+            }
+            let at = |f: f64| {
+                let mut q = DVec2::ZERO;
+                q[axis] = bound;
+                q[along] = lo[along] + size[along] * f;
+                surface.point(q)
+            };
+            let (a, b, c) = (at(0.0), at(0.37), at(1.0));
+            let eps = 1e-10 * a.abs().max_element().max(b.abs().max_element()).max(c.abs().max_element());
+            if a.distance(b) > eps || a.distance(c) > eps {
+                continue;
+            }
+            let off = gap.max(1e-3 * size[axis]);
+            for k in 0..SAMPLES {
+                let mut q = uv;
+                q[axis] = bound + inward * off;
+                q[along] = lo[along] + size[along] * (k as f64 + 0.5) / SAMPLES as f64;
+                let dist = surface.point(q).distance_squared(target);
+                if best.is_none_or(|b| dist < b.0) {
+                    best = Some((dist, q));
+                }
+            }
+        }
+    }
+    best.map(|b| b.1)
 }
 
 /// Safeguarded Newton iterations from `start`.
+///
+/// A step ends at the next knot line (`breaks`) at the latest: across a knot
+/// the cell's derivatives say nothing, and on a crease (C0 knot) a step
+/// across it can land in the wrong basin. On a knot line the cells on both
+/// sides propose a step (their derivatives evaluated a hair inside them) and
+/// the one that gets closer wins, so the search can go on or turn back there.
 fn newton(
     surface: &dyn Surface,
     target: DVec3,
     start: DVec2,
     options: &ProjectionOptions,
     seams: &mut Seams,
+    breaks: &[Vec<f64>; 2],
 ) -> Projection {
     let [lo, hi] = surface.domain();
     let size = (hi - lo).max(DVec2::splat(1e-300));
-    let mut uv = start;
+    let mut uv = start.clamp(lo, hi);
     let mut d = surface.derivs(uv);
     let mut point = d.point;
     let mut dist = point.distance(target);
@@ -93,49 +204,138 @@ fn newton(
         if it > 0 {
             d = surface.derivs(uv);
         }
-        let r = d.point - target;
-        let g = DVec2::new(d.su.dot(r), d.sv.dot(r));
-        let j00 = d.su.length_squared() + d.suu.dot(r);
-        let j01 = d.su.dot(d.sv) + d.suv.dot(r);
-        let j11 = d.sv.length_squared() + d.svv.dot(r);
-        let det = j00 * j11 - j01 * j01;
-        let step = if det > 0.0 && j00 > 0.0 {
-            DVec2::new(-(j11 * g.x - j01 * g.y) / det, -(j00 * g.y - j01 * g.x) / det)
-        } else {
-            // Not positive definite: scaled gradient descent.
-            let a = d.su.length_squared().max(1e-300);
-            let b = d.sv.length_squared().max(1e-300);
-            DVec2::new(-g.x / a, -g.y / b)
-        };
-        if !step.is_finite() {
-            break;
-        }
-        // A step longer than half the domain is not a local model any more
-        // (it comes from a vanishing derivative at a collapsed edge).
-        let mut step = step.clamp(-size * 0.5, size * 0.5);
-        let mut accepted = false;
-        for _ in 0..12 {
-            let next = seams.wrap(surface, uv + step);
-            let p = surface.point(next);
-            let dn = p.distance(target);
-            if dn <= dist {
-                let moved = (seams.delta(surface, next - uv) / size).abs().max_element();
-                uv = next;
-                point = p;
-                dist = dn;
-                accepted = true;
-                if moved <= options.parameter_tolerance {
-                    return Projection { uv, point, distance: dist };
-                }
-                break;
+        // The cells touching uv: the one above (what `derivs` evaluates) and,
+        // on an inner knot line, the one below in that direction.
+        // Knots within a hair of uv count as under it (a parameter computed
+        // as `lo + (hi − lo)·f` can miss a knot by one rounding).
+        let on_knot = [0, 1].map(|axis| {
+            let tol = KNOT_SNAP * size[axis];
+            breaks[axis].iter().copied().find(|&k| k > lo[axis] + tol && (k - uv[axis]).abs() <= tol)
+        });
+        let mut best_step: Option<(f64, DVec2, DVec3)> = None;
+        let mut sides = 0;
+        for (below_u, below_v) in [(false, false), (true, false), (false, true), (true, true)] {
+            if (below_u && on_knot[0].is_none()) || (below_v && on_knot[1].is_none()) {
+                continue;
             }
-            step *= 0.5;
+            sides += 1;
+            let dd = if sides == 1 {
+                d
+            } else {
+                let mut q = uv;
+                if let (true, Some(k)) = (below_u, on_knot[0]) {
+                    q.x = k - 1e-9 * size.x;
+                }
+                if let (true, Some(k)) = (below_v, on_knot[1]) {
+                    q.y = k - 1e-9 * size.y;
+                }
+                surface.derivs(q)
+            };
+            if let Some(found) = try_step(surface, target, uv, point, dist, &dd, seams, breaks) {
+                if best_step.is_none_or(|b| found.0 < b.0) {
+                    best_step = Some(found);
+                }
+            }
         }
-        if !accepted {
+        let Some((dn, next, p)) = best_step else {
+            break;
+        };
+        let moved = ((next - uv) / size).abs().max_element();
+        uv = next;
+        point = p;
+        dist = dn;
+        if moved <= options.parameter_tolerance {
             break;
         }
     }
     Projection { uv, point, distance: dist }
+}
+
+/// One safeguarded step from `uv` (at `point`, `dist` from the target) with
+/// the derivatives `d`: Newton where the Hessian of the squared distance is
+/// positive definite, scaled gradient descent elsewhere, halved until the
+/// distance does not grow (12 times at most). Returns the new distance,
+/// parameters and point, or `None` when no step helps.
+#[allow(clippy::too_many_arguments)]
+fn try_step(
+    surface: &dyn Surface,
+    target: DVec3,
+    uv: DVec2,
+    point: DVec3,
+    dist: f64,
+    d: &SurfaceDerivs,
+    seams: &mut Seams,
+    breaks: &[Vec<f64>; 2],
+) -> Option<(f64, DVec2, DVec3)> {
+    let [lo, hi] = surface.domain();
+    let size = (hi - lo).max(DVec2::splat(1e-300));
+    let r = point - target;
+    let g = DVec2::new(d.su.dot(r), d.sv.dot(r));
+    let j00 = d.su.length_squared() + d.suu.dot(r);
+    let j01 = d.su.dot(d.sv) + d.suv.dot(r);
+    let j11 = d.sv.length_squared() + d.svv.dot(r);
+    let det = j00 * j11 - j01 * j01;
+    let step = if det > 0.0 && j00 > 0.0 {
+        DVec2::new(-(j11 * g.x - j01 * g.y) / det, -(j00 * g.y - j01 * g.x) / det)
+    } else {
+        // Not positive definite: scaled gradient descent.
+        let a = d.su.length_squared().max(1e-300);
+        let b = d.sv.length_squared().max(1e-300);
+        DVec2::new(-g.x / a, -g.y / b)
+    };
+    if !step.is_finite() {
+        return None;
+    }
+    // On an edge of an open direction with the step pointing out of the
+    // domain: hold that parameter and take the 1-D Newton step along the
+    // edge (a clamped 2-D step would point the wrong way along it). On the
+    // seam of a closed direction: continue from the other side.
+    let mut from = uv;
+    let mut hold = [false; 2];
+    for axis in 0..2 {
+        let up = step[axis] > 0.0;
+        let at_end = if up { uv[axis] >= hi[axis] } else { uv[axis] <= lo[axis] };
+        if at_end && step[axis] != 0.0 {
+            if seams.is_closed(surface, axis) {
+                from[axis] = if up { lo[axis] } else { hi[axis] };
+            } else {
+                hold[axis] = true;
+            }
+        }
+    }
+    let step = match hold {
+        [true, true] => DVec2::ZERO,
+        [true, false] => DVec2::new(0.0, if j11 > 0.0 { -g.y / j11 } else { -g.y / d.sv.length_squared().max(1e-300) }),
+        [false, true] => DVec2::new(if j00 > 0.0 { -g.x / j00 } else { -g.x / d.su.length_squared().max(1e-300) }, 0.0),
+        [false, false] => step,
+    };
+    if !step.is_finite() {
+        return None;
+    }
+    // A step longer than half the domain is not a local model any more
+    // (it comes from a vanishing derivative at a collapsed edge).
+    let mut step = step.clamp(-size * 0.5, size * 0.5);
+    // The cell the step heads into.
+    let mut cell = [lo, hi];
+    for axis in 0..2 {
+        let x = from[axis];
+        let tol = KNOT_SNAP * size[axis];
+        if step[axis] > 0.0 {
+            cell[1][axis] = breaks[axis].iter().copied().find(|&k| k > x + tol).unwrap_or(hi[axis]);
+        } else if step[axis] < 0.0 {
+            cell[0][axis] = breaks[axis].iter().rev().copied().find(|&k| k < x - tol).unwrap_or(lo[axis]);
+        }
+    }
+    for _ in 0..12 {
+        let next = (from + step).clamp(cell[0], cell[1]).clamp(lo, hi);
+        let p = surface.point(next);
+        let dn = p.distance(target);
+        if dn <= dist {
+            return Some((dn, next, p));
+        }
+        step *= 0.5;
+    }
+    None
 }
 
 /// Which directions of the domain close on themselves (a full circle of a
@@ -166,36 +366,6 @@ impl Seams {
         self.closed[axis] = Some(c);
         c
     }
-
-    /// `uv` brought back into the domain: across the seam of a closed
-    /// direction, clamped otherwise.
-    fn wrap(&mut self, surface: &dyn Surface, uv: DVec2) -> DVec2 {
-        let [lo, hi] = surface.domain();
-        let mut q = uv;
-        for axis in 0..2 {
-            if (q[axis] < lo[axis] || q[axis] > hi[axis]) && self.is_closed(surface, axis) {
-                let period = hi[axis] - lo[axis];
-                if period > 0.0 {
-                    let x = q[axis] - lo[axis];
-                    q[axis] = lo[axis] + (x - crate::math::floor(x / period) * period);
-                }
-            }
-        }
-        q.clamp(lo, hi)
-    }
-
-    /// Parameter difference measured the short way round a seam.
-    fn delta(&mut self, surface: &dyn Surface, d: DVec2) -> DVec2 {
-        let [lo, hi] = surface.domain();
-        let mut out = d;
-        for axis in 0..2 {
-            let period = hi[axis] - lo[axis];
-            if out[axis].abs() > 0.5 * period && self.is_closed(surface, axis) {
-                out[axis] -= period * out[axis].signum();
-            }
-        }
-        out
-    }
 }
 
 /// Up to [`MAX_STARTS`] + 1 starting parameters.
@@ -225,13 +395,17 @@ fn coarse_search(surface: &dyn Surface, target: DVec3, n: usize) -> Starts {
         }
     }
     let dist: Vec<f64> = pts.iter().map(|p| p.distance_squared(target)).collect();
+    // Points closer than this are the same point (a collapsed edge evaluates
+    // to its point only up to rounding).
+    let eps = 1e-12 * pts.iter().fold(0.0f64, |a, p| a.max(p.abs().max_element()));
+    let same = |a: DVec3, b: DVec3| a.distance(b) <= eps;
     // Grid indices bounded by construction: 0 <= i, j < m.
     let collapsed = |i: usize, j: usize| -> bool {
         let p = pts[i * m + j];
-        (i + 1 < m && pts[(i + 1) * m + j] == p)
-            || (i > 0 && pts[(i - 1) * m + j] == p)
-            || (j + 1 < m && pts[i * m + j + 1] == p)
-            || (j > 0 && pts[i * m + j - 1] == p)
+        (i + 1 < m && same(pts[(i + 1) * m + j], p))
+            || (i > 0 && same(pts[(i - 1) * m + j], p))
+            || (j + 1 < m && same(pts[i * m + j + 1], p))
+            || (j > 0 && same(pts[i * m + j - 1], p))
     };
     let mut minima: Vec<(f64, usize, usize)> = Vec::new();
     for i in 0..m {
@@ -259,7 +433,7 @@ fn coarse_search(surface: &dyn Surface, target: DVec3, n: usize) -> Starts {
             break;
         }
         let p = pts[i * m + j];
-        if starts.uv[..starts.len].iter().any(|&s| surface.point(s) == p) {
+        if starts.uv[..starts.len].iter().any(|&s| same(surface.point(s), p)) {
             continue;
         }
         on_edge |= collapsed(i, j);
@@ -287,6 +461,7 @@ fn coarse_search(surface: &dyn Surface, target: DVec3, n: usize) -> Starts {
     starts
 }
 
+/// Grid parameter `(i, j)` of `n` steps; clamped, as `lo + (hi − lo)·1` may round past `hi`.
 fn param(lo: DVec2, hi: DVec2, n: usize, i: usize, j: usize) -> DVec2 {
-    lo + (hi - lo) * DVec2::new(i as f64 / n as f64, j as f64 / n as f64)
+    (lo + (hi - lo) * DVec2::new(i as f64 / n as f64, j as f64 / n as f64)).clamp(lo, hi)
 }
