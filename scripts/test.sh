@@ -22,7 +22,9 @@ total=$SECONDS
 step "native tests" cargo test
 step "no-std core (wasm32v1-none)" cargo rustc --lib --no-default-features --target wasm32v1-none --crate-type rlib
 step "docs" env RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --lib
-step "benches build" cargo bench --no-run
+# Only that the benches compile: skip the bench profile's LTO here (minutes on 2 cores).
+step "benches build" env CARGO_PROFILE_BENCH_LTO=false CARGO_PROFILE_BENCH_CODEGEN_UNITS=16 \
+  cargo bench --no-run
 # The wasm suite runs the mesher for real; unoptimized wasm is ~20x slower.
 step "wasm tests in Node" env CARGO_PROFILE_TEST_OPT_LEVEL=2 \
   cargo test --target wasm32-unknown-unknown --test wasm_node
