@@ -252,7 +252,7 @@ function remesh({ fresh = false } = {}) {
       pool.cancelAll();
       hideProgress();
       setState('error');
-      showError(`Could not mesh ${name}`, error.message);
+      showError(pool.error ? 'The mesher could not start' : `Could not mesh ${name}`, error.message);
     },
   );
 }

@@ -31,6 +31,7 @@ export class MeshPool {
     this.nextId = 1;
     this.version = null;
     this.prestarted = [];
+    this.error = null;
     for (const { worker, early, job } of workers) this.slots.push(this.#adopt(worker, early, job));
     while (this.slots.length < this.size) this.slots.push(this.#spawn());
   }
@@ -142,6 +143,7 @@ export class MeshPool {
   #fail(slot, error) {
     slot.onFatal(error);
     slot.error = error;
+    this.error ??= error; // the first reason a worker could not start
     const job = slot.job;
     slot.job = null;
     if (job && !job.settled) {
