@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Every test of the project, from a fresh clone: installs what is missing
 # (scripts/setup.sh), then native tests, the no_std build check, docs, the
-# benches' build, the wasm-bindgen-test suite in Node, the npm package build
-# and the package's own tests in Node. Stops at the first failure.
+# benches' build, the wasm-bindgen-test suite in Node, the npm package build,
+# the package's own tests in Node, and a smoke run of the benchmark. Stops at
+# the first failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH="$HOME/.cargo/bin:$PATH"
@@ -30,5 +31,7 @@ step "wasm tests in Node" env CARGO_PROFILE_TEST_OPT_LEVEL=2 \
   cargo test --target wasm32-unknown-unknown --test wasm_node
 step "npm package build" node scripts/build-wasm.mjs
 step "npm package tests in Node" node --test scripts/pkg.test.mjs
+# One small surface, one run, the debug runners `cargo test` built: that the benchmark still runs.
+step "benchmark smoke run" node --test bench/compare.test.mjs
 step "browser tests (page, Vite and Node consumers)" node --test --test-concurrency=1 tests/browser/page.test.mjs tests/browser/consumer.test.mjs
 printf '\n== test: all passed (%d s)\n' $((SECONDS - total))

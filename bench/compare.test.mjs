@@ -1,0 +1,54 @@
+// Smoke run of the side-by-side benchmark (bench/compare.mjs): one small JSON
+// surface, one tolerance, one timed run, debug binaries (the ones `cargo
+// test` already built). Checks that every mesher ran and that the yardstick
+// measured every mesh; the figures themselves are the benchmark's business.
+//
+//   node --test bench/compare.test.mjs   (after `node scripts/build-wasm.mjs`)
+
+import assert from 'node:assert/strict';
+import { spawnSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { dirname, join } from 'node:path';
+import { test } from 'node:test';
+import { fileURLToPath } from 'node:url';
+
+const root = join(dirname(fileURLToPath(import.meta.url)), '..');
+
+test('the benchmark meshes, measures and compares one small surface', { timeout: 300_000 }, () => {
+  const out = mkdtempSync(join(tmpdir(), 'surfmesh-bench-test-'));
+  try {
+    const args = ['bench/compare.mjs', '--profile', 'debug', '--no-corpus', '--only', 'cylinder.json'];
+    args.push('--tols', '1e-2', '--runs', '1', '--out', out);
+    const r = spawnSync('node', args, { cwd: root, encoding: 'utf8', maxBuffer: 1 << 26 });
+    assert.equal(r.status, 0, r.stderr);
+    const { meta, rows, comparisons } = JSON.parse(readFileSync(join(out, 'latest.json'), 'utf8'));
+    assert.deepEqual(meta.tolerances, [1e-2]);
+    assert.equal(rows.length, 1);
+    const row = rows[0];
+    assert.equal(row.file, 'cylinder.json');
+    // surfmesh, both builds: the same mesh, within its tolerance, no cracks.
+    const sw = row.surfmesh_wasm.measure;
+    assert.ok(sw.triangles > 0 && sw.max_deviation > 0 && sw.max_deviation <= row.tolerance, JSON.stringify(sw));
+    assert.equal(row.surfmesh_native.run.triangles, sw.triangles);
+    assert.equal(sw.free_edges + sw.nonmanifold_edges, 0);
+    assert.equal(row.surfmesh_wasm.run.total_ms.length, 1);
+    // Each peer reached surfmesh's measured deviation and was measured by the same yardstick.
+    for (const peer of ['verb', 'curvo']) {
+      const m = row[peer].measure;
+      assert.ok(row[peer].search.reached, `${peer}: ${JSON.stringify(row[peer].search)}`);
+      assert.ok(m.triangles > 0 && m.max_deviation <= sw.max_deviation, `${peer}: ${JSON.stringify(m)}`);
+    }
+    const ratios = comparisons[0];
+    assert.deepEqual(
+      ratios.map((c) => c.peer),
+      ['verb', 'curvo'],
+    );
+    for (const c of ratios) assert.ok(c.triangles > 0 && Number.isFinite(c.time), JSON.stringify(c));
+    const md = readFileSync(join(out, 'latest.md'), 'utf8');
+    assert.match(md, /\| verb-nurbs \(JS\) \| 0\.01 \| 1 \|/);
+    assert.match(md, /### cylinder\.json at 0\.01/);
+  } finally {
+    rmSync(out, { recursive: true, force: true });
+  }
+});
