@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Every test of the project, from a fresh clone: installs what is missing
 # (scripts/setup.sh), then native tests, the no_std build check, docs, the
-# benches' build, the wasm-bindgen-test suite in Node, the npm package build,
+# benches (built, each run once), the wasm-bindgen-test suite in Node, the npm package build,
 # the package's own tests in Node, and a smoke run of the benchmark. Stops at
 # the first failure.
 set -euo pipefail
@@ -23,9 +23,10 @@ total=$SECONDS
 step "native tests" cargo test
 step "no-std core (wasm32v1-none)" cargo rustc --lib --no-default-features --target wasm32v1-none --crate-type rlib
 step "docs" env RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --lib
-# Only that the benches compile: skip the bench profile's LTO here (minutes on 2 cores).
-step "benches build" env CARGO_PROFILE_BENCH_LTO=false CARGO_PROFILE_BENCH_CODEGEN_UNITS=16 \
-  cargo bench --no-run
+# The criterion benches built in the test profile (reusing the native tests'
+# dependencies; an optimized bench build takes minutes on 2 cores) and each
+# run once in criterion's test mode, so a bench that breaks fails here.
+step "benches (each run once)" cargo test --bench '*'
 # The wasm suite runs the mesher for real; unoptimized wasm is ~20x slower.
 step "wasm tests in Node" env CARGO_PROFILE_TEST_OPT_LEVEL=2 \
   cargo test --target wasm32-unknown-unknown --test wasm_node
