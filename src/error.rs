@@ -45,6 +45,17 @@ pub enum Error {
         /// What went wrong.
         message: String,
     },
+    /// The IGES file is malformed.
+    Iges {
+        /// Section: `"Start"`, `"Global"`, `"Directory"`, `"Parameter"` or `"Terminate"`.
+        section: &'static str,
+        /// 1-based line of the file (0 when the problem has no single line).
+        line: usize,
+        /// Directory entry number of the entity concerned (0 when none).
+        entity: usize,
+        /// What is wrong.
+        message: String,
+    },
     /// A limit guarding memory or time was hit.
     Limit(String),
     /// The caller's progress callback asked to stop.
@@ -62,6 +73,16 @@ impl fmt::Display for Error {
             Self::Options(e) => write!(f, "{e}"),
             Self::Format(m) => write!(f, "format: {m}"),
             Self::Mesh { face, message } => write!(f, "face {face}: {message}"),
+            Self::Iges { section, line, entity, message } => {
+                write!(f, "IGES {section} section")?;
+                if *line > 0 {
+                    write!(f, " line {line}")?;
+                }
+                if *entity > 0 {
+                    write!(f, ", entity DE {entity}")?;
+                }
+                write!(f, ": {message}")
+            }
             Self::Limit(m) => write!(f, "limit: {m}"),
             Self::Cancelled => write!(f, "cancelled"),
             Self::Internal(m) => write!(f, "internal error (a bug in surfmesh): {m}"),

@@ -25,7 +25,7 @@ mod tessellate;
 mod wasm;
 
 pub use error::Error;
-pub use io::{read_json, read_model, write_glb, write_obj, write_stl, Format};
+pub use io::{read_iges, read_json, read_model, write_glb, write_obj, write_stl, Format};
 pub use measure::{measure_mesh, MeasureOptions, MeshMeasure};
 pub use mesh::{angle_stats, edge_counts, weld_positions, AngleStats, EdgeCounts, FaceRange, Mesh, Report};
 pub use model::{Face, FaceSurface, Model, TrimLoop};

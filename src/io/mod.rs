@@ -1,6 +1,7 @@
 //! Readers (bytes in, [`Model`] out) and mesh writers (bytes out).
 
 mod glb;
+mod iges;
 mod json;
 mod obj;
 mod stl;
@@ -8,6 +9,7 @@ mod stl;
 use alloc::format;
 
 pub use glb::write_glb;
+pub use iges::read_iges;
 pub use json::read_json;
 pub use obj::write_obj;
 pub use stl::write_stl;
@@ -20,10 +22,12 @@ use crate::{Error, Model};
 pub enum Format {
     /// The JSON model of DESIGN.md.
     Json,
+    /// IGES 5.3, fixed 80-column ASCII form (`.igs`, `.iges`).
+    Iges,
 }
 
 impl Format {
-    /// Format from a name or file extension (`"json"`, `".json"`, case-insensitive).
+    /// Format from a name or file extension (`"json"`, `".igs"`, `"iges"`, case-insensitive).
     ///
     /// # Errors
     /// [`Error::Format`] for an unknown name.
@@ -31,15 +35,26 @@ impl Format {
         let n = name.trim_start_matches('.');
         if n.eq_ignore_ascii_case("json") {
             Ok(Self::Json)
+        } else if n.eq_ignore_ascii_case("igs") || n.eq_ignore_ascii_case("iges") {
+            Ok(Self::Iges)
         } else {
-            Err(Error::Format(format!("unknown input format '{name}' (expected json)")))
+            Err(Error::Format(format!("unknown input format '{name}' (expected json, igs or iges)")))
         }
     }
 
-    /// Guesses the format from the first bytes (`{` after white space: JSON).
+    /// Guesses the format from the first bytes: `{` after white space is
+    /// JSON; a first line of at least 73 columns with `S` or `G` in column 73
+    /// (and a sequence number after it, when the line is 80 columns) is IGES.
     pub fn detect(bytes: &[u8]) -> Option<Self> {
         let first = bytes.iter().find(|b| !b.is_ascii_whitespace())?;
-        (*first == b'{').then_some(Self::Json)
+        if *first == b'{' {
+            return Some(Self::Json);
+        }
+        let line = bytes.split(|&b| b == b'\n').next()?;
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        let letter = *line.get(72)?;
+        let seq_ok = line.get(73..).is_none_or(|s| s.iter().all(|c| c.is_ascii_digit() || *c == b' '));
+        (matches!(letter, b'S' | b'G') && seq_ok && line.len() <= 80).then_some(Self::Iges)
     }
 }
 
@@ -50,5 +65,6 @@ impl Format {
 pub fn read_model(bytes: &[u8], format: Format) -> Result<Model, Error> {
     match format {
         Format::Json => read_json(bytes),
+        Format::Iges => read_iges(bytes),
     }
 }

@@ -1,5 +1,6 @@
 //! The model to mesh: faces made of a surface and trim loops in its (u,v).
 
+use alloc::boxed::Box;
 use alloc::string::String;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
@@ -46,35 +47,123 @@ pub struct TrimLoop {
 pub enum FaceSurface {
     /// A (rational) B-spline surface.
     Nurbs(NurbsSurface),
+    /// The surface at signed `distance` along the unit normal of `base`
+    /// (`S + d·N`, IGES 140), evaluated exactly (first derivatives by the Weingarten equations).
+    Offset {
+        /// The surface offset.
+        base: Box<FaceSurface>,
+        /// Offset distance along `Su × Sv` normalized, model units.
+        distance: f64,
+    },
 }
 
 impl FaceSurface {
-    fn inner(&self) -> &dyn Surface {
-        match self {
-            Self::Nurbs(s) => s,
+    /// The B-spline surface under any offsets: it defines the domain and knots.
+    fn base_nurbs(&self) -> &NurbsSurface {
+        let mut s = self;
+        loop {
+            match s {
+                Self::Nurbs(n) => return n,
+                Self::Offset { base, .. } => s = base,
+            }
         }
     }
 }
 
 impl Surface for FaceSurface {
     fn domain(&self) -> [DVec2; 2] {
-        self.inner().domain()
+        self.base_nurbs().domain()
     }
     fn point(&self, uv: DVec2) -> DVec3 {
-        self.inner().point(uv)
+        match self {
+            Self::Nurbs(s) => s.point(uv),
+            Self::Offset { base, distance } => base.point(uv) + base.normal(uv) * *distance,
+        }
     }
     fn derivs(&self, uv: DVec2) -> SurfaceDerivs {
-        self.inner().derivs(uv)
+        match self {
+            Self::Nurbs(s) => s.derivs(uv),
+            Self::Offset { base, distance } => offset_derivs(base, *distance, uv),
+        }
     }
     fn breaks(&self, along_u: bool) -> Vec<f64> {
-        self.inner().breaks(along_u)
+        self.base_nurbs().breaks(along_u)
     }
     fn bounding_box(&self) -> Aabb {
-        self.inner().bounding_box()
+        match self {
+            Self::Nurbs(s) => s.bounding_box(),
+            Self::Offset { base, distance } => {
+                let mut b = base.bounding_box();
+                if !b.is_empty() {
+                    let d = DVec3::splat(distance.abs());
+                    b.min -= d;
+                    b.max += d;
+                }
+                b
+            }
+        }
     }
     fn normal(&self, uv: DVec2) -> DVec3 {
-        self.inner().normal(uv)
+        match self {
+            Self::Nurbs(s) => s.normal(uv),
+            // Parallel to the base's normal wherever the offset is regular.
+            Self::Offset { base, .. } => base.normal(uv),
+        }
     }
+}
+
+/// First derivatives of the offset surface `O = S + d·N` exactly, second
+/// derivatives by central differences.
+///
+/// `O_u = S_u + d·N_u`, `O_v = S_v + d·N_v`, with the normal's derivatives
+/// from the Weingarten equations: with `E, F, G` the first and `L, M, N` the
+/// second fundamental form of the base and `D = EG − F²`,
+/// `N_u = ((FM − GL)·S_u + (FL − EM)·S_v) / D` and
+/// `N_v = ((FN − GM)·S_u + (FM − EN)·S_v) / D`. They need the base's second
+/// derivatives, so the offset's second derivatives would need its third:
+/// instead they are central differences of `O_u` and `O_v` over a step of
+/// 1e-5 of the domain (one-sided next to the domain's edges), which is what
+/// the mesher's curvature estimates need. Where the base degenerates
+/// (`D ≈ 0`, a pole) the normal's derivatives are taken as zero.
+fn offset_derivs(base: &FaceSurface, d: f64, uv: DVec2) -> SurfaceDerivs {
+    let first = |q: DVec2| -> (DVec3, DVec3, DVec3) {
+        let b = base.derivs(q);
+        let n = base.normal(q);
+        let (e, f, g) = (b.su.dot(b.su), b.su.dot(b.sv), b.sv.dot(b.sv));
+        let (l, m, nn) = (b.suu.dot(n), b.suv.dot(n), b.svv.dot(n));
+        let den = e * g - f * f;
+        let (nu, nv) = if den > 1e-24 * (e * g).max(1e-300) && den.is_finite() {
+            (
+                (b.su * (f * m - g * l) + b.sv * (f * l - e * m)) / den,
+                (b.su * (f * nn - g * m) + b.sv * (f * m - e * nn)) / den,
+            )
+        } else {
+            (DVec3::ZERO, DVec3::ZERO)
+        };
+        (b.point + n * d, b.su + nu * d, b.sv + nv * d)
+    };
+    let (point, su, sv) = first(uv);
+    let [lo, hi] = base.domain();
+    let h = (hi - lo) * 1e-5;
+    // Step inside the domain: centred where possible.
+    let pair = |x: f64, lo: f64, hi: f64, h: f64| -> (f64, f64) {
+        let a = (x - h).max(lo);
+        let b = (a + 2.0 * h).min(hi);
+        let a = (b - 2.0 * h).max(lo);
+        (a, b)
+    };
+    let (u0, u1) = pair(uv.x, lo.x, hi.x, h.x);
+    let (v0, v1) = pair(uv.y, lo.y, hi.y, h.y);
+    let (_, su_a, sv_a) = first(DVec2::new(u0, uv.y));
+    let (_, su_b, sv_b) = first(DVec2::new(u1, uv.y));
+    let (_, _, sv_c) = first(DVec2::new(uv.x, v0));
+    let (_, _, sv_d) = first(DVec2::new(uv.x, v1));
+    let du = u1 - u0;
+    let dv = v1 - v0;
+    let suu = if du > 0.0 { (su_b - su_a) / du } else { DVec3::ZERO };
+    let suv = if du > 0.0 { (sv_b - sv_a) / du } else { DVec3::ZERO };
+    let svv = if dv > 0.0 { (sv_d - sv_c) / dv } else { DVec3::ZERO };
+    SurfaceDerivs { point, su, sv, suu, suv, svv }
 }
 
 impl Model {

@@ -1,10 +1,15 @@
 //! NURBS geometry: knot vectors, basis functions, curves, surfaces, projection.
 
+pub(crate) mod analytic;
 mod bbox;
 mod curve;
+pub(crate) mod elevate;
 mod error;
+pub(crate) mod join;
 mod knots;
 mod project;
+pub(crate) mod reparam;
+pub(crate) mod seam;
 mod surface;
 
 use alloc::vec::Vec;
@@ -59,7 +64,8 @@ pub trait Surface {
     /// taken from a point nudged toward the domain's centre, which is the
     /// direction every nearby facet sees.
     fn normal(&self, uv: DVec2) -> DVec3 {
-        if let Some(n) = regular_normal(&self.derivs(uv)) {
+        let d = self.derivs(uv);
+        if let Some(n) = regular_normal(&d) {
             return n;
         }
         let [lo, hi] = self.domain();
@@ -69,11 +75,35 @@ pub trait Surface {
             f *= 10.0;
             let q = uv + (centre - uv) * f;
             if let Some(n) = regular_normal(&self.derivs(q)) {
-                return n;
+                // The exact limit where it exists, on the side the nudge found.
+                return match collapsed_normal(&d) {
+                    Some(exact) if exact.dot(n) > 0.0 => exact,
+                    Some(exact) if exact.dot(n) < 0.0 => -exact,
+                    _ => n,
+                };
             }
         }
         DVec3::Z
     }
+}
+
+/// The normal's limit at a collapsed edge, up to sign: where `Sv` vanishes,
+/// `Sv ≈ Suv·Δu` next to it, so the normal is along `Su × Suv` (and
+/// `Suv × Sv` where `Su` vanishes). Exact at a sphere's pole, where the
+/// nudged normal is only close; an offset surface needs it exact, or its
+/// pole would open into a small loop.
+fn collapsed_normal(d: &SurfaceDerivs) -> Option<DVec3> {
+    let (lu, lv) = (d.su.length_squared(), d.sv.length_squared());
+    let n = if lv < 1e-20 * lu {
+        d.su.cross(d.suv)
+    } else if lu < 1e-20 * lv {
+        d.suv.cross(d.sv)
+    } else {
+        return None;
+    };
+    let len = n.length();
+    let scale = libm::sqrt(lu.max(lv)) * d.suv.length();
+    (len.is_finite() && len > 1e-6 * scale).then(|| n / len)
 }
 
 /// `Su × Sv` normalized, or `None` where the surface is degenerate: the cross

@@ -58,7 +58,7 @@ Options of `mesh`:
   --max-triangles N   triangle budget (default 4000000)
   --mode fast         meshing mode (`quality` is not available yet)
   --reparam auto|off  re-parameterization of poor surfaces (`force` is not available yet)
-  --format json       input format (default: from the extension, else from the content)
+  --format json|iges  input format (default: from the extension, else from the content)
   -o, --output FILE   write the mesh; .stl, .obj or .glb picks the format
   --report FILE       write the JSON report (printed to stdout when neither
                       -o nor --report is given)

@@ -1,0 +1,278 @@
+//! Which entities are faces, and how each becomes one: trimmed surfaces
+//! (144 with 142 boundaries), bounded surfaces (143 with 141 boundaries),
+//! B-rep faces (510 in 514 shells in 186 solids), bounded planes (108 form
+//! 1) and surfaces no face uses (untrimmed).
+//!
+//! A face that cannot be read is skipped with a warning naming its directory
+//! entry and type.
+
+use alloc::string::String;
+use alloc::vec::Vec;
+use glam::DAffine3;
+use hashbrown::HashSet;
+
+use super::brep::{chain_transform, face_510, reverse_all, shell_faces};
+use super::curves::{model_curve, param_curve};
+use super::directory::Entity;
+use super::loops::{build_face, FaceSrc, LoopSrc};
+use super::surfaces::{is_surface, surface_def};
+use super::xform::own_transform;
+use super::Ctx;
+use crate::model::Face;
+use crate::Error;
+
+/// The faces of the file, in directory order, with warnings for what was
+/// skipped; the first skip's error is kept for files where nothing is left.
+pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face>, Option<Error>) {
+    let dir = ctx.dir;
+    // Surfaces that faces (or offsets) use are not faces themselves.
+    let mut used: HashSet<usize> = HashSet::new();
+    let mut in_shell: HashSet<usize> = HashSet::new();
+    let mut shell_in_solid: HashSet<usize> = HashSet::new();
+    for e in &dir.entities {
+        let at = match e.kind {
+            144 | 510 => Some(1),
+            143 | 142 => Some(2),
+            141 => Some(3),
+            140 => Some(5),
+            _ => None,
+        };
+        if let Some(Ok(Some(s))) = at.map(|i| e.ptr(i)) {
+            used.insert(s);
+        }
+        if e.kind == 186 || e.kind == 514 {
+            if e.kind == 186 {
+                if let Ok(Some(s)) = e.ptr(1) {
+                    shell_in_solid.insert(s);
+                }
+            }
+            if let Ok(faces) = shell_faces(ctx, e.de) {
+                in_shell.extend(faces);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    let mut first_error: Option<Error> = None;
+    let mut unsupported: Vec<(u32, usize)> = Vec::new();
+    for e in &dir.entities {
+        let jobs: Vec<(usize, Job)> = match e.kind {
+            144 => alloc::vec![(e.de, Job::Trimmed)],
+            143 => alloc::vec![(e.de, Job::Bounded)],
+            186 => match shell_faces(ctx, e.de) {
+                Ok(f) => f.into_iter().map(|f| (f, Job::Brep(alloc::vec![e.de]))).collect(),
+                Err(err) => {
+                    skip(warnings, &mut first_error, e, err);
+                    continue;
+                }
+            },
+            514 if !shell_in_solid.contains(&e.de) => match shell_faces(ctx, e.de) {
+                Ok(f) => f.into_iter().map(|f| (f, Job::Brep(alloc::vec![e.de]))).collect(),
+                Err(err) => {
+                    skip(warnings, &mut first_error, e, err);
+                    continue;
+                }
+            },
+            510 if !in_shell.contains(&e.de) => alloc::vec![(e.de, Job::Brep(Vec::new()))],
+            108 if e.form == 1 && !used.contains(&e.de) => alloc::vec![(e.de, Job::BoundedPlane)],
+            108 => continue,
+            k if is_surface(k) && !used.contains(&e.de) && e.subordinate & 1 == 0 => {
+                alloc::vec![(e.de, Job::Untrimmed)]
+            }
+            308 | 408 | 402 if e.kind != 402 || e.form == 9 => {
+                match unsupported.iter_mut().find(|(k, _)| *k == e.kind) {
+                    Some(x) => x.1 += 1,
+                    None => unsupported.push((e.kind, 1)),
+                }
+                continue;
+            }
+            _ => continue,
+        };
+        for (de, job) in jobs {
+            let Ok(fe) = ctx.entity(de) else {
+                skip(warnings, &mut first_error, e, ctx.entity(de).err().unwrap_or(Error::Internal("entity".into())));
+                continue;
+            };
+            let mut local = Vec::new();
+            let result =
+                face_source(ctx, fe, &job).and_then(|src| build_face(src, &mut local).map_err(|m| fe.error(m)));
+            for w in local {
+                warnings.push(alloc::format!("DE {} (type {}): {w}", fe.de, fe.kind));
+            }
+            match result {
+                Ok(mut face) => {
+                    face.name = name_of(ctx, fe, &job);
+                    out.push(face);
+                }
+                Err(err) => skip(warnings, &mut first_error, fe, err),
+            }
+        }
+    }
+    for (kind, n) in unsupported {
+        warnings.push(alloc::format!(
+            "{n} entities of type {kind} (subfigures, instances, perforated planes) skipped: not supported"
+        ));
+    }
+    (out, first_error)
+}
+
+/// How one face is read.
+#[derive(Debug, Clone)]
+enum Job {
+    Trimmed,
+    Bounded,
+    /// A 510 face and the solid/shell entities above it.
+    Brep(Vec<usize>),
+    BoundedPlane,
+    Untrimmed,
+}
+
+fn skip(warnings: &mut Vec<String>, first: &mut Option<Error>, e: &Entity, err: Error) {
+    warnings.push(alloc::format!("DE {} (type {}): skipped: {err}", e.de, e.kind));
+    if first.is_none() {
+        *first = Some(err);
+    }
+}
+
+fn face_source(ctx: &Ctx<'_>, e: &Entity, job: &Job) -> Result<FaceSrc, Error> {
+    let m = ctx.world * own_transform(ctx.dir, e.de)?;
+    match job {
+        Job::Trimmed => trimmed_144(ctx, e, m),
+        Job::Bounded => bounded_143(ctx, e, m),
+        Job::Brep(parents) => {
+            if e.kind != 510 {
+                return Err(e.error(alloc::format!("a shell lists type {} as a face (expected 510)", e.kind)));
+            }
+            let parent = chain_transform(ctx, parents)?;
+            face_510(ctx, e, parent)
+        }
+        Job::BoundedPlane => {
+            let (def, native) = surface_def(ctx, e.de, ctx.world, 0)?;
+            let boundary = e.ptr(5)?.ok_or_else(|| e.error("bounded plane without a boundary curve"))?;
+            let model = model_curve(ctx, boundary, m, 1)?;
+            let loops = alloc::vec![LoopSrc { model, params: None }];
+            Ok(FaceSrc { def, native, loops, domain_outer: false, resolution: ctx.resolution })
+        }
+        Job::Untrimmed => {
+            let (def, native) = surface_def(ctx, e.de, ctx.world, 0)?;
+            Ok(FaceSrc { def, native, loops: Vec::new(), domain_outer: false, resolution: ctx.resolution })
+        }
+    }
+}
+
+/// 144: surface, N1 (0: the outer boundary is the surface's), N2 holes,
+/// outer 142, inner 142s.
+fn trimmed_144(ctx: &Ctx<'_>, e: &Entity, m: DAffine3) -> Result<FaceSrc, Error> {
+    let surf = e.ptr(1)?.ok_or_else(|| e.error("trimmed surface without a surface"))?;
+    let (def, native) = surface_def(ctx, surf, m, 0)?;
+    let n1 = e.int(2)?;
+    let n2 = e.count(3, 1, 5)?;
+    let mut loops = Vec::with_capacity(n2 + 1);
+    let outer = if n1 != 0 { e.ptr(4)? } else { None };
+    if let Some(o) = outer {
+        loops.push(curve_on_surface(ctx, e, o, m)?);
+    }
+    for k in 0..n2 {
+        if let Some(h) = e.ptr(5 + k)? {
+            loops.push(curve_on_surface(ctx, e, h, m)?);
+        }
+    }
+    Ok(FaceSrc { def, native, loops, domain_outer: outer.is_none(), resolution: ctx.resolution })
+}
+
+/// 142: creation flag, surface, parameter curve B, model curve C, preference
+/// (0 none, 1 B, 2 C, 3 both).
+fn curve_on_surface(ctx: &Ctx<'_>, owner: &Entity, de: usize, m: DAffine3) -> Result<LoopSrc, Error> {
+    let e = ctx.entity(de)?;
+    if e.kind != 142 {
+        return Err(owner.error(alloc::format!("boundary pointer {de} names type {}, not 142", e.kind)));
+    }
+    let m = m * own_transform(ctx.dir, de)?;
+    let b = e.ptr(3)?;
+    let c = e.ptr(4)?;
+    let pref = e.int(5)?;
+    let model = match c {
+        Some(c) => model_curve(ctx, c, m, 1)?,
+        None => Vec::new(),
+    };
+    let want_params = pref != 2 || model.is_empty();
+    let params = match b {
+        Some(b) if want_params => Some(param_curve(ctx, b)?),
+        _ => None,
+    };
+    Ok(LoopSrc { model, params })
+}
+
+/// 143: type, surface, boundaries (141 each).
+fn bounded_143(ctx: &Ctx<'_>, e: &Entity, m: DAffine3) -> Result<FaceSrc, Error> {
+    let surf = e.ptr(2)?.ok_or_else(|| e.error("bounded surface without a surface"))?;
+    let (def, native) = surface_def(ctx, surf, m, 0)?;
+    let n = e.count(3, 1, 4)?;
+    let mut loops = Vec::with_capacity(n);
+    for k in 0..n {
+        let Some(b) = e.ptr(4 + k)? else { continue };
+        loops.push(boundary_141(ctx, e, b, m)?);
+    }
+    Ok(FaceSrc { def, native, loops, domain_outer: false, resolution: ctx.resolution })
+}
+
+/// 141: type, preference (1 model space, 2 parameter space), surface, N
+/// curves each with its sense (1 agrees, 2 reversed) and parameter curves.
+fn boundary_141(ctx: &Ctx<'_>, owner: &Entity, de: usize, m: DAffine3) -> Result<LoopSrc, Error> {
+    let e = ctx.entity(de)?;
+    if e.kind != 141 {
+        return Err(owner.error(alloc::format!("boundary pointer {de} names type {}, not 141", e.kind)));
+    }
+    let m = m * own_transform(ctx.dir, de)?;
+    let with_params = e.int(1)? == 1;
+    let pref = e.int(2)?;
+    let n = e.count(4, 3, 5)?;
+    let mut at = 5;
+    let mut model = Vec::new();
+    let mut params = Vec::new();
+    let mut all = with_params;
+    for _ in 0..n {
+        let c = e.ptr(at)?;
+        let sense = e.int(at + 1)?;
+        let k = e.count(at + 2, 1, at + 3)?;
+        if let Some(c) = c {
+            let pieces = model_curve(ctx, c, m, 1)?;
+            model.extend(if sense == 2 { reverse_all(e, pieces)? } else { pieces });
+        }
+        if k == 0 {
+            all = false;
+        }
+        for j in 0..k {
+            if let Some(p) = e.ptr(at + 3 + j)? {
+                params.extend(param_curve(ctx, p)?);
+            }
+        }
+        at += 3 + k;
+    }
+    let use_params = all && !params.is_empty() && (pref != 1 || model.is_empty());
+    Ok(LoopSrc { model, params: use_params.then_some(params) })
+}
+
+/// A 406 form 15 name property attached to the face entity.
+fn name_of(ctx: &Ctx<'_>, e: &Entity, job: &Job) -> Option<String> {
+    let used = match (job, e.kind) {
+        (Job::Trimmed, _) => 5 + usize::try_from(e.int(3).ok()?).ok()?,
+        (Job::Bounded, _) | (Job::Brep(_), 510) => {
+            let at = if e.kind == 510 { 2 } else { 3 };
+            4 + usize::try_from(e.int(at).ok()?).ok()?
+        }
+        _ => return None,
+    };
+    for p in e.properties(used.min(e.params.len())) {
+        if let Ok(prop) = ctx.entity(p) {
+            if prop.kind == 406 && prop.form == 15 {
+                if let Some(s) = prop.string(2) {
+                    let s = s.trim();
+                    if !s.is_empty() {
+                        return Some(s.into());
+                    }
+                }
+            }
+        }
+    }
+    None
+}

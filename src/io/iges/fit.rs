@@ -1,0 +1,302 @@
+//! Trim curves in a surface's parameters from samples (paper 001 §3.4):
+//! sample a model-space edge (or a parameter-space curve that needs a change
+//! of parameters), find each sample's native coordinates on the surface,
+//! make them continuous across seams, then interpolate them with a C¹ cubic
+//! (Hermite pieces, tangents from neighbouring samples) and add samples
+//! until the fitted curve, mapped onto the surface, stays within the
+//! tolerance of the exact points at every interval's midpoint.
+
+use alloc::vec::Vec;
+use glam::{DVec2, DVec3};
+
+use super::surfaces::{AxisMap, SurfDef};
+use crate::model::FaceSurface;
+use crate::nurbs::{NurbsCurve, Surface};
+
+/// At least this many samples on every curve (paper 001 §3.4 uses 51).
+pub(super) const MIN_SAMPLES: usize = 51;
+/// At most this many samples on one curve.
+pub(super) const MAX_SAMPLES: usize = 4096;
+
+/// Samples of one trim curve in the surface's native coordinates.
+#[derive(Debug, Clone)]
+pub(super) struct Track {
+    /// The source: a model-space curve (`model`) or a curve whose (x, y)
+    /// already are native coordinates.
+    pub curve: NurbsCurve,
+    pub model: bool,
+    pub ts: Vec<f64>,
+    pub qs: Vec<DVec2>,
+}
+
+/// `q` moved by whole periods to lie nearest to `near`.
+pub(super) fn unwrap_near(mut q: DVec2, near: DVec2, periods: [Option<f64>; 2]) -> DVec2 {
+    for k in 0..2 {
+        if let Some(p) = periods[k] {
+            if p > 0.0 {
+                q[k] += libm::round((near[k] - q[k]) / p) * p;
+            }
+        }
+    }
+    q
+}
+
+impl Track {
+    /// Native coordinates at `t`, continuous with `near` (free coordinates
+    /// taken from it, periods unwrapped towards it).
+    fn at(&self, def: &SurfDef, t: f64, near: Option<DVec2>, periods: [Option<f64>; 2]) -> DVec2 {
+        let p = self.curve.point(t);
+        if !self.model {
+            let q = p.truncate();
+            return near.map_or(q, |n| unwrap_near(q, n, periods));
+        }
+        let nat = def.invert(p, near);
+        let mut q = nat.q;
+        if let Some(n) = near {
+            for k in 0..2 {
+                if nat.free[k] {
+                    q[k] = n[k];
+                }
+            }
+            q = unwrap_near(q, n, periods);
+        }
+        q
+    }
+
+    /// Samples `curve` at [`MIN_SAMPLES`] even parameters plus its inner
+    /// knots; `start` is the native point the curve should continue from.
+    pub fn sample(
+        def: &SurfDef,
+        curve: NurbsCurve,
+        model: bool,
+        start: Option<DVec2>,
+        periods: [Option<f64>; 2],
+    ) -> Self {
+        let (a, b) = curve.domain();
+        let mut ts: Vec<f64> = (0..MIN_SAMPLES).map(|i| a + (b - a) * i as f64 / (MIN_SAMPLES - 1) as f64).collect();
+        let breaks = curve.knots().breakpoints();
+        if breaks.len() < MAX_SAMPLES / 4 {
+            ts.extend(breaks.iter().copied().filter(|&k| k > a && k < b));
+            ts.sort_by(f64::total_cmp);
+            ts.dedup_by(|x, y| (*x - *y).abs() <= 1e-12 * (b - a));
+        }
+        let mut tr = Self { curve, model, ts, qs: Vec::new() };
+        // Coordinates free at a sample (on an axis, at a pole) follow the
+        // next sample that has them: first a backward pass for free starts.
+        let mut qs: Vec<DVec2> = Vec::with_capacity(tr.ts.len());
+        let mut near = start;
+        for &t in &tr.ts {
+            let q = tr.at(def, t, near, periods);
+            qs.push(q);
+            near = Some(q);
+        }
+        if start.is_none() && model && qs.len() > 1 {
+            // The first sample had no neighbour: redo it from the second.
+            qs[0] = tr.at(def, tr.ts[0], Some(qs[1]), periods);
+        }
+        tr.qs = qs;
+        tr
+    }
+
+    /// Moves every sample by `shift` (whole periods).
+    pub fn shift(&mut self, shift: DVec2) {
+        for q in &mut self.qs {
+            *q += shift;
+        }
+    }
+
+    /// Box of the samples.
+    pub fn bounds(&self) -> (DVec2, DVec2) {
+        let mut lo = DVec2::splat(f64::INFINITY);
+        let mut hi = DVec2::splat(f64::NEG_INFINITY);
+        for &q in &self.qs {
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+        (lo, hi)
+    }
+
+    /// The cubic through the samples in the face surface's parameters
+    /// (native coordinates mapped by `maps`), refined until its image on
+    /// `surface` is within `tol` of the exact points at interval midpoints;
+    /// control points are kept inside the surface's domain. Returns the curve
+    /// and whether the tolerance was met within [`MAX_SAMPLES`].
+    pub fn fit(
+        &mut self,
+        def: &SurfDef,
+        surface: &FaceSurface,
+        maps: &[AxisMap; 2],
+        periods: [Option<f64>; 2],
+        tol: f64,
+    ) -> (Option<NurbsCurve>, bool) {
+        let map = |q: DVec2| DVec2::new(maps[0].apply(q.x), maps[1].apply(q.y));
+        let mut met = false;
+        for _ in 0..24 {
+            let ws: Vec<DVec2> = self.qs.iter().map(|&q| map(q)).collect();
+            let ms = tangents(&self.ts, &ws);
+            let mut add: Vec<(usize, f64, DVec2)> = Vec::new();
+            for i in 0..self.ts.len().saturating_sub(1) {
+                let (t0, t1) = (self.ts[i], self.ts[i + 1]);
+                let h = t1 - t0;
+                if h.is_nan() || h <= 1e-14 * (t0.abs() + t1.abs()).max(1e-300) {
+                    continue;
+                }
+                // Below this chord the samples resolve the file's own noise, not the curve.
+                if surface.point(ws[i]).distance(surface.point(ws[i + 1])) < 16.0 * tol {
+                    continue;
+                }
+                let tm = 0.5 * (t0 + t1);
+                let qm = self.at(def, tm, Some(0.5 * (self.qs[i] + self.qs[i + 1])), periods);
+                let exact = surface.point(map(qm));
+                let hm = (ws[i] + ws[i + 1]) * 0.5 + (ms[i] - ms[i + 1]) * (h / 8.0);
+                if surface.point(hm).distance(exact) > tol {
+                    add.push((i, tm, qm));
+                }
+            }
+            if add.is_empty() {
+                met = true;
+                break;
+            }
+            if self.ts.len() + add.len() > MAX_SAMPLES {
+                break;
+            }
+            for &(i, tm, qm) in add.iter().rev() {
+                self.ts.insert(i + 1, tm);
+                self.qs.insert(i + 1, qm);
+            }
+        }
+        let mut ws: Vec<DVec2> = self.qs.iter().map(|&q| map(q)).collect();
+        let mut ts = self.ts.clone();
+        if met {
+            (ts, ws) = coarsen(ts, ws, surface, 0.5 * tol);
+        }
+        let ms = tangents(&ts, &ws);
+        let [lo, hi] = surface.domain();
+        (hermite_curve(&ts, &ws, &ms, lo, hi), met)
+    }
+}
+
+/// Drops samples the cubic does not need: repeatedly tries to remove every
+/// other inner sample, keeping those where the cubic through the rest
+/// passes farther than `tol` (on the surface) from the removed exact point.
+fn coarsen(mut ts: Vec<f64>, mut ws: Vec<DVec2>, surface: &FaceSurface, tol: f64) -> (Vec<f64>, Vec<DVec2>) {
+    loop {
+        let n = ts.len();
+        if n <= 2 {
+            break;
+        }
+        // Candidates: odd inner indices.
+        let keep_idx: Vec<usize> = (0..n).filter(|&i| i % 2 == 0 || i == n - 1).collect();
+        let kt: Vec<f64> = keep_idx.iter().map(|&i| ts[i]).collect();
+        let kw: Vec<DVec2> = keep_idx.iter().map(|&i| ws[i]).collect();
+        let km = tangents(&kt, &kw);
+        let mut keep = alloc::vec![true; n];
+        let mut removed = 0;
+        for (k, w) in keep_idx.windows(2).enumerate() {
+            let (a, b) = (w[0], w[1]);
+            let h = ts[b] - ts[a];
+            for i in a + 1..b {
+                let s = if h > 0.0 { (ts[i] - ts[a]) / h } else { 0.5 };
+                let (s2, s3) = (s * s, s * s * s);
+                let hp = kw[k] * (2.0 * s3 - 3.0 * s2 + 1.0)
+                    + km[k] * (h * (s3 - 2.0 * s2 + s))
+                    + kw[k + 1] * (3.0 * s2 - 2.0 * s3)
+                    + km[k + 1] * (h * (s3 - s2));
+                if surface.point(hp).distance(surface.point(ws[i])) <= tol {
+                    keep[i] = false;
+                    removed += 1;
+                }
+            }
+        }
+        if removed == 0 {
+            break;
+        }
+        let mut i = 0;
+        ts.retain(|_| {
+            i += 1;
+            keep[i - 1]
+        });
+        let mut j = 0;
+        ws.retain(|_| {
+            j += 1;
+            keep[j - 1]
+        });
+    }
+    (ts, ws)
+}
+
+/// Derivatives at the samples, shape-preserving per coordinate (Fritsch
+/// and Butland): zero where a coordinate turns, a weighted harmonic mean of
+/// the neighbouring slopes elsewhere, so each cubic piece is monotone in u
+/// and in v between its samples. The fit never overshoots its samples, and
+/// noise in the samples (a file's edge lying slightly off its surface)
+/// cannot fold it into loops.
+fn tangents(ts: &[f64], ws: &[DVec2]) -> Vec<DVec2> {
+    let n = ts.len();
+    if n < 2 {
+        return alloc::vec![DVec2::ZERO; n];
+    }
+    let slope = |i: usize| {
+        let h = ts[i + 1] - ts[i];
+        if h > 0.0 {
+            (ws[i + 1] - ws[i]) / h
+        } else {
+            DVec2::ZERO
+        }
+    };
+    if n == 2 {
+        return alloc::vec![slope(0); 2];
+    }
+    let mut m = alloc::vec![DVec2::ZERO; n];
+    for i in 1..n - 1 {
+        let (h0, h1) = (ts[i] - ts[i - 1], ts[i + 1] - ts[i]);
+        let (d0, d1) = (slope(i - 1), slope(i));
+        for k in 0..2 {
+            let (a, b) = (d0[k], d1[k]);
+            m[i][k] = if a * b > 0.0 { 3.0 * (h0 + h1) / ((2.0 * h1 + h0) / a + (h1 + 2.0 * h0) / b) } else { 0.0 };
+        }
+    }
+    // Ends: the three-point formula, kept monotone.
+    let end = |h0: f64, h1: f64, d0: DVec2, d1: DVec2| {
+        let mut e = ((2.0 * h0 + h1) * d0 - h0 * d1) / (h0 + h1);
+        for k in 0..2 {
+            if e[k] * d0[k] <= 0.0 {
+                e[k] = 0.0;
+            } else if d0[k] * d1[k] < 0.0 && e[k].abs() > 3.0 * d0[k].abs() {
+                e[k] = 3.0 * d0[k];
+            }
+        }
+        e
+    };
+    m[0] = end(ts[1] - ts[0], ts[2] - ts[1], slope(0), slope(1));
+    m[n - 1] = end(ts[n - 1] - ts[n - 2], ts[n - 2] - ts[n - 3], slope(n - 2), slope(n - 3));
+    m
+}
+
+/// The C¹ cubic through `ws` at `ts` with derivatives `ms`, as Bézier
+/// pieces (inner knots of multiplicity 3), control points clamped to `lo..hi`.
+fn hermite_curve(ts: &[f64], ws: &[DVec2], ms: &[DVec2], lo: DVec2, hi: DVec2) -> Option<NurbsCurve> {
+    let mut keep: Vec<usize> = Vec::with_capacity(ts.len());
+    for i in 0..ts.len() {
+        if keep.last().is_none_or(|&j| ts[i] > ts[j]) {
+            keep.push(i);
+        }
+    }
+    if keep.len() < 2 {
+        return None;
+    }
+    let clamp = |p: DVec2| p.clamp(lo, hi).extend(0.0);
+    let first = keep[0];
+    let mut knots: Vec<f64> = alloc::vec![ts[first]; 4];
+    let mut pts: Vec<DVec3> = alloc::vec![clamp(ws[first])];
+    for w in keep.windows(2) {
+        let (i, j) = (w[0], w[1]);
+        let h = ts[j] - ts[i];
+        pts.push(clamp(ws[i] + ms[i] * (h / 3.0)));
+        pts.push(clamp(ws[j] - ms[j] * (h / 3.0)));
+        pts.push(clamp(ws[j]));
+        knots.extend([ts[j]; 3]);
+    }
+    knots.push(ts[keep[keep.len() - 1]]);
+    NurbsCurve::try_new(3, knots, pts, None).ok()
+}

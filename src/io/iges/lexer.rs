@@ -1,0 +1,317 @@
+//! IGES records and free-format fields: the file split into its sections
+//! (column 73 names the section), and the parameter tokenizer shared by the
+//! Global and Parameter sections (delimiters, Hollerith strings, Fortran
+//! `D` exponents).
+
+use alloc::string::String;
+use alloc::vec::Vec;
+
+use super::{iges_error, Section};
+use crate::Error;
+
+/// One 80-column record.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Record<'a> {
+    /// 1-based line of the file.
+    pub line: usize,
+    /// Columns 1–72 (fewer when the line was short).
+    pub data: &'a [u8],
+    /// Whether the section letter sat in column 73 (fixed columns intact).
+    pub fixed: bool,
+}
+
+/// The records of each section, in file order.
+#[derive(Debug, Default)]
+pub(super) struct Sections<'a> {
+    pub global: Vec<Record<'a>>,
+    pub directory: Vec<Record<'a>>,
+    pub parameter: Vec<Record<'a>>,
+    pub terminate: Vec<Record<'a>>,
+    /// Line of a last record cut short (no section letter): the file was
+    /// truncated there, and the record was dropped.
+    pub truncated: Option<usize>,
+}
+
+/// Splits `bytes` into records. Accepts LF or CRLF line ends, a missing
+/// final newline, blank lines, and lines shorter than 80 columns (trailing
+/// blanks dropped); the section letter is column 73, or, on a line shorter
+/// than that, the letter before the trailing sequence number.
+///
+/// # Errors
+/// A line with no section letter, a compressed or binary file, or sections
+/// out of order.
+pub(super) fn split_sections(bytes: &[u8]) -> Result<Sections<'_>, Error> {
+    let mut out = Sections::default();
+    let mut last = 0u8; // order: S < G < D < P < T
+    let rank = |c: u8| match c {
+        b'S' => 1,
+        b'G' => 2,
+        b'D' => 3,
+        b'P' => 4,
+        b'T' => 5,
+        _ => 0,
+    };
+    // The last line with content: cut short there, it is a truncated record.
+    let last_line = bytes
+        .split(|&b| b == b'\n')
+        .enumerate()
+        .filter(|(_, l)| !l.iter().all(|b| b.is_ascii_whitespace()))
+        .map(|(i, _)| i + 1)
+        .last()
+        .unwrap_or(0);
+    for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+        let line = i + 1;
+        let text = raw.strip_suffix(b"\r").unwrap_or(raw);
+        if text.iter().all(|b| b.is_ascii_whitespace()) {
+            continue;
+        }
+        let (letter, data, fixed) = if text.len() >= 73 {
+            (text[72], &text[..72], true)
+        } else {
+            match short_record(text) {
+                Some((letter, cut)) => (letter, &text[..cut], false),
+                None if line == last_line && last >= 3 => {
+                    out.truncated = Some(line);
+                    break;
+                }
+                None => {
+                    return Err(iges_error(
+                        Section::Unknown,
+                        line,
+                        0,
+                        "no section letter (S, G, D, P or T) in column 73: not an 80-column IGES record",
+                    ))
+                }
+            }
+        };
+        let r = rank(letter);
+        if r == 0 {
+            let message = match letter {
+                b'C' => "compressed IGES (section letter C) is not supported".into(),
+                b'B' => "binary IGES (section letter B) is not supported".into(),
+                other => alloc::format!("unknown section letter '{}' in column 73", char::from(other).escape_default()),
+            };
+            return Err(iges_error(Section::Unknown, line, 0, message));
+        }
+        if r < last {
+            return Err(iges_error(
+                Section::from_letter(letter),
+                line,
+                0,
+                "section out of order (expected Start, Global, Directory, Parameter, Terminate)",
+            ));
+        }
+        last = r;
+        let rec = Record { line, data, fixed };
+        match letter {
+            b'G' => out.global.push(rec),
+            b'D' => out.directory.push(rec),
+            b'P' => out.parameter.push(rec),
+            b'T' => out.terminate.push(rec),
+            _ => {}
+        }
+    }
+    Ok(out)
+}
+
+/// On a line shorter than 73 columns: the section letter followed by
+/// blanks and digits at its end. Returns the letter and where the data ends.
+fn short_record(text: &[u8]) -> Option<(u8, usize)> {
+    let mut end = text.len();
+    while end > 0 && text[end - 1].is_ascii_whitespace() {
+        end -= 1;
+    }
+    let digits_end = end;
+    while end > 0 && text[end - 1].is_ascii_digit() {
+        end -= 1;
+    }
+    if end == digits_end {
+        return None;
+    }
+    while end > 0 && text[end - 1] == b' ' {
+        end -= 1;
+    }
+    let letter = *text.get(end.checked_sub(1)?)?;
+    matches!(letter, b'S' | b'G' | b'D' | b'P' | b'T' | b'C' | b'B').then_some((letter, end - 1))
+}
+
+/// One free-format field.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum Value {
+    /// Nothing between two delimiters: the field's default.
+    Empty,
+    /// An integer.
+    Int(i64),
+    /// A real number.
+    Real(f64),
+    /// A Hollerith string.
+    Str(String),
+}
+
+/// Splits one record of free-format data (all lines of one entity, or the
+/// whole Global section) into fields, up to the record delimiter.
+pub(super) struct Tokenizer<'a> {
+    text: &'a [u8],
+    pos: usize,
+    pub param: u8,
+    pub record: u8,
+}
+
+impl<'a> Tokenizer<'a> {
+    pub fn new(text: &'a [u8], param: u8, record: u8) -> Self {
+        Self { text, pos: 0, param, record }
+    }
+
+    fn skip_blanks(&mut self) {
+        while self.pos < self.text.len() && self.text[self.pos] == b' ' {
+            self.pos += 1;
+        }
+    }
+
+    /// The Global section's first two fields: the delimiters, each either
+    /// empty (defaults `,` and `;`) or a `1H` string.
+    pub fn read_delimiters(&mut self) -> Result<(), String> {
+        self.skip_blanks();
+        if self.text.get(self.pos) == Some(&b',') {
+            self.param = b',';
+            self.pos += 1;
+        } else {
+            let c = self.one_char_string(1)?;
+            self.param = c;
+            self.skip_blanks();
+            if self.text.get(self.pos) != Some(&c) {
+                return Err("field 1: expected the parameter delimiter after it".into());
+            }
+            self.pos += 1;
+        }
+        self.skip_blanks();
+        match self.text.get(self.pos) {
+            Some(&c) if c == self.param => {
+                self.record = b';';
+                self.pos += 1;
+            }
+            Some(b';') => self.record = b';',
+            _ => {
+                let c = self.one_char_string(2)?;
+                self.record = c;
+                self.skip_blanks();
+                match self.text.get(self.pos) {
+                    Some(&d) if d == self.param => self.pos += 1,
+                    Some(&d) if d == self.record => {}
+                    _ => return Err("field 2: expected a delimiter after it".into()),
+                }
+            }
+        }
+        if self.param == self.record || self.param == b' ' || self.record == b' ' {
+            return Err("the parameter and record delimiters must differ and not be blank".into());
+        }
+        Ok(())
+    }
+
+    /// `1Hc` at the cursor.
+    fn one_char_string(&mut self, field: usize) -> Result<u8, String> {
+        let t = &self.text[self.pos..];
+        if t.len() >= 3 && t[0] == b'1' && (t[1] == b'H' || t[1] == b'h') {
+            self.pos += 3;
+            return Ok(t[2]);
+        }
+        Err(alloc::format!("field {field} (a delimiter) must be empty or a 1H string"))
+    }
+
+    /// All fields up to the record delimiter (or the end of the text).
+    /// `max` caps the count (the caller's limit).
+    pub fn fields(&mut self, max: usize) -> Result<Vec<Value>, String> {
+        let mut out = Vec::new();
+        let mut after_delim = false;
+        loop {
+            self.skip_blanks();
+            let Some(&c) = self.text.get(self.pos) else {
+                if after_delim {
+                    out.push(Value::Empty);
+                }
+                return Ok(out);
+            };
+            if out.len() >= max {
+                return Err(alloc::format!("more than {max} parameters"));
+            }
+            if c == self.record {
+                if after_delim {
+                    out.push(Value::Empty);
+                }
+                return Ok(out);
+            }
+            if c == self.param {
+                out.push(Value::Empty);
+                self.pos += 1;
+                after_delim = true;
+                continue;
+            }
+            let v = self.field(out.len() + 1)?;
+            out.push(v);
+            self.skip_blanks();
+            match self.text.get(self.pos) {
+                None => return Ok(out),
+                Some(&d) if d == self.record => return Ok(out),
+                Some(&d) if d == self.param => {
+                    self.pos += 1;
+                    after_delim = true;
+                }
+                Some(&d) => {
+                    return Err(alloc::format!(
+                        "parameter {}: unexpected '{}' after the value",
+                        out.len(),
+                        char::from(d).escape_default()
+                    ))
+                }
+            }
+        }
+    }
+
+    /// One non-empty field starting at `pos`.
+    fn field(&mut self, index: usize) -> Result<Value, String> {
+        let t = &self.text[self.pos..];
+        let digits = t.iter().take_while(|b| b.is_ascii_digit()).count();
+        if digits > 0 && matches!(t.get(digits), Some(b'H' | b'h')) {
+            let n: usize = core::str::from_utf8(&t[..digits])
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .ok_or_else(|| alloc::format!("parameter {index}: bad string length"))?;
+            let start = digits + 1;
+            let body = t.get(start..start.saturating_add(n)).ok_or_else(|| {
+                alloc::format!("parameter {index}: string of {n} characters runs past the end of the entity's data")
+            })?;
+            self.pos += start + n;
+            return Ok(Value::Str(body.iter().map(|&b| char::from(b)).collect()));
+        }
+        let len = t.iter().take_while(|&&b| b != self.param && b != self.record).count();
+        self.pos += len;
+        let raw = &t[..len];
+        parse_number(raw).ok_or_else(|| {
+            let shown: String = raw.iter().take(24).map(|&b| char::from(b)).collect();
+            alloc::format!("parameter {index}: '{}' is not a number", shown.trim())
+        })
+    }
+}
+
+/// An integer or real in IGES syntax (blanks ignored; `D` or `E` exponent).
+pub(super) fn parse_number(raw: &[u8]) -> Option<Value> {
+    let mut s = String::with_capacity(raw.len());
+    for &b in raw {
+        match b {
+            b' ' => {}
+            b'D' | b'd' | b'e' => s.push('E'),
+            b'0'..=b'9' | b'+' | b'-' | b'.' | b'E' => s.push(char::from(b)),
+            _ => return None,
+        }
+    }
+    if s.is_empty() {
+        return Some(Value::Empty);
+    }
+    if !s.contains(['.', 'E']) {
+        if let Ok(i) = s.parse::<i64>() {
+            return Some(Value::Int(i));
+        }
+    }
+    let x: f64 = s.parse().ok()?;
+    x.is_finite().then_some(Value::Real(x))
+}

@@ -1,0 +1,254 @@
+//! IGES: small files written for these tests check units, scale, trims,
+//! analytic surfaces and malformed input.
+
+use std::path::Path;
+
+use glam::DVec3;
+use surfmesh::{mesh_model, read_iges, read_model, Error, Format, Mesh, MeshOptions};
+
+fn data(name: &str) -> Vec<u8> {
+    std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)).unwrap()
+}
+
+/// Area of the triangles of face `f`.
+fn face_area(m: &Mesh, f: usize) -> f64 {
+    let r = m.face_ranges[f];
+    (r.first as usize..(r.first + r.count) as usize)
+        .map(|t| {
+            let [a, b, c] = m.triangle(t);
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .sum()
+}
+
+/// Vertices used by the triangles of face `f`.
+fn face_vertices(m: &Mesh, f: usize) -> Vec<DVec3> {
+    let r = m.face_ranges[f];
+    (r.first as usize..(r.first + r.count) as usize).flat_map(|t| m.triangle(t)).collect()
+}
+
+#[test]
+fn plate_reads_units_scale_names_and_trims() {
+    let model = read_iges(&data("iges_plate.igs")).unwrap();
+    assert_eq!(model.units, "in");
+    // Resolution 0.002 in a file drawn at scale 2: 0.001 in real units.
+    assert!((model.tolerance.unwrap() - 0.001).abs() < 1e-15);
+    assert_eq!(model.faces.len(), 2, "warnings: {:?}", model.warnings);
+    assert_eq!(model.faces[0].name, None);
+    assert_eq!(model.faces[1].name.as_deref(), Some("FLANGE"));
+    assert_eq!(model.faces[0].loops.len(), 2, "outer rectangle and circular hole");
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-3)).unwrap();
+    let rep = &r.report;
+    assert!(rep.max_deviation <= rep.tolerance);
+    assert_eq!(rep.free_edges, 0, "the projected and the parameter-space trims share an edge");
+    assert_eq!(rep.inverted_triangles, 0);
+    // Model coordinates are halved by the scale: areas by four.
+    let tol = rep.tolerance;
+    let hole = std::f64::consts::PI * 16.0;
+    let expect0 = (30.0 * 16.0 - hole) / 4.0;
+    // The hole's polygon is inscribed: its area error is below its perimeter times the tolerance.
+    assert!((face_area(&r.mesh, 0) - expect0).abs() < 2.0 * std::f64::consts::PI * 2.0 * tol + 1e-9, "plate area");
+    assert!((face_area(&r.mesh, 1) - 15.0 * 16.0 / 4.0).abs() < 1e-9, "flange area");
+    for p in face_vertices(&r.mesh, 0) {
+        assert!(p.z.abs() < 1e-12 && p.x > 2.5 - 1e-9 && p.x < 17.5 + 1e-9 && p.y > 1.0 - 1e-9 && p.y < 9.0 + 1e-9);
+        assert!(p.distance(DVec3::new(10.0, 5.0, 0.0)) > 2.0 - tol, "vertex inside the hole: {p}");
+    }
+}
+
+#[test]
+fn crlf_short_lines_blank_fields_and_no_final_newline_read_the_same() {
+    let a = read_iges(&data("iges_plate.igs")).unwrap();
+    let b = read_iges(&data("iges_plate_crlf.igs")).unwrap();
+    assert_eq!(a.faces.len(), b.faces.len());
+    let opts = MeshOptions::default().with_relative_tolerance(1e-2);
+    let (ma, mb) = (mesh_model(&a, &opts).unwrap(), mesh_model(&b, &opts).unwrap());
+    for f in 0..a.faces.len() {
+        assert!((face_area(&ma.mesh, f) - face_area(&mb.mesh, f)).abs() < 1e-9);
+    }
+    assert_eq!(a.units, b.units);
+}
+
+#[test]
+fn analytic_surfaces_are_exact() {
+    let model = read_iges(&data("iges_analytic.igs")).unwrap();
+    assert_eq!(model.faces.len(), 5, "warnings: {:?}", model.warnings);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-3)).unwrap();
+    let rep = &r.report;
+    assert!(rep.max_deviation <= rep.tolerance);
+    assert_eq!(rep.inverted_triangles, 0);
+    assert_eq!(rep.free_edges, 0);
+    let tol = rep.tolerance;
+    let mut seen = [false; 5];
+    for f in 0..model.faces.len() {
+        let vs = face_vertices(&r.mesh, f);
+        let c = vs.iter().fold(DVec3::ZERO, |a, &p| a + p) / vs.len() as f64;
+        // Which shape: by where it sits along x.
+        let k = ((c.x + 10.0) / 20.0).floor() as usize;
+        seen[k] = true;
+        for p in vs {
+            let err = match k {
+                // Cylinder r = 5 about z, 0 <= z <= 10.
+                0 => {
+                    assert!(p.z > -tol && p.z < 10.0 + tol);
+                    (p.x.hypot(p.y) - 5.0).abs()
+                }
+                // Cone frustum about x = 20: r = 2 + 2z/5, half a turn (y >= 0).
+                1 => {
+                    assert!(p.y > -tol);
+                    ((p.x - 20.0).hypot(p.y) - (2.0 + 0.4 * p.z)).abs()
+                }
+                2 => (p.distance(DVec3::new(40.0, 0.0, 0.0)) - 3.0).abs(),
+                3 => {
+                    let q = p - DVec3::new(60.0, 0.0, 0.0);
+                    ((q.x.hypot(q.y) - 4.0).hypot(q.z) - 1.0).abs()
+                }
+                _ => (p.distance(DVec3::new(80.0, 0.0, 0.0)) - 3.5).abs(),
+            };
+            assert!(err <= 1e-9, "face {f} (shape {k}): vertex {p} off the exact surface by {err}");
+        }
+    }
+    assert_eq!(seen, [true; 5]);
+}
+
+fn iges_error(name: &str) -> (String, usize, usize, String) {
+    match read_iges(&data(name)) {
+        Err(Error::Iges { section, line, entity, message }) => (section.to_string(), line, entity, message),
+        Err(other) => panic!("{name}: expected an IGES error, got {other}"),
+        Ok(m) => panic!("{name}: read {} faces, expected an error", m.faces.len()),
+    }
+}
+
+#[test]
+fn truncated_file_is_an_error_naming_the_entity() {
+    let (section, _, entity, message) = iges_error("iges_truncated.igs");
+    assert!(entity > 0, "{message}");
+    assert!(section == "Directory" || section == "Parameter", "{section}: {message}");
+    assert!(message.contains("truncated"), "{message}");
+}
+
+#[test]
+fn bad_parameter_pointer_is_an_error_naming_the_entity() {
+    let (section, _, entity, message) = iges_error("iges_bad_pointer.igs");
+    assert_eq!(section, "Directory");
+    assert!(entity % 2 == 1 && entity > 1, "entity {entity}");
+    assert!(message.contains("999"), "{message}");
+}
+
+#[test]
+fn shifted_columns_are_an_error_naming_the_line() {
+    let (_, line, _, message) = iges_error("iges_shifted.igs");
+    let text = String::from_utf8(data("iges_shifted.igs")).unwrap();
+    let shifted = text.lines().position(|l| l.len() > 80).unwrap() + 1;
+    assert_eq!(line, shifted, "{message}");
+    let shown = Error::Iges { section: "file", line, entity: 0, message: message.clone() }.to_string();
+    assert!(shown.contains(&format!("line {shifted}")), "{shown}");
+}
+
+#[test]
+fn huge_counts_and_reference_cycles_skip_the_face_with_a_reason() {
+    let m = read_iges(&data("iges_huge_count.igs")).unwrap();
+    assert_eq!(m.faces.len(), 1, "the other face still reads");
+    assert!(m.warnings.iter().any(|w| w.contains("skipped") && w.contains("999999999")), "{:?}", m.warnings);
+    let m = read_iges(&data("iges_cycle.igs")).unwrap();
+    assert_eq!(m.faces.len(), 1);
+    assert!(m.warnings.iter().any(|w| w.contains("skipped") && w.contains("cycle")), "{:?}", m.warnings);
+}
+
+/// An 80-column record: `data` in columns 1-72, the section letter, the sequence number.
+fn record(data: &str, letter: char, seq: usize) -> String {
+    format!("{data:<72}{letter}{seq:>7}\n")
+}
+
+#[test]
+fn a_file_without_faces_is_an_error() {
+    // Only the Global section and a point.
+    let text = [
+        record("", 'S', 1),
+        record("1H,,1H;,4Htest,4Htest,4Htest,4Htest,32,38,6,308,15,4Htest,1.0,2,2HMM,1,", 'G', 1),
+        record("0.1,15H20240101.000000,0.001,10.0,4Htest,4Htest,11,0;", 'G', 2),
+        record("     116       1       0       0       0       0       0       000000000", 'D', 1),
+        record("     116       0       0       1       0                               0", 'D', 2),
+        format!("{:<64}{:>8}P{:>7}\n", "116,1.0,2.0,3.0;", 1, 1),
+        record("S      1G      2D      2P      1", 'T', 1),
+    ]
+    .concat();
+    match read_iges(text.as_bytes()) {
+        Err(Error::Iges { message, .. }) => assert!(message.contains("no surfaces"), "{message}"),
+        other => panic!("expected an error, got {other:?}"),
+    }
+}
+
+#[test]
+fn mutated_files_never_panic() {
+    // Deterministic byte-level damage of a valid file: replaced, deleted and
+    // duplicated bytes, and truncation. Every outcome is Ok or Err.
+    let base = data("iges_plate.igs");
+    let alphabet = b",;0123456789H .DPE-\n";
+    let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut next = |n: usize| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state % n as u64) as usize
+    };
+    let mut outcomes = [0usize; 2];
+    for _ in 0..400 {
+        let mut b = base.clone();
+        for _ in 0..1 + next(4) {
+            let at = next(b.len());
+            match next(4) {
+                0 => b[at] = alphabet[next(alphabet.len())],
+                1 => {
+                    b.remove(at);
+                }
+                2 => {
+                    let c = b[at];
+                    b.insert(at, c);
+                }
+                _ => b.truncate(at),
+            }
+            if b.is_empty() {
+                break;
+            }
+        }
+        outcomes[usize::from(read_iges(&b).is_ok())] += 1;
+    }
+    assert_eq!(outcomes.iter().sum::<usize>(), 400);
+    assert!(outcomes[0] > 0 && outcomes[1] > 0, "some mutants read, some fail: {outcomes:?}");
+}
+
+#[test]
+fn format_from_extension_and_first_line() {
+    assert_eq!(Format::from_name("igs").unwrap(), Format::Iges);
+    assert_eq!(Format::from_name(".IGES").unwrap(), Format::Iges);
+    assert!(Format::from_name("stp2").is_err());
+    let bytes = data("iges_plate.igs");
+    assert_eq!(Format::detect(&bytes), Some(Format::Iges));
+    assert_eq!(Format::detect(&data("iges_plate_crlf.igs")), Some(Format::Iges));
+    assert_eq!(Format::detect(b"  {\"faces\": []}"), Some(Format::Json));
+    assert_eq!(Format::detect(b"hello"), None);
+    let m = read_model(&bytes, Format::Iges).unwrap();
+    assert_eq!(m.faces.len(), 2);
+}
+
+#[test]
+fn command_line_meshes_an_iges_file_by_its_extension() {
+    let out_dir = std::env::temp_dir().join(format!("surfmesh-iges-{}", std::process::id()));
+    std::fs::create_dir_all(&out_dir).unwrap();
+    let report = out_dir.join("report.json");
+    let input = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/iges_plate.igs");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_surfmesh"))
+        .arg("mesh")
+        .arg(&input)
+        .arg("--tol-rel")
+        .arg("1e-2")
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert!(json["triangles"].as_u64().unwrap() > 0);
+    assert_eq!(json["faces"].as_u64().unwrap(), 2);
+    let _ = std::fs::remove_dir_all(&out_dir);
+}
