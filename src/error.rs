@@ -56,6 +56,15 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// The STEP file (ISO 10303-21) is malformed.
+    Step {
+        /// Instance number `#id` concerned (0 when none).
+        id: u64,
+        /// 1-based line of the file (0 when the problem has no single line).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
     /// A limit guarding memory or time was hit.
     Limit(String),
     /// The caller's progress callback asked to stop.
@@ -80,6 +89,16 @@ impl fmt::Display for Error {
                 }
                 if *entity > 0 {
                     write!(f, ", entity DE {entity}")?;
+                }
+                write!(f, ": {message}")
+            }
+            Self::Step { id, line, message } => {
+                write!(f, "STEP")?;
+                if *line > 0 {
+                    write!(f, " line {line}")?;
+                }
+                if *id > 0 {
+                    write!(f, "{} #{id}", if *line > 0 { "," } else { "" })?;
                 }
                 write!(f, ": {message}")
             }

@@ -4,6 +4,7 @@ mod glb;
 mod iges;
 mod json;
 mod obj;
+mod step;
 mod stl;
 
 use alloc::format;
