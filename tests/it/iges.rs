@@ -252,3 +252,7 @@ fn command_line_meshes_an_iges_file_by_its_extension() {
     assert_eq!(json["faces"].as_u64().unwrap(), 2);
     let _ = std::fs::remove_dir_all(&out_dir);
 }
+
+/// The shared corpus, in a file of its own.
+#[path = "iges_corpus.rs"]
+mod corpus;

@@ -1,0 +1,144 @@
+//! IGES corpus: the IGES files of the shared corpus (`../shared/corpus`, see
+//! its SOURCES.md). Every one must read; the files in [`MESHED`] must also
+//! mesh at relative tolerances 1e-2 and 1e-3 with a measured deviation
+//! within the tolerance, no inverted triangle, no crack between faces, and
+//! (for [`CLOSED`] solids) no boundary edge at all. Files still missing from
+//! [`MESHED`] are named in the output. An unoptimized build (the plain
+//! `cargo test`) meshes only the files under [`DEBUG_MAX_BYTES`], to stay
+//! within CI's time; `cargo test --release` meshes them all.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use surfmesh::{mesh_model, read_iges, MeshOptions, Model};
+
+fn corpus_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("shared").join("corpus")
+}
+
+/// IGES files of the corpus, sorted by name.
+fn corpus_files() -> Option<Vec<PathBuf>> {
+    let entries = std::fs::read_dir(corpus_dir()).ok()?;
+    let mut files: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| e.eq_ignore_ascii_case("igs") || e.eq_ignore_ascii_case("iges"))
+        })
+        .collect();
+    files.sort();
+    Some(files)
+}
+
+/// Files that must meet the whole acceptance.
+const MESHED: [&str; 7] = [
+    "OCC26138_Torus.igs",
+    "OCC8842_cylinder_CATIA.igs",
+    "PRO20358-W10.igs",
+    "PRO20359-L1.igs",
+    "bug23171_tube_surf.igs",
+    "cube_10x10_inventor.igs",
+    "nozzleAndCavity.igs",
+];
+
+/// In a debug build, larger files are read but not meshed (meshing the
+/// 1.3 MB bearing unoptimized takes most of a minute).
+const DEBUG_MAX_BYTES: usize = 200_000;
+
+/// Files whose faces make closed solids: no boundary edge may remain.
+const CLOSED: [&str; 2] = ["cube_10x10_inventor.igs", "bug22869_Spring.igs"];
+
+fn skipped_faces(model: &Model) -> usize {
+    model.warnings.iter().filter(|w| w.contains(": skipped:")).count()
+}
+
+#[test]
+fn corpus_reads_and_meshes_within_tolerance_without_cracks() {
+    let Some(files) = corpus_files() else {
+        eprintln!("SKIPPED: no corpus at {} (the IGES corpus test needs ../shared/corpus)", corpus_dir().display());
+        return;
+    };
+    let names: Vec<String> = files.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    for m in MESHED {
+        assert!(names.iter().any(|n| n == m), "{m} is not in the corpus");
+    }
+    let mut failures = Vec::new();
+    println!(
+        "{:<28} {:>6} {:>5} {:>5} {:>8} {:>11} {:>11} {:>4} {:>5} {:>6} {:>7}",
+        "file", "rel", "faces", "skip", "tris", "max dev", "tolerance", "inv", "free", "bound", "ms"
+    );
+    for (path, name) in files.iter().zip(&names) {
+        let bytes = std::fs::read(path).unwrap();
+        let start = Instant::now();
+        let model = match read_iges(&bytes) {
+            Ok(m) => m,
+            Err(e) => {
+                failures.push(format!("{name}: read: {e}"));
+                continue;
+            }
+        };
+        let parse_ms = start.elapsed().as_secs_f64() * 1e3;
+        if !MESHED.contains(&name.as_str()) {
+            println!(
+                "{name:<28} read only: {} faces, {} skipped (not yet meshed here)",
+                model.faces.len(),
+                skipped_faces(&model)
+            );
+            continue;
+        }
+        if cfg!(debug_assertions) && bytes.len() > DEBUG_MAX_BYTES {
+            println!(
+                "{name:<28} read only in a debug build: {} faces (cargo test --release meshes it)",
+                model.faces.len()
+            );
+            continue;
+        }
+        for rel in [1e-2, 1e-3] {
+            let start = Instant::now();
+            let r = match mesh_model(&model, &MeshOptions::default().with_relative_tolerance(rel)) {
+                Ok(r) => r,
+                Err(e) => {
+                    failures.push(format!("{name} @ {rel}: mesh: {e}"));
+                    continue;
+                }
+            };
+            let ms = start.elapsed().as_secs_f64() * 1e3 + parse_ms;
+            let rep = &r.report;
+            println!(
+                "{:<28} {:>6} {:>5} {:>5} {:>8} {:>11.4e} {:>11.4e} {:>4} {:>5} {:>6} {:>7.0}",
+                name,
+                rel,
+                model.faces.len(),
+                skipped_faces(&model) + rep.faces_skipped,
+                rep.triangles,
+                rep.max_deviation,
+                rep.tolerance,
+                rep.inverted_triangles,
+                rep.free_edges,
+                rep.boundary_edges,
+                ms
+            );
+            let mut problems = Vec::new();
+            if rep.max_deviation.is_nan() || rep.max_deviation > rep.tolerance {
+                problems.push(format!("max deviation {} above tolerance {}", rep.max_deviation, rep.tolerance));
+            }
+            if rep.inverted_triangles != 0 {
+                problems.push(format!("{} inverted triangles", rep.inverted_triangles));
+            }
+            if rep.free_edges != 0 {
+                problems.push(format!("{} free edges (cracks)", rep.free_edges));
+            }
+            if CLOSED.contains(&name.as_str()) && rep.boundary_edges != 0 {
+                problems.push(format!("{} boundary edges on a closed solid", rep.boundary_edges));
+            }
+            if rep.triangles == 0 || rep.faces_skipped != 0 || skipped_faces(&model) != 0 {
+                problems.push(format!("{} triangles, faces skipped", rep.triangles));
+            }
+            if !problems.is_empty() {
+                failures.push(format!("{name} @ {rel}: {}", problems.join("; ")));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "IGES corpus failures:\n{}", failures.join("\n"));
+}
