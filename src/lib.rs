@@ -20,6 +20,7 @@ mod measure;
 mod mesh;
 mod model;
 mod nurbs;
+mod reparam;
 mod tessellate;
 #[cfg(all(target_arch = "wasm32", target_os = "unknown"))]
 mod wasm;
@@ -33,6 +34,7 @@ pub use nurbs::{
     project_to_surface, Aabb, BasisDers, CurveDerivs, KnotVector, NurbsCurve, NurbsError, NurbsSurface, Projection,
     ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
 };
+pub use reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
 pub use tessellate::{mesh_model, mesh_model_with_progress, MeshOptions, MeshResult, OptionsError, Tolerance};
 
 /// Reads `bytes` in `format` and meshes the model: the one call both doors use.

@@ -19,9 +19,9 @@ use crate::{read_model, Error, Format, MeshOptions, MeshResult};
 // `tests/wasm_node.rs` compiles this file into a crate where `crate::` is the
 // test itself, which does not import this name; take it from the library there.
 #[cfg(not(test))]
-use crate::mesh_model_with_progress;
+use crate::{mesh_model_with_progress, Reparam};
 #[cfg(test)]
-use surfmesh::mesh_model_with_progress;
+use surfmesh::{mesh_model_with_progress, Reparam};
 
 #[cfg_attr(not(test), wasm_bindgen(typescript_custom_section))]
 #[cfg_attr(test, allow(dead_code))]
@@ -40,6 +40,8 @@ export interface MeshOptions {
   minEdge?: number;
   /** Triangle budget; refinement stops with a warning past it. */
   maxTriangles?: number;
+  /** Rebuild poorly parameterized faces first: "off" (default), "auto" (flagged faces), "force". */
+  reparam?: "auto" | "off" | "force";
 }
 
 /** What `mesh` returns. */
@@ -76,7 +78,7 @@ export function meshWithProgress(
 "#;
 
 /// Option names `mesh` accepts, in the order they are read.
-const OPTION_NAMES: [&str; 6] = ["tolerance", "toleranceRel", "angle", "maxEdge", "minEdge", "maxTriangles"];
+const OPTION_NAMES: [&str; 7] = ["tolerance", "toleranceRel", "angle", "maxEdge", "minEdge", "maxTriangles", "reparam"];
 
 /// The crate version, so a page can show which mesher produced a mesh.
 #[cfg_attr(not(test), wasm_bindgen)]
@@ -161,8 +163,9 @@ fn run(
 /// `""` and `"auto"` detect the format from the bytes; anything else is a name.
 fn pick_format(bytes: &[u8], name: &str) -> Result<Format, Error> {
     if name.is_empty() || name.eq_ignore_ascii_case("auto") {
-        Format::detect(bytes)
-            .ok_or_else(|| Error::Format("cannot detect the input format from its first bytes (expected json or iges)".into()))
+        Format::detect(bytes).ok_or_else(|| {
+            Error::Format("cannot detect the input format from its first bytes (expected json or iges)".into())
+        })
     } else {
         Format::from_name(name)
     }
@@ -220,6 +223,16 @@ fn read_options(value: &JsValue) -> Result<MeshOptions, String> {
             return Err(format!("option maxTriangles: expected a whole number, found {n}"));
         }
         options = options.with_max_triangles(n as usize);
+    }
+    let reparam = Reflect::get(object, &JsValue::from_str("reparam")).map_err(|_| "option reparam: cannot be read")?;
+    if !(reparam.is_undefined() || reparam.is_null()) {
+        let mode = match reparam.as_string().as_deref() {
+            Some("auto") => Reparam::Auto,
+            Some("off") => Reparam::Off,
+            Some("force") => Reparam::Force,
+            _ => return Err("option reparam: expected \"auto\", \"off\" or \"force\"".into()),
+        };
+        options = options.with_reparam(mode);
     }
     Ok(options)
 }

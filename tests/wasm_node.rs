@@ -16,7 +16,7 @@ use surfmesh::{mesh_model, read_model, Error, Format, MeshOptions, MeshResult};
 #[path = "../src/wasm.rs"]
 mod binding;
 
-use js_sys::{Float32Array, Object, Reflect, Uint32Array};
+use js_sys::{Array, Float32Array, Object, Reflect, Uint32Array};
 use wasm_bindgen::{JsCast, JsValue};
 use wasm_bindgen_test::wasm_bindgen_test;
 
@@ -214,7 +214,7 @@ fn open_loop_is_named() {
 
 #[wasm_bindgen_test]
 fn bad_options_are_named() {
-    let cases: [(JsValue, &str); 8] = [
+    let cases: [(JsValue, &str); 9] = [
         (options(&[("tolerance", "fine".into())]), "option tolerance: expected a number, found string"),
         (options(&[("tol", num(0.1))]), "option tol: unknown option"),
         (options(&[("tolerance", num(0.1)), ("toleranceRel", num(0.01))]), "not both"),
@@ -223,6 +223,7 @@ fn bad_options_are_named() {
         (options(&[("maxEdge", num(-1.0))]), "option --max-edge"),
         (options(&[("toleranceRel", num(2.0))]), "option --tol-rel"),
         (num(5.0), "options: expected an object"),
+        (options(&[("reparam", "sometimes".into())]), "option reparam: expected \"auto\", \"off\" or \"force\""),
     ];
     for (opts, expected) in cases {
         let m = err(&dome(), opts);
@@ -320,6 +321,18 @@ fn smaller_angle_gives_more_triangles() {
     let narrow = ok(FREEFORM, options(&[("tolerance", num(1.0)), ("angle", num(0.1))]));
     assert_eq!(narrow.number("angle"), 0.1);
     assert!(narrow.triangles() > wide.triangles(), "{} vs {}", narrow.triangles(), wide.triangles());
+}
+
+#[wasm_bindgen_test]
+fn reparam_force_rebuilds_and_lists_the_face() {
+    let plain = ok(FREEFORM, options(&[("toleranceRel", num(1e-2))]));
+    let forced = ok(FREEFORM, options(&[("toleranceRel", num(1e-2)), ("reparam", "force".into())]));
+    let list = |o: &Output| Array::from(&Reflect::get(&o.report, &"reparameterized".into()).unwrap());
+    assert_eq!(list(&plain).length(), 0);
+    assert_eq!(list(&forced).length(), 1);
+    let face = list(&forced).get(0);
+    assert_eq!(Reflect::get(&face, &"face".into()).unwrap().as_f64(), Some(0.0));
+    assert!(forced.number("max_deviation") <= forced.number("tolerance"));
 }
 
 #[wasm_bindgen_test]

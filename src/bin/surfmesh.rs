@@ -101,9 +101,9 @@ fn mesh(m: &MeshArgs) -> Result<(), String> {
 /// Input format from the file's extension, else from its first bytes.
 fn input_format(path: &Path, bytes: &[u8]) -> Result<Format, String> {
     let by_name = path.extension().and_then(|e| e.to_str()).and_then(|e| Format::from_name(e).ok());
-    by_name
-        .or_else(|| Format::detect(bytes))
-        .ok_or_else(|| Error::Format("cannot tell the input format; give --format json or --format iges".into()).to_string())
+    by_name.or_else(|| Format::detect(bytes)).ok_or_else(|| {
+        Error::Format("cannot tell the input format; give --format json or --format iges".into()).to_string()
+    })
 }
 
 fn millis(start: Instant) -> f64 {

@@ -86,4 +86,6 @@ pub struct Report {
     pub parse_ms: f64,
     /// Skipped entities, repaired surfaces, incomplete refinement.
     pub warnings: Vec<String>,
+    /// Faces the parameterization test flagged (paper 001), rebuilt or not.
+    pub reparameterized: Vec<crate::reparam::ReparamFace>,
 }

@@ -47,6 +47,9 @@ pub struct TrimLoop {
 pub enum FaceSurface {
     /// A (rational) B-spline surface.
     Nurbs(NurbsSurface),
+    /// A bicubic B-spline rebuilt on even parameters (paper 001): C² across
+    /// its simple knots, so they do not bound the mesher's first intervals.
+    Rebuilt(NurbsSurface),
     /// The surface at signed `distance` along the unit normal of `base`
     /// (`S + d·N`, IGES 140), evaluated exactly (first derivatives by the Weingarten equations).
     Offset {
@@ -63,7 +66,7 @@ impl FaceSurface {
         let mut s = self;
         loop {
             match s {
-                Self::Nurbs(n) => return n,
+                Self::Nurbs(n) | Self::Rebuilt(n) => return n,
                 Self::Offset { base, .. } => s = base,
             }
         }
@@ -76,22 +79,32 @@ impl Surface for FaceSurface {
     }
     fn point(&self, uv: DVec2) -> DVec3 {
         match self {
-            Self::Nurbs(s) => s.point(uv),
+            Self::Nurbs(s) | Self::Rebuilt(s) => s.point(uv),
             Self::Offset { base, distance } => base.point(uv) + base.normal(uv) * *distance,
         }
     }
     fn derivs(&self, uv: DVec2) -> SurfaceDerivs {
         match self {
-            Self::Nurbs(s) => s.derivs(uv),
+            Self::Nurbs(s) | Self::Rebuilt(s) => s.derivs(uv),
             Self::Offset { base, distance } => offset_derivs(base, *distance, uv),
         }
     }
     fn breaks(&self, along_u: bool) -> Vec<f64> {
-        self.base_nurbs().breaks(along_u)
+        match self {
+            Self::Rebuilt(s) => {
+                let [lo, hi] = s.domain();
+                if along_u {
+                    alloc::vec![lo.x, hi.x]
+                } else {
+                    alloc::vec![lo.y, hi.y]
+                }
+            }
+            _ => self.base_nurbs().breaks(along_u),
+        }
     }
     fn bounding_box(&self) -> Aabb {
         match self {
-            Self::Nurbs(s) => s.bounding_box(),
+            Self::Nurbs(s) | Self::Rebuilt(s) => s.bounding_box(),
             Self::Offset { base, distance } => {
                 let mut b = base.bounding_box();
                 if !b.is_empty() {
@@ -105,7 +118,7 @@ impl Surface for FaceSurface {
     }
     fn normal(&self, uv: DVec2) -> DVec3 {
         match self {
-            Self::Nurbs(s) => s.normal(uv),
+            Self::Nurbs(s) | Self::Rebuilt(s) => s.normal(uv),
             // Parallel to the base's normal wherever the offset is regular.
             Self::Offset { base, .. } => base.normal(uv),
         }

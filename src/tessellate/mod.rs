@@ -17,6 +17,7 @@ use glam::DVec2;
 
 use crate::mesh::{angle_stats, edge_counts, FaceRange};
 use crate::nurbs::{Aabb, Surface};
+use crate::reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
 use crate::{Error, Mesh, Model, Report};
 
 pub use options::{MeshOptions, OptionsError, Tolerance};
@@ -74,11 +75,18 @@ pub fn mesh_model_with_progress(
     let crit = refine::Criteria { tol: aim, angle: options.angle, max_edge, min_edge, steps: options.measure_steps };
     let mut report = Report { tolerance: tol, angle: options.angle, faces: model.faces.len(), ..Report::default() };
     report.warnings.extend(model.warnings.iter().cloned());
+    // Paper 001: faces whose parameters crowd are rebuilt on even ones first.
+    let rebuilt = reparameterize(model, options.reparam, tol, &mut report);
     // Mesh every face on its own.
     let mut works: Vec<sew::FaceWork<'_>> = Vec::with_capacity(model.faces.len());
     let mut outcomes: Vec<refine::Outcome> = Vec::with_capacity(model.faces.len());
+    let mut fit_errors: Vec<f64> = Vec::with_capacity(model.faces.len());
     let mut used = 0usize;
-    for (index, f) in model.faces.iter().enumerate() {
+    for (index, original) in model.faces.iter().enumerate() {
+        let (mut f, mut fit_error) = match rebuilt.get(index) {
+            Some(Some(r)) => (&r.face, r.fit_error),
+            _ => (original, 0.0),
+        };
         let budget = options.max_triangles.saturating_sub(used);
         if budget < 2 {
             report.faces_skipped += 1;
@@ -92,7 +100,27 @@ pub fn mesh_model_with_progress(
             report.warnings.push(format!("face {index}: trimmed faces need the default `std` feature (CDT); skipped"));
             continue;
         }
-        let fr = face::mesh_face(index, f, &lim, &crit, budget)?;
+        // A rebuilt face is meshed within what its fit error leaves of the tolerance.
+        let share = if fit_error > 0.0 { ((tol - fit_error) / tol).clamp(0.5, 1.0) } else { 1.0 };
+        let face_lim = params::Limits { tol: lim.tol * share, ..lim };
+        let face_crit = refine::Criteria { tol: crit.tol * share, ..crit };
+        let mut fr = face::mesh_face(index, f, &face_lim, &face_crit, budget);
+        if fit_error > 0.0 && !matches!(&fr, Ok(r) if !r.mesh.tris.is_empty()) {
+            // The rebuilt face failed to mesh: the original face it is, with a warning.
+            report.warnings.push(format!("face {index}: the rebuilt face did not mesh; meshed the original"));
+            if let Some(r) = report.reparameterized.iter_mut().find(|r| r.face == index) {
+                r.rebuilt = false;
+            }
+            (f, fit_error) = (original, 0.0);
+            fr = face::mesh_face(index, f, &lim, &crit, budget);
+        }
+        let mut fr = fr?;
+        if fit_error > 0.0 {
+            // Reported against the original face: the mesh's distance to the new one plus the fit error.
+            for m in &mut fr.outcome.measures {
+                m.max += fit_error;
+            }
+        }
         used += fr.mesh.tris.len();
         if fr.mesh.tris.is_empty() {
             report.faces_skipped += 1;
@@ -106,6 +134,7 @@ pub fn mesh_model_with_progress(
             ));
         }
         works.push(sew::FaceWork { surface: &f.surface, curves: fr.curves, mesh: fr.mesh });
+        fit_errors.push(fit_error);
         outcomes.push(fr.outcome);
         if !progress(index + 1, model.faces.len()) {
             return Err(Error::Cancelled);
@@ -117,11 +146,12 @@ pub fn mesh_model_with_progress(
         model.tolerance.filter(|t| t.is_finite() && *t > 0.0).map_or(auto, |t| auto.max(t.min(0.5 * tol)))
     });
     let changed = sew::conform(&mut works, sew_tol, aim + sew_tol);
-    for ((w, out), ch) in works.iter().zip(outcomes.iter_mut()).zip(&changed) {
+    for (((w, out), ch), fit_error) in works.iter().zip(outcomes.iter_mut()).zip(&changed).zip(&fit_errors) {
         out.measures.resize(w.mesh.tris.len(), Default::default());
         out.turns.resize(w.mesh.tris.len(), 0.0);
         for &t in ch {
-            let (m, turn) = w.mesh.measure_one(w.surface, t as usize, &crit);
+            let (mut m, turn) = w.mesh.measure_one(w.surface, t as usize, &crit);
+            m.max += fit_error;
             out.measures[t as usize] = m;
             out.turns[t as usize] = turn;
         }
@@ -161,6 +191,54 @@ pub fn mesh_model_with_progress(
     report.min_angle_deg = angles.min_deg;
     report.p1_angle_deg = angles.p1_deg;
     Ok(MeshResult { mesh, report })
+}
+
+/// Runs paper 001's ratio test on every face (unless `mode` is off) and
+/// rebuilds those it flags (every face when forced); the report lists them.
+/// A rebuild that fails leaves the original face, with a warning.
+fn reparameterize(model: &Model, mode: Reparam, tol: f64, report: &mut Report) -> Vec<Option<Rebuilt>> {
+    if mode == Reparam::Off {
+        return Vec::new();
+    }
+    let mut out = Vec::with_capacity(model.faces.len());
+    for (index, f) in model.faces.iter().enumerate() {
+        let ratio = step_ratio(&f.surface);
+        if mode == Reparam::Auto && ratio <= RATIO_LIMIT {
+            out.push(None);
+            continue;
+        }
+        match rebuild_face(f, tol) {
+            Ok(r) => {
+                report.warnings.push(format!(
+                    "face {index}: poorly parameterized (step ratio {ratio:.1}), rebuilt from {} x {} points \
+                     within {:.2e} of the original",
+                    r.samples[0], r.samples[1], r.fit_error
+                ));
+                report.reparameterized.push(ReparamFace {
+                    face: index,
+                    ratio,
+                    rebuilt: true,
+                    samples: r.samples,
+                    fit_error: r.fit_error,
+                });
+                out.push(Some(r));
+            }
+            Err(why) => {
+                report.warnings.push(format!(
+                    "face {index}: poorly parameterized (step ratio {ratio:.1}), meshed as it is: {why}"
+                ));
+                report.reparameterized.push(ReparamFace {
+                    face: index,
+                    ratio,
+                    rebuilt: false,
+                    samples: [0, 0],
+                    fit_error: 0.0,
+                });
+                out.push(None);
+            }
+        }
+    }
+    out
 }
 
 fn face_is_supported(f: &crate::Face) -> bool {

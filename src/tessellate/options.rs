@@ -2,6 +2,8 @@
 
 use core::fmt;
 
+use crate::reparam::Reparam;
+
 /// How the chordal tolerance is given.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Tolerance {
@@ -39,6 +41,10 @@ pub struct MeshOptions {
     /// Fraction of the tolerance refinement aims at, so that what lies between
     /// verification samples stays within the tolerance too. Default 0.8.
     pub safety: f64,
+    /// Re-parameterization of poorly parameterized faces before meshing
+    /// (paper 001). Default [`Reparam::Off`]; [`Reparam::Auto`] rebuilds the
+    /// faces the ratio test flags.
+    pub reparam: Reparam,
 }
 
 impl Default for MeshOptions {
@@ -52,6 +58,7 @@ impl Default for MeshOptions {
             max_triangles: 4_000_000,
             measure_steps: 4,
             safety: 0.8,
+            reparam: Reparam::Off,
         }
     }
 }
@@ -113,6 +120,12 @@ impl MeshOptions {
     /// Sets the triangle budget.
     pub fn with_max_triangles(mut self, n: usize) -> Self {
         self.max_triangles = n;
+        self
+    }
+
+    /// Sets when poorly parameterized faces are rebuilt (paper 001).
+    pub fn with_reparam(mut self, mode: Reparam) -> Self {
+        self.reparam = mode;
         self
     }
 

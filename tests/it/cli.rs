@@ -503,7 +503,7 @@ fn cli_usage_errors_exit_2() {
         (vec!["mesh", p, "--angle", "7"], "--angle"),
         (vec!["mesh", p, "--mode", "quality"], "not available yet"),
         (vec!["mesh", p, "--mode", "slow"], "--mode"),
-        (vec!["mesh", p, "--reparam", "force"], "not available yet"),
+        (vec!["mesh", p, "--reparam", "sometimes"], "--reparam must be auto, off or force"),
         (vec!["mesh", p, "--format", "dxf"], "--format"),
         (vec!["mesh", p, "-o", "out.ply"], ".stl, .obj or .glb"),
         (vec!["mesh", p, p], "more than one input"),

@@ -4,4 +4,5 @@ mod cli;
 mod iges;
 mod mesh;
 mod nurbs;
+mod reparam;
 mod shapes;

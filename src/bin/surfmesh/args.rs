@@ -4,7 +4,7 @@
 use std::ffi::OsString;
 use std::path::PathBuf;
 
-use surfmesh::{Format, MeshOptions};
+use surfmesh::{Format, MeshOptions, Reparam};
 
 /// What the user asked for.
 pub enum Command {
@@ -57,7 +57,8 @@ Options of `mesh`:
   --min-edge L        edges this short are never split, model units
   --max-triangles N   triangle budget (default 4000000)
   --mode fast         meshing mode (`quality` is not available yet)
-  --reparam auto|off  re-parameterization of poor surfaces (`force` is not available yet)
+  --reparam MODE      rebuild poorly parameterized faces before meshing: off
+                      (default), auto (faces the step-ratio test flags), force
   --format json|iges  input format (default: from the extension, else from the content)
   -o, --output FILE   write the mesh; .stl, .obj or .glb picks the format
   --report FILE       write the JSON report (printed to stdout when neither
@@ -122,11 +123,15 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
                 Some("quality") => return Err("--mode quality is not available yet; use --mode fast".into()),
                 _ => return Err("--mode must be fast (quality is not available yet)".into()),
             },
-            "--reparam" => match value()?.to_str() {
-                Some("off" | "auto") => {}
-                Some("force") => return Err("--reparam force is not available yet; use auto or off".into()),
-                _ => return Err("--reparam must be auto, off or force".into()),
-            },
+            "--reparam" => {
+                let mode = match value()?.to_str() {
+                    Some("auto") => Reparam::Auto,
+                    Some("off") => Reparam::Off,
+                    Some("force") => Reparam::Force,
+                    _ => return Err("--reparam must be auto, off or force".into()),
+                };
+                options = options.with_reparam(mode);
+            }
             "--format" => {
                 let v = value()?;
                 format = Some(Format::from_name(&v.to_string_lossy()).map_err(|e| format!("--format: {e}"))?);

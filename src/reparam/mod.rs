@@ -1,0 +1,520 @@
+//! Poorly parameterized surfaces (paper 001): the step-length ratio test finds
+//! them, and they are rebuilt as bicubic surfaces whose parameters follow
+//! model-space distance, with their trim loops re-expressed on the new surface.
+//! The rebuilt face is checked against the original, so a mesh within
+//! `tolerance − fit error` of the new face is within tolerance of the original.
+
+mod interp;
+
+use alloc::format;
+use alloc::string::String;
+use alloc::vec;
+use alloc::vec::Vec;
+use glam::{DVec2, DVec3};
+use serde::Serialize;
+
+use crate::model::{Face, FaceSurface, TrimLoop};
+use crate::nurbs::{project_to_surface, NurbsCurve, ProjectionOptions, Surface};
+
+pub(crate) use interp::{chord_params, interpolate_curve, interpolate_surface};
+
+/// When faces are re-parameterized before meshing.
+///
+/// Off by default for now: rebuilt faces hold the tolerance against the
+/// original and get better-shaped triangles, but the mesher does not yet
+/// always turn the even parameters into fewer triangles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Reparam {
+    /// Faces the ratio test flags.
+    Auto,
+    /// Never (the default).
+    #[default]
+    Off,
+    /// Every face.
+    Force,
+}
+
+/// Paper 001's empirical limit `k`: a parameter step whose model-space length
+/// is more than `k` times, or less than `1/k` of, the iso-line's mean step is poor.
+pub const RATIO_LIMIT: f64 = 4.5;
+/// Equal parameter steps per tested iso-line (paper 001 step 1).
+const STEPS: usize = 50;
+/// Most samples per direction of a rebuilt surface.
+const MAX_SAMPLES: usize = 400;
+/// Most samples along one rebuilt trim curve.
+const MAX_CURVE_SAMPLES: usize = 6400;
+
+/// One face the ratio test flagged, for the report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReparamFace {
+    /// Face index in the model.
+    pub face: usize,
+    /// Worst step ratio found (`max(L/C, C/L)` over the tested iso-lines).
+    pub ratio: f64,
+    /// Whether the face was rebuilt (false: the rebuild failed and the
+    /// original was meshed; the reason is among the warnings).
+    pub rebuilt: bool,
+    /// Interpolated points of the rebuilt surface along u and v.
+    pub samples: [usize; 2],
+    /// Largest distance found between the rebuilt and the original face, model units.
+    pub fit_error: f64,
+}
+
+/// Worst step ratio over the iso-lines `v = v_min` and `u = u_min` (paper 001
+/// step 1) and, beyond the paper, the opposite and middle iso-lines, since one
+/// poor row can hide anywhere. Each line is cut into 50 equal parameter steps
+/// of model-space lengths `L_i`; with `C` their mean, the ratio is the
+/// largest `max(L_i / C, C / L_i)`. Lines of no length (poles) are left out.
+pub fn step_ratio(surface: &dyn Surface) -> f64 {
+    let [lo, hi] = surface.domain();
+    let mut lines: Vec<Vec<f64>> = Vec::with_capacity(6);
+    let mut longest = 0.0f64;
+    for along_u in [true, false] {
+        for f in [0.0, 0.5, 1.0] {
+            let mut prev: Option<DVec3> = None;
+            let mut steps = Vec::with_capacity(STEPS);
+            for k in 0..=STEPS {
+                let a = k as f64 / STEPS as f64;
+                let uv = if along_u {
+                    DVec2::new(lo.x + (hi.x - lo.x) * a, lo.y + (hi.y - lo.y) * f)
+                } else {
+                    DVec2::new(lo.x + (hi.x - lo.x) * f, lo.y + (hi.y - lo.y) * a)
+                };
+                let p = surface.point(uv);
+                if let Some(q) = prev {
+                    steps.push(p.distance(q));
+                }
+                prev = Some(p);
+            }
+            let total: f64 = steps.iter().sum();
+            if total.is_finite() {
+                longest = longest.max(total);
+                lines.push(steps);
+            }
+        }
+    }
+    let mut worst = 1.0f64;
+    for steps in &lines {
+        let total: f64 = steps.iter().sum();
+        if total <= 1e-9 * longest {
+            continue;
+        }
+        let c = total / STEPS as f64;
+        for &l in steps {
+            let r = if l > 0.0 { (l / c).max(c / l) } else { 1e9 };
+            worst = worst.max(r.min(1e9));
+        }
+    }
+    worst
+}
+
+/// A face rebuilt on an evenly parameterized surface.
+#[derive(Debug, Clone)]
+pub struct Rebuilt {
+    /// The new face: a bicubic B-spline surface on `[0,1]²` and its loops.
+    pub face: Face,
+    /// Largest distance found between the new and the original face.
+    pub fit_error: f64,
+    /// Interpolated points along u and v.
+    pub samples: [usize; 2],
+}
+
+/// Piecewise-linear monotone map between the original parameters of the
+/// grid nodes and the new ones (`s_i ↔ u_i`), both ascending.
+struct Map1 {
+    old: Vec<f64>,
+    new: Vec<f64>,
+}
+
+impl Map1 {
+    fn lerp(from: &[f64], to: &[f64], x: f64) -> f64 {
+        let n = from.len();
+        if n == 0 {
+            return x;
+        }
+        if x <= from[0] {
+            return to[0];
+        }
+        if x >= from[n - 1] {
+            return to[n - 1];
+        }
+        let i = from.partition_point(|&f| f <= x).clamp(1, n - 1);
+        let (a, b) = (from[i - 1], from[i]);
+        let w = if b > a { (x - a) / (b - a) } else { 0.0 };
+        to[i - 1] + (to[i] - to[i - 1]) * w
+    }
+    fn to_new(&self, x: f64) -> f64 {
+        Self::lerp(&self.old, &self.new, x)
+    }
+    fn to_old(&self, x: f64) -> f64 {
+        Self::lerp(&self.new, &self.old, x)
+    }
+}
+
+/// Samples along u (`along_u`) or v: paper 001 step 2's chord count
+/// `n = (b − a)·sqrt(sup‖S''‖ / 8ε)` taken in the arc-length parameter the
+/// samples are spaced in (so `b − a` is the iso-line's length and `‖S''‖` its
+/// curvature), averaged over five iso-lines; `(control points − degree)·3`
+/// for a B-spline of degree ≤ 2 in that direction.
+fn sample_count(surface: &FaceSurface, along_u: bool, eps: f64) -> usize {
+    if let FaceSurface::Nurbs(n) = surface {
+        let (deg, count) = if along_u { (n.degree()[0], n.counts()[0]) } else { (n.degree()[1], n.counts()[1]) };
+        if deg <= 2 {
+            return ((count - deg) * 3).clamp(3, MAX_SAMPLES);
+        }
+    }
+    let [lo, hi] = surface.domain();
+    let (mut sum, mut used) = (0.0, 0usize);
+    for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
+        let mut length = 0.0;
+        let mut kappa = 0.0f64;
+        let mut prev: Option<DVec3> = None;
+        for k in 0..=100 {
+            let a = k as f64 / 100.0;
+            let uv = if along_u {
+                DVec2::new(lo.x + (hi.x - lo.x) * a, lo.y + (hi.y - lo.y) * f)
+            } else {
+                DVec2::new(lo.x + (hi.x - lo.x) * f, lo.y + (hi.y - lo.y) * a)
+            };
+            let d = surface.derivs(uv);
+            let (d1, d2) = if along_u { (d.su, d.suu) } else { (d.sv, d.svv) };
+            let speed = d1.length();
+            if speed > 1e-12 {
+                let k = d1.cross(d2).length() / (speed * speed * speed);
+                if k.is_finite() {
+                    kappa = kappa.max(k);
+                }
+            }
+            if let Some(q) = prev {
+                length += d.point.distance(q);
+            }
+            prev = Some(d.point);
+        }
+        if length > 0.0 && length.is_finite() {
+            sum += length * (kappa / (8.0 * eps)).sqrt();
+            used += 1;
+        }
+    }
+    let n = if used > 0 { sum / used as f64 } else { 3.0 };
+    if !n.is_finite() {
+        return MAX_SAMPLES;
+    }
+    (libm::ceil(n) as usize).clamp(3, MAX_SAMPLES)
+}
+
+/// `n + 1` parameters along u (or v) spaced as evenly as possible in model
+/// space (paper 001 step 3): the normalized arc length of five iso-lines,
+/// averaged, inverted at `i / n`.
+fn even_params(surface: &FaceSurface, along_u: bool, n: usize) -> Vec<f64> {
+    let [lo, hi] = surface.domain();
+    let (a0, a1) = if along_u { (lo.x, hi.x) } else { (lo.y, hi.y) };
+    let dense = (16 * n).max(400);
+    let xs: Vec<f64> = (0..=dense).map(|k| a0 + (a1 - a0) * k as f64 / dense as f64).collect();
+    let mut avg = vec![0.0; dense + 1];
+    let mut used = 0usize;
+    for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
+        let pts: Vec<DVec3> = xs
+            .iter()
+            .map(|&x| {
+                surface.point(if along_u {
+                    DVec2::new(x, lo.y + (hi.y - lo.y) * f)
+                } else {
+                    DVec2::new(lo.x + (hi.x - lo.x) * f, x)
+                })
+            })
+            .collect();
+        let lengths: Vec<f64> = pts.windows(2).map(|w| w[0].distance(w[1])).collect();
+        let total: f64 = lengths.iter().sum();
+        if !(total > 0.0 && total.is_finite()) {
+            continue;
+        }
+        for (a, t) in avg.iter_mut().zip(chord_params(&lengths)) {
+            *a += t;
+        }
+        used += 1;
+    }
+    if used == 0 {
+        return (0..=n).map(|i| a0 + (a1 - a0) * i as f64 / n as f64).collect();
+    }
+    for a in &mut avg {
+        *a /= used as f64;
+    }
+    let mut out: Vec<f64> = (0..=n).map(|i| Map1::lerp(&avg, &xs, i as f64 / n as f64)).collect();
+    out[0] = a0;
+    out[n] = a1;
+    // Strictly increasing even where the surface has no length.
+    let min_gap = (a1 - a0) * 1e-9;
+    for i in 1..=n {
+        if out[i] <= out[i - 1] + min_gap {
+            out[i] = out[i - 1] + min_gap;
+        }
+    }
+    if out[n] > a1 {
+        // Squeezed by the nudges: fall back to equal steps.
+        return (0..=n).map(|i| a0 + (a1 - a0) * i as f64 / n as f64).collect();
+    }
+    out
+}
+
+/// The rebuilt surface with its parameter maps and the largest distance
+/// found from it to the original, split by direction (`[along u, along v]`).
+struct Fit {
+    surface: crate::nurbs::NurbsSurface,
+    map_u: Map1,
+    map_v: Map1,
+    errors: [f64; 2],
+}
+
+/// Samples, interpolates (paper 001 steps 3–4) and checks one rebuild at
+/// `n × m` intervals: the new surface at mid-points of grid edges and cells
+/// is projected onto the original from the mapped parameters.
+fn fit_once(surface: &FaceSurface, n: usize, m: usize) -> Result<Fit, String> {
+    let us = even_params(surface, true, n);
+    let vs = even_params(surface, false, m);
+    let grid: Vec<Vec<DVec3>> =
+        us.iter().map(|&u| vs.iter().map(|&v| surface.point(DVec2::new(u, v))).collect()).collect();
+    let cols: Vec<Vec<DVec3>> = (0..vs.len()).map(|j| grid.iter().map(|r| r[j]).collect()).collect();
+    let s = interp::averaged_params(cols.iter().map(Vec::as_slice), us.len());
+    let t = interp::averaged_params(grid.iter().map(Vec::as_slice), vs.len());
+    let new = interpolate_surface(&grid, &s, &t).map_err(|e| format!("{e}"))?;
+    let map_u = Map1 { old: us, new: s };
+    let map_v = Map1 { old: vs, new: t };
+    let opts = ProjectionOptions { max_iterations: 12, ..ProjectionOptions::default() };
+    let mut errors = [0.0f64; 2];
+    let mut centre = 0.0f64;
+    let err_at = |st: DVec2| -> f64 {
+        let p = new.point(st);
+        let hint = DVec2::new(map_u.to_old(st.x), map_v.to_old(st.y));
+        project_to_surface(surface, p, Some(hint), &opts).distance
+    };
+    for i in 0..map_u.new.len() {
+        for j in 0..map_v.new.len() {
+            let (si, tj) = (map_u.new[i], map_v.new[j]);
+            let s_mid = map_u.new.get(i + 1).map(|&b| 0.5 * (si + b));
+            let t_mid = map_v.new.get(j + 1).map(|&b| 0.5 * (tj + b));
+            if let Some(sm) = s_mid {
+                errors[0] = errors[0].max(err_at(DVec2::new(sm, tj)));
+            }
+            if let Some(tm) = t_mid {
+                errors[1] = errors[1].max(err_at(DVec2::new(si, tm)));
+            }
+            if let (Some(sm), Some(tm)) = (s_mid, t_mid) {
+                centre = centre.max(err_at(DVec2::new(sm, tm)));
+            }
+        }
+    }
+    // A cell centre off the original is charged to the direction whose edges are worse.
+    if errors[0] >= errors[1] {
+        errors[0] = errors[0].max(centre);
+    } else {
+        errors[1] = errors[1].max(centre);
+    }
+    if !(errors[0].is_finite() && errors[1].is_finite()) {
+        return Err("the rebuilt surface is not finite".into());
+    }
+    Ok(Fit { surface: new, map_u, map_v, errors })
+}
+
+/// Rebuilds `face` (paper 001 steps 2–5) so that the new face lies within
+/// `tol / 4` of the original: sample counts from the chord bound, grown by
+/// 1.7× in the direction whose check fails, up to 400 per direction.
+///
+/// # Errors
+/// A reason (for the report's warning) when the interpolation is singular,
+/// the check cannot be met within the sample limits, or a trim curve cannot be
+/// re-expressed; the caller then meshes the original face.
+pub fn rebuild_face(face: &Face, tol: f64) -> Result<Rebuilt, String> {
+    let goal = 0.25 * tol;
+    let mut n = sample_count(&face.surface, true, tol);
+    let mut m = sample_count(&face.surface, false, tol);
+    let fit = loop {
+        let fit = fit_once(&face.surface, n, m)?;
+        let [eu, ev] = fit.errors;
+        if eu <= goal && ev <= goal {
+            break fit;
+        }
+        if (eu > goal && n >= MAX_SAMPLES) || (ev > goal && m >= MAX_SAMPLES) {
+            return Err(format!(
+                "the rebuilt surface stays {:.3e} from the original at {n} × {m} samples (goal {goal:.3e})",
+                eu.max(ev)
+            ));
+        }
+        // Interpolation error falls as h⁴: grow by the fourth root of the excess, at least 1.25×.
+        let grow = |k: usize, e: f64| {
+            let f = libm::pow(e / goal, 0.25).clamp(1.25, 4.0);
+            (libm::ceil(k as f64 * f) as usize).min(MAX_SAMPLES)
+        };
+        if eu > goal {
+            n = grow(n, eu);
+        }
+        if ev > goal {
+            m = grow(m, ev);
+        }
+    };
+    let mut fit_error = fit.errors[0].max(fit.errors[1]);
+    let new_surface = FaceSurface::Rebuilt(fit.surface.clone());
+    let mut loops = Vec::with_capacity(face.loops.len());
+    for (li, lp) in face.loops.iter().enumerate() {
+        let (curves, err) =
+            rebuild_loop(&face.surface, &new_surface, &fit, lp, goal).map_err(|e| format!("loop {li}: {e}"))?;
+        fit_error = fit_error.max(err);
+        loops.push(TrimLoop { curves });
+    }
+    Ok(Rebuilt {
+        face: Face { name: face.name.clone(), surface: new_surface, loops },
+        fit_error,
+        samples: [n + 1, m + 1],
+    })
+}
+
+/// Paper 001 step 5 for one loop: each model-space trim curve sampled evenly
+/// by arc length (51 points at least, doubled until within `goal`), each point
+/// projected onto the new surface from its mapped parameters, a cubic (u,v)
+/// curve interpolated. Curves of no model-space length (along a pole) map
+/// their parameters directly. Consecutive curves share their end points exactly.
+fn rebuild_loop(
+    old: &FaceSurface,
+    new: &FaceSurface,
+    fit: &Fit,
+    lp: &TrimLoop,
+    goal: f64,
+) -> Result<(Vec<NurbsCurve>, f64), String> {
+    let map = |uv: DVec2| DVec2::new(fit.map_u.to_new(uv.x), fit.map_v.to_new(uv.y));
+    let opts = ProjectionOptions { max_iterations: 12, ..ProjectionOptions::default() };
+    let cell = DVec2::new(1.0 / (fit.map_u.new.len().max(2) - 1) as f64, 1.0 / (fit.map_v.new.len().max(2) - 1) as f64);
+    // Where an old (u,v) lands on the new surface.
+    let land = |uv: DVec2| -> DVec2 {
+        let hint = map(uv);
+        let p = old.point(uv);
+        let pr = project_to_surface(new, p, Some(hint), &opts);
+        let off = (pr.uv - hint).abs();
+        if off.x <= 2.0 * cell.x && off.y <= 2.0 * cell.y && pr.distance.is_finite() {
+            pr.uv
+        } else {
+            hint
+        }
+    };
+    // Loop vertices landed once, so curves meet exactly.
+    let ends: Vec<DVec2> = lp.curves.iter().map(|c| land(c.point(c.domain().0).truncate())).collect();
+    let mut out = Vec::with_capacity(lp.curves.len());
+    let mut worst = 0.0f64;
+    for (ci, c) in lp.curves.iter().enumerate() {
+        let start = ends[ci];
+        let end = ends[(ci + 1) % ends.len()];
+        let (a, b) = c.domain();
+        let mut samples = STEPS;
+        loop {
+            // Dense model-space polyline of the old curve, 8 points per sample interval.
+            let dense = 8 * samples;
+            let ts: Vec<f64> = (0..=dense).map(|k| a + (b - a) * k as f64 / dense as f64).collect();
+            let pts: Vec<DVec3> = ts.iter().map(|&t| old.point(c.point(t).truncate())).collect();
+            let lengths: Vec<f64> = pts.windows(2).map(|w| w[0].distance(w[1])).collect();
+            let total: f64 = lengths.iter().sum();
+            let degenerate = !(total > 1e-3 * goal && total.is_finite());
+            let arc = chord_params(&lengths);
+            // Parameters of the old curve at equal arc length (equal parameter steps when degenerate).
+            let picks: Vec<f64> = (0..=samples)
+                .map(|i| {
+                    let x = i as f64 / samples as f64;
+                    if degenerate {
+                        a + (b - a) * x
+                    } else {
+                        Map1::lerp(&arc, &ts, x)
+                    }
+                })
+                .collect();
+            let mut st: Vec<DVec2> = picks
+                .iter()
+                .map(|&t| {
+                    let uv = c.point(t).truncate();
+                    if degenerate {
+                        map(uv)
+                    } else {
+                        land(uv)
+                    }
+                })
+                .collect();
+            st[0] = start;
+            st[samples] = end;
+            // The samples are equally spaced in model space: equal parameter steps keep the
+            // curve from curling where (u,v) speed varies along it.
+            let params: Vec<f64> = (0..=samples).map(|i| i as f64 / samples as f64).collect();
+            let curve = interpolate_curve(&st, &params).map_err(|e| format!("curve {ci}: {e}"))?;
+            // Check: mid-points of the new curve against the old polyline nearby.
+            let mut err = 0.0f64;
+            if !degenerate {
+                for i in 0..samples {
+                    let q = new.point(curve.point(0.5 * (params[i] + params[i + 1])).truncate());
+                    // The old polyline between the two samples' arc lengths, one segment either side.
+                    let (x0, x1) = (i as f64 / samples as f64, (i + 1) as f64 / samples as f64);
+                    let k0 = arc.partition_point(|&x| x < x0).saturating_sub(1);
+                    let k1 = (arc.partition_point(|&x| x <= x1) + 1).min(dense);
+                    let d = (k0..k1).map(|k| segment_distance(q, pts[k], pts[k + 1])).fold(f64::INFINITY, f64::min);
+                    err = err.max(d);
+                }
+            }
+            if err <= goal {
+                worst = worst.max(err);
+                out.push(curve);
+                break;
+            }
+            if samples * 2 > MAX_CURVE_SAMPLES {
+                return Err(format!("curve {ci}: stays {err:.3e} from the original trim curve (goal {goal:.3e})"));
+            }
+            samples *= 2;
+        }
+    }
+    Ok((out, worst))
+}
+
+/// Distance from `q` to the segment `a`–`b`.
+fn segment_distance(q: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let d = b - a;
+    let len2 = d.length_squared();
+    let w = if len2 > 0.0 { ((q - a).dot(d) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    q.distance(a + d * w)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nurbs::NurbsSurface;
+
+    /// A wavy sheet whose u parameter crowds: 90% of its range covers the first 5% of x.
+    fn crowded() -> NurbsSurface {
+        let xs = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 5.0, 10.0];
+        let pts: Vec<Vec<DVec3>> = xs
+            .iter()
+            .map(|&x| (0..5).map(|j| DVec3::new(x, j as f64, (x * 0.6).sin() + 0.2 * j as f64)).collect())
+            .collect();
+        let mut ku = vec![0.0; 4];
+        ku.extend((1..8).map(|k| k as f64 / 8.0));
+        ku.extend([1.0; 4]);
+        NurbsSurface::try_new([3, 3], ku, vec![0.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0], &pts, None).unwrap()
+    }
+
+    #[test]
+    fn ratio_test_flags_crowded_and_passes_even_parameters() {
+        let s = FaceSurface::Nurbs(crowded());
+        assert!(step_ratio(&s) > RATIO_LIMIT, "ratio {}", step_ratio(&s));
+        let pts: Vec<Vec<DVec3>> =
+            (0..4).map(|i| (0..4).map(|j| DVec3::new(i as f64, j as f64, ((i + j) % 2) as f64)).collect()).collect();
+        let k = vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        let even = NurbsSurface::try_new([3, 3], k.clone(), k, &pts, None).unwrap();
+        assert!(step_ratio(&even) < RATIO_LIMIT, "ratio {}", step_ratio(&even));
+    }
+
+    #[test]
+    fn rebuilt_surface_is_even_and_within_a_quarter_tolerance() {
+        let face = Face { name: None, surface: FaceSurface::Nurbs(crowded()), loops: Vec::new() };
+        let tol = 0.01;
+        let r = rebuild_face(&face, tol).unwrap();
+        assert!(r.fit_error <= tol / 4.0, "fit error {}", r.fit_error);
+        assert!(step_ratio(&r.face.surface) < RATIO_LIMIT, "still poor: {}", step_ratio(&r.face.surface));
+        // Corners are kept exactly (interpolated nodes).
+        let [lo, hi] = face.surface.domain();
+        for (a, b) in [(lo, DVec2::ZERO), (hi, DVec2::ONE)] {
+            assert!(face.surface.point(a).distance(r.face.surface.point(b)) < 1e-9);
+        }
+    }
+}
