@@ -53,18 +53,28 @@ pub(crate) fn measure_triangle(
 }
 
 /// Distance from `q` to the surface, starting at `hint` (the triangle's own
-/// interpolated (u,v), so already close): Newton steps, each costing one
-/// evaluation with derivatives, accepted only while they bring a surface point
-/// closer. The result is always the distance to an actual surface point, so it
-/// can only over-state the deviation, never hide it; iterations stop once a
-/// step gains less than 1e-4 of the distance. Falls back to the general
-/// projection if the steps cannot start.
+/// interpolated (u,v), so already close): Newton steps, accepted only while
+/// they bring a surface point closer. The result is always the distance to an
+/// actual surface point, so it can only over-state the deviation, never hide
+/// it; iterations stop once a step gains less than 1e-4 of the distance. Falls
+/// back to the general projection if the steps cannot start.
+///
+/// Derivatives cost about three point evaluations and are needed only where
+/// another step starts. The first step from the hint nearly always gains
+/// enough to go on, so its end point is evaluated with derivatives at once;
+/// later steps usually end the search, so their end points are evaluated
+/// first as points and with derivatives only if the search goes on. A typical
+/// sample costs two evaluations with derivatives and one point instead of
+/// three with derivatives (the steps taken, and so the distance, are the same).
 pub(crate) fn distance_from_hint(surface: &dyn Surface, q: DVec3, hint: DVec2, opts: &ProjectionOptions) -> f64 {
     let [lo, hi] = surface.domain();
     let mut uv = hint.clamp(lo, hi);
-    let mut d = surface.derivs(uv);
-    let mut best = d.point.distance(q);
-    for _ in 0..opts.max_iterations {
+    let first = surface.derivs(uv);
+    let mut best = first.point.distance(q);
+    // Derivatives at `uv` when already evaluated.
+    let mut ready = Some(first);
+    for iteration in 0..opts.max_iterations {
+        let d = ready.take().unwrap_or_else(|| surface.derivs(uv));
         let r = d.point - q;
         let g = DVec2::new(d.su.dot(r), d.sv.dot(r));
         let a = d.su.length_squared();
@@ -86,18 +96,107 @@ pub(crate) fn distance_from_hint(surface: &dyn Surface, q: DVec3, hint: DVec2, o
             break;
         }
         let next = (uv + step).clamp(lo, hi);
-        let dn = surface.derivs(next);
-        let dist = dn.point.distance(q);
+        ready = (iteration == 0).then(|| surface.derivs(next));
+        let dist = ready.map_or_else(|| surface.point(next), |dn| dn.point).distance(q);
         if dist >= best {
             break;
         }
         let gain = best - dist;
         uv = next;
-        d = dn;
         best = dist;
         if gain <= 1e-4 * best {
             break;
         }
     }
     best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nurbs::{Aabb, SurfaceDerivs};
+    use alloc::vec::Vec;
+    use core::cell::Cell;
+    use libm::{cos, sin};
+
+    /// The sphere of radius `r` about the origin away from its poles (u:
+    /// longitude, v: polar angle), exact, counting its evaluations.
+    struct Sphere {
+        r: f64,
+        points: Cell<usize>,
+        derivs: Cell<usize>,
+    }
+
+    impl Sphere {
+        fn new(r: f64) -> Self {
+            Self { r, points: Cell::new(0), derivs: Cell::new(0) }
+        }
+        fn at(&self, uv: DVec2) -> DVec3 {
+            self.r * DVec3::new(sin(uv.y) * cos(uv.x), sin(uv.y) * sin(uv.x), cos(uv.y))
+        }
+    }
+
+    impl Surface for Sphere {
+        fn domain(&self) -> [DVec2; 2] {
+            [DVec2::new(0.0, 0.3), DVec2::new(6.0, 2.8)]
+        }
+        fn point(&self, uv: DVec2) -> DVec3 {
+            self.points.set(self.points.get() + 1);
+            self.at(uv)
+        }
+        fn derivs(&self, uv: DVec2) -> SurfaceDerivs {
+            self.derivs.set(self.derivs.get() + 1);
+            let (su, cu, sv, cv) = (sin(uv.x), cos(uv.x), sin(uv.y), cos(uv.y));
+            let r = self.r;
+            SurfaceDerivs {
+                point: self.at(uv),
+                su: r * DVec3::new(-sv * su, sv * cu, 0.0),
+                sv: r * DVec3::new(cv * cu, cv * su, -sv),
+                suu: r * DVec3::new(-sv * cu, -sv * su, 0.0),
+                suv: r * DVec3::new(-cv * su, cv * cu, 0.0),
+                svv: r * DVec3::new(-sv * cu, -sv * su, -cv),
+            }
+        }
+        fn breaks(&self, _along_u: bool) -> Vec<f64> {
+            Vec::new()
+        }
+        fn bounding_box(&self) -> Aabb {
+            Aabb::from_points([DVec3::splat(-self.r), DVec3::splat(self.r)])
+        }
+    }
+
+    /// Points off the sphere along its normal are found at their exact
+    /// distance from a hint some way off their foot point, and the search
+    /// evaluates derivatives only at the hint, at the first step's end (taken
+    /// eagerly) and where a later step starts: with `k` later steps tried
+    /// (each one point evaluation), at most `k + 1` times, never the `k + 2`
+    /// that evaluating every step's end with derivatives costs.
+    #[test]
+    fn distance_from_hint_is_exact_and_spares_derivatives() {
+        let s = Sphere::new(10.0);
+        let opts = measure_projection();
+        let (mut samples, mut derivs, mut points) = (0usize, 0usize, 0usize);
+        for i in 0..12 {
+            for j in 0..8 {
+                let foot = DVec2::new(0.4 + 0.45 * i as f64, 0.5 + 0.28 * j as f64);
+                for (k, off) in [-0.3, 0.02, 0.25].into_iter().enumerate() {
+                    let q = s.at(foot) * (1.0 + off / s.r);
+                    let hint = foot + DVec2::new(0.01, -0.008) * (k as f64 + 1.0);
+                    s.points.set(0);
+                    s.derivs.set(0);
+                    let got = distance_from_hint(&s, q, hint, &opts);
+                    let want = libm::fabs(off);
+                    assert!(got >= want - 1e-12 && got - want <= 1e-9 * s.r, "{foot} {off}: {got} vs {want}");
+                    let (d, p) = (s.derivs.get(), s.points.get());
+                    assert!(d <= (p + 1).max(2), "{foot} {off}: {d} with derivatives, {p} points");
+                    (samples, derivs, points) = (samples + 1, derivs + d, points + p);
+                }
+            }
+        }
+        // These hints take a few steps: most samples try a second step, none gets by without derivatives twice.
+        assert!(
+            points > samples && derivs >= 2 * samples,
+            "{samples} samples: {derivs} with derivatives, {points} points"
+        );
+    }
 }
