@@ -35,6 +35,10 @@ pub use nurbs::{
     ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
 };
 pub use reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
+/// The mesher's stages one at a time, for the criterion benches; not a stable API.
+#[cfg(feature = "std")]
+#[doc(hidden)]
+pub use tessellate::stages;
 pub use tessellate::{mesh_model, mesh_model_with_progress, MeshOptions, MeshResult, OptionsError, Tolerance};
 
 /// Reads `bytes` in `format` and meshes the model: the one call both doors use.

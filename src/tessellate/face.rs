@@ -22,7 +22,7 @@ pub(crate) struct FaceResult<'a> {
 /// Grid parameters in both directions over `[lo, hi]`, sharing the tolerance
 /// between the two directions: half each, then the whole remainder to one
 /// direction when the other turned out (nearly) straight, as on a cylinder.
-fn grid(surface: &dyn Surface, lo: DVec2, hi: DVec2, lim: &Limits) -> (Vec<f64>, Vec<f64>) {
+pub(super) fn grid(surface: &dyn Surface, lo: DVec2, hi: DVec2, lim: &Limits) -> (Vec<f64>, Vec<f64>) {
     let half = Limits { tol: lim.tol * 0.5, ..*lim };
     let (mut pu, mut su) = grid_params(surface, lo, hi, true, &half);
     let (mut pv, mut sv) = grid_params(surface, lo, hi, false, &half);
@@ -165,7 +165,7 @@ fn trimmed<'a>(
     Err(Error::Mesh { face: index, message: "trimmed faces need the `std` feature".into() })
 }
 
-fn check_grid(index: usize, pu: &[f64], pv: &[f64], budget: usize) -> Result<(), Error> {
+pub(super) fn check_grid(index: usize, pu: &[f64], pv: &[f64], budget: usize) -> Result<(), Error> {
     let cells = pu.len().saturating_sub(1).saturating_mul(pv.len().saturating_sub(1));
     if cells.saturating_mul(2) > budget {
         return Err(Error::Limit(format!(
@@ -200,7 +200,7 @@ fn weld_nodes(surface: &dyn Surface, nodes: &[DVec2], wm: &mut WorkMesh) -> (Vec
 
 /// Untrimmed surface: the grid's quads, each split along its shorter diagonal
 /// (in model space) into two counter-clockwise triangles.
-fn build_full_grid(surface: &dyn Surface, pu: &[f64], pv: &[f64], wm: &mut WorkMesh) {
+pub(super) fn build_full_grid(surface: &dyn Surface, pu: &[f64], pv: &[f64], wm: &mut WorkMesh) {
     let (nu, nv) = (pu.len(), pv.len());
     let nodes: Vec<DVec2> = (0..nu).flat_map(|i| pv.iter().map(move |&v| DVec2::new(pu[i], v))).collect();
     let (vid, mult) = weld_nodes(surface, &nodes, wm);
@@ -254,50 +254,78 @@ fn build_trimmed(
     pv: &[f64],
     wm: &mut WorkMesh,
 ) -> Result<(), Error> {
-    let lo = DVec2::new(pu[0], pv[0]);
-    let hi = DVec2::new(pu[pu.len() - 1], pv[pv.len() - 1]);
-    let scale = mean_scale(surface, lo, hi);
-    // Loop nodes first.
-    let mut nodes: Vec<DVec2> = Vec::new();
-    let mut constraints: Vec<[usize; 2]> = Vec::new();
-    let mut seg_info = Vec::new();
-    for poly in &loops.polys {
-        let base = nodes.len();
-        let n = poly.uv.len();
-        nodes.extend_from_slice(&poly.uv);
-        for i in 0..n {
-            let j = (i + 1) % n;
-            constraints.push([base + i, base + j]);
-            let (curve, ta, tb) = poly.seg[i];
-            seg_info.push((base + i, base + j, curve, ta, tb));
-        }
-    }
-    // Grid nodes inside the region and not too close to a loop segment.
-    let segs: Vec<(DVec2, DVec2)> = loops.segments().collect();
-    let near = near_loop_mask(&segs, pu, pv, scale);
-    let inside = loops.contains_grid(pu, pv);
-    for (i, &u) in pu.iter().enumerate() {
-        for (j, &v) in pv.iter().enumerate() {
-            let k = i * pv.len() + j;
-            if inside[k] && !near[k] {
-                nodes.push(DVec2::new(u, v));
+    let band = Band::new(surface, loops, pu, pv);
+    let tris = band.triangulate(index)?;
+    band.build(surface, &tris, wm);
+    Ok(())
+}
+
+#[cfg(feature = "std")]
+/// What the CDT of a trimmed face works on: loop nodes first (with their
+/// segments as constraints), then the grid nodes inside the region and not too
+/// close to a loop, and the scale of the plane the triangulation runs in.
+pub(super) struct Band {
+    pub nodes: Vec<DVec2>,
+    pub constraints: Vec<[usize; 2]>,
+    /// Per loop segment: its two nodes, its curve and the curve's parameters at them.
+    pub segs: Vec<(usize, usize, u32, f64, f64)>,
+    pub scale: DVec2,
+}
+
+#[cfg(feature = "std")]
+impl Band {
+    pub fn new(surface: &dyn Surface, loops: &super::trim::Loops<'_>, pu: &[f64], pv: &[f64]) -> Self {
+        let lo = DVec2::new(pu[0], pv[0]);
+        let hi = DVec2::new(pu[pu.len() - 1], pv[pv.len() - 1]);
+        let scale = mean_scale(surface, lo, hi);
+        let mut nodes: Vec<DVec2> = Vec::new();
+        let mut constraints: Vec<[usize; 2]> = Vec::new();
+        let mut segs = Vec::new();
+        for poly in &loops.polys {
+            let base = nodes.len();
+            let n = poly.uv.len();
+            nodes.extend_from_slice(&poly.uv);
+            for i in 0..n {
+                let j = (i + 1) % n;
+                constraints.push([base + i, base + j]);
+                let (curve, ta, tb) = poly.seg[i];
+                segs.push((base + i, base + j, curve, ta, tb));
             }
         }
+        let loop_segs: Vec<(DVec2, DVec2)> = loops.segments().collect();
+        let near = near_loop_mask(&loop_segs, pu, pv, scale);
+        let inside = loops.contains_grid(pu, pv);
+        for (i, &u) in pu.iter().enumerate() {
+            for (j, &v) in pv.iter().enumerate() {
+                let k = i * pv.len() + j;
+                if inside[k] && !near[k] {
+                    nodes.push(DVec2::new(u, v));
+                }
+            }
+        }
+        Self { nodes, constraints, segs, scale }
     }
-    let scaled: Vec<DVec2> = nodes.iter().map(|&q| q * scale).collect();
-    let tris = super::cdt::triangulate_region(index, &scaled, &constraints)?;
-    let mut vid = Vec::with_capacity(nodes.len());
-    for &q in &nodes {
-        vid.push(wm.add_vertex(surface.point(q), surface.normal(q)));
+
+    /// The kept triangles (indices into `nodes`), counter-clockwise.
+    pub fn triangulate(&self, index: usize) -> Result<Vec<[u32; 3]>, Error> {
+        let scaled: Vec<DVec2> = self.nodes.iter().map(|&q| q * self.scale).collect();
+        super::cdt::triangulate_region(index, &scaled, &self.constraints)
     }
-    for t in tris {
-        let uv = [nodes[t[0] as usize], nodes[t[1] as usize], nodes[t[2] as usize]];
-        wm.add_triangle([vid[t[0] as usize], vid[t[1] as usize], vid[t[2] as usize]], uv);
+
+    /// Puts the nodes on the surface and the triangles `tris` into `wm`, loop segments marked as trim edges.
+    pub fn build(&self, surface: &dyn Surface, tris: &[[u32; 3]], wm: &mut WorkMesh) {
+        let mut vid = Vec::with_capacity(self.nodes.len());
+        for &q in &self.nodes {
+            vid.push(wm.add_vertex(surface.point(q), surface.normal(q)));
+        }
+        for t in tris {
+            let uv = [self.nodes[t[0] as usize], self.nodes[t[1] as usize], self.nodes[t[2] as usize]];
+            wm.add_triangle([vid[t[0] as usize], vid[t[1] as usize], vid[t[2] as usize]], uv);
+        }
+        for &(a, b, curve, ta, tb) in &self.segs {
+            wm.mark_trim(vid[a], vid[b], curve, ta, tb);
+        }
     }
-    for (a, b, curve, ta, tb) in seg_info {
-        wm.mark_trim(vid[a], vid[b], curve, ta, tb);
-    }
-    Ok(())
 }
 
 #[cfg(feature = "std")]

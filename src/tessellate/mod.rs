@@ -9,6 +9,8 @@ mod params;
 mod refine;
 mod sew;
 #[cfg(feature = "std")]
+pub mod stages;
+#[cfg(feature = "std")]
 mod trim;
 
 use alloc::format;
@@ -56,23 +58,8 @@ pub fn mesh_model_with_progress(
     options: &MeshOptions,
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<MeshResult, Error> {
-    options.validate()?;
-    if model.faces.is_empty() {
-        return Err(Error::Model { location: "model".into(), message: "has no faces".into() });
-    }
-    let diag = trimmed_bbox(model).diagonal();
-    let tol = match options.tolerance {
-        Tolerance::Absolute(t) => t,
-        Tolerance::Relative(r) => r * diag,
-    };
-    if !(tol > 0.0 && tol.is_finite()) {
-        return Err(Error::Model { location: "model".into(), message: "has zero size; use an absolute --tol".into() });
-    }
-    let min_edge = options.min_edge.unwrap_or(tol * 1e-3);
-    let max_edge = options.max_edge.unwrap_or(f64::INFINITY);
-    let aim = tol * options.safety;
-    let lim = params::Limits { tol: aim, angle: options.angle, max_edge, min_edge };
-    let crit = refine::Criteria { tol: aim, angle: options.angle, max_edge, min_edge, steps: options.measure_steps };
+    let Setup { tol, diag, lim, crit } = setup(model, options)?;
+    let aim = crit.tol;
     let mut report = Report { tolerance: tol, angle: options.angle, faces: model.faces.len(), ..Report::default() };
     report.warnings.extend(model.warnings.iter().cloned());
     // Paper 001: faces whose parameters crowd are rebuilt on even ones first.
@@ -239,6 +226,40 @@ fn reparameterize(model: &Model, mode: Reparam, tol: f64, report: &mut Report) -
         }
     }
     out
+}
+
+/// What the options come to for one model.
+pub(crate) struct Setup {
+    /// Absolute chordal tolerance.
+    tol: f64,
+    /// Diagonal of the trimmed geometry's box.
+    diag: f64,
+    /// Limits of the grid and loop discretization (the tolerance times the safety factor).
+    lim: params::Limits,
+    /// Limits every triangle must meet after refinement.
+    crit: refine::Criteria,
+}
+
+/// Validates `options` and turns them into the limits for `model`.
+fn setup(model: &Model, options: &MeshOptions) -> Result<Setup, Error> {
+    options.validate()?;
+    if model.faces.is_empty() {
+        return Err(Error::Model { location: "model".into(), message: "has no faces".into() });
+    }
+    let diag = trimmed_bbox(model).diagonal();
+    let tol = match options.tolerance {
+        Tolerance::Absolute(t) => t,
+        Tolerance::Relative(r) => r * diag,
+    };
+    if !(tol > 0.0 && tol.is_finite()) {
+        return Err(Error::Model { location: "model".into(), message: "has zero size; use an absolute --tol".into() });
+    }
+    let min_edge = options.min_edge.unwrap_or(tol * 1e-3);
+    let max_edge = options.max_edge.unwrap_or(f64::INFINITY);
+    let aim = tol * options.safety;
+    let lim = params::Limits { tol: aim, angle: options.angle, max_edge, min_edge };
+    let crit = refine::Criteria { tol: aim, angle: options.angle, max_edge, min_edge, steps: options.measure_steps };
+    Ok(Setup { tol, diag, lim, crit })
 }
 
 fn face_is_supported(f: &crate::Face) -> bool {
