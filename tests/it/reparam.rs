@@ -2,9 +2,9 @@
 //! parameters and leaves good ones alone; rebuilt faces mesh with
 //! better-shaped triangles within tolerance of the *original* surface.
 
-use std::f64::consts::FRAC_1_SQRT_2;
-
 use glam::DVec3;
+
+use crate::shapes::{unit_circle, CIRCLE_KNOTS};
 use surfmesh::{
     measure_mesh, mesh_model, read_json, step_ratio, Face, FaceSurface, MeasureOptions, MeshOptions, MeshResult, Model,
     NurbsCurve, NurbsSurface, Reparam, TrimLoop, RATIO_LIMIT,
@@ -27,23 +27,11 @@ fn crowded_surface() -> NurbsSurface {
     NurbsSurface::try_new([3, 3], ku, kv, &pts, None).unwrap()
 }
 
-/// An exact ellipse in (u,v) (a rational quadratic circle, affinely scaled).
+/// An exact ellipse in (u,v): the rational unit circle, affinely scaled.
 fn ellipse(cu: f64, cv: f64, ru: f64, rv: f64) -> TrimLoop {
-    let unit = [
-        (1.0, 0.0),
-        (1.0, 1.0),
-        (0.0, 1.0),
-        (-1.0, 1.0),
-        (-1.0, 0.0),
-        (-1.0, -1.0),
-        (0.0, -1.0),
-        (1.0, -1.0),
-        (1.0, 0.0),
-    ];
-    let pts = unit.iter().map(|&(x, y)| DVec3::new(cu + ru * x, cv + rv * y, 0.0)).collect();
-    let w = (0..9).map(|i| if i % 2 == 0 { 1.0 } else { FRAC_1_SQRT_2 }).collect();
-    let knots = vec![0.0, 0.0, 0.0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1.0, 1.0, 1.0];
-    TrimLoop { curves: vec![NurbsCurve::try_new(2, knots, pts, Some(w)).unwrap()] }
+    let (unit, w) = unit_circle();
+    let pts = unit.iter().map(|p| DVec3::new(cu + ru * p.x, cv + rv * p.y, 0.0)).collect();
+    TrimLoop { curves: vec![NurbsCurve::try_new(2, CIRCLE_KNOTS.to_vec(), pts, Some(w)).unwrap()] }
 }
 
 fn model(loops: Vec<TrimLoop>) -> Model {

@@ -285,11 +285,11 @@ fn write_value(v: &Value, indent: usize, out: &mut String) {
 // ---------------------------------------------------------------------------
 
 /// Knots of the exact 9-point rational quadratic full circle.
-const CIRCLE_KNOTS: [f64; 12] = [0.0, 0.0, 0.0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1.0, 1.0, 1.0];
+pub const CIRCLE_KNOTS: [f64; 12] = [0.0, 0.0, 0.0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1.0, 1.0, 1.0];
 
 /// Control points and weights of the unit circle (counter-clockwise from (1,0)):
 /// the corners of the circumscribed square carry weight √2/2.
-fn unit_circle() -> (Vec<DVec2>, Vec<f64>) {
+pub fn unit_circle() -> (Vec<DVec2>, Vec<f64>) {
     let pts = [
         (1.0, 0.0),
         (1.0, 1.0),
