@@ -217,6 +217,24 @@ fn mutated_files_never_panic() {
     assert!(outcomes[0] > 0 && outcomes[1] > 0, "some mutants read, some fail: {outcomes:?}");
 }
 
+/// Found by fuzzing (a timeout): a mutated copy of the analytic file whose
+/// trim curve lies far off its sphere made every trim sample run a futile
+/// global projection; now the search is given up once it fails for a curve.
+/// The file still reads, and the face whose loop the damage tangled is a
+/// meshing error naming it.
+#[test]
+fn fuzz_timeout_off_surface_trim_curve_reads_and_fails_cleanly() {
+    let model = read_iges(&data("iges_fuzz_timeout_off_surface.igs")).unwrap();
+    assert_eq!(model.faces.len(), 5, "{:?}", model.warnings);
+    match mesh_model(&model, &MeshOptions::default().with_relative_tolerance(0.05)) {
+        Err(Error::Mesh { face, message }) => {
+            assert_eq!(face, 1);
+            assert!(message.contains("crosses itself"), "{message}");
+        }
+        other => panic!("expected a mesh error for face 1, got {:?}", other.map(|r| r.report.triangles)),
+    }
+}
+
 #[test]
 fn format_from_extension_and_first_line() {
     assert_eq!(Format::from_name("igs").unwrap(), Format::Iges);

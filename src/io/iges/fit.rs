@@ -27,6 +27,8 @@ pub(super) struct Track {
     pub model: bool,
     pub ts: Vec<f64>,
     pub qs: Vec<DVec2>,
+    /// Whether a sample far off the surface may still be retried by a global search.
+    retry: bool,
 }
 
 /// `q` moved by whole periods to lie nearest to `near`.
@@ -44,13 +46,13 @@ pub(super) fn unwrap_near(mut q: DVec2, near: DVec2, periods: [Option<f64>; 2]) 
 impl Track {
     /// Native coordinates at `t`, continuous with `near` (free coordinates
     /// taken from it, periods unwrapped towards it).
-    fn at(&self, def: &SurfDef, t: f64, near: Option<DVec2>, periods: [Option<f64>; 2]) -> DVec2 {
+    fn at(&mut self, def: &SurfDef, t: f64, near: Option<DVec2>, periods: [Option<f64>; 2]) -> DVec2 {
         let p = self.curve.point(t);
         if !self.model {
             let q = p.truncate();
             return near.map_or(q, |n| unwrap_near(q, n, periods));
         }
-        let nat = def.invert(p, near);
+        let nat = def.invert(p, near, &mut self.retry);
         let mut q = nat.q;
         if let Some(n) = near {
             for k in 0..2 {
@@ -80,13 +82,13 @@ impl Track {
             ts.sort_by(f64::total_cmp);
             ts.dedup_by(|x, y| (*x - *y).abs() <= 1e-12 * (b - a));
         }
-        let mut tr = Self { curve, model, ts, qs: Vec::new() };
+        let mut tr = Self { curve, model, ts, qs: Vec::new(), retry: true };
         // Coordinates free at a sample (on an axis, at a pole) follow the
         // next sample that has them: first a backward pass for free starts.
         let mut qs: Vec<DVec2> = Vec::with_capacity(tr.ts.len());
         let mut near = start;
-        for &t in &tr.ts {
-            let q = tr.at(def, t, near, periods);
+        for i in 0..tr.ts.len() {
+            let q = tr.at(def, tr.ts[i], near, periods);
             qs.push(q);
             near = Some(q);
         }

@@ -162,18 +162,26 @@ impl SurfDef {
     }
 
     /// Native coordinates of the surface point closest to `p` (`hint`: the
-    /// coordinates of a nearby point, to stay on the same branch).
-    pub fn invert(&self, p: DVec3, hint: Option<DVec2>) -> Native {
+    /// coordinates of a nearby point, to stay on the same branch). `retry`
+    /// allows a global search when Newton from the hint ends far off, and
+    /// is cleared when that search does not come close either: the curve
+    /// itself is off the surface, and every further sample would pay for a
+    /// futile search (a fuzzed file took seconds that way).
+    pub fn invert(&self, p: DVec3, hint: Option<DVec2>, retry: &mut bool) -> Native {
         match self {
             Self::Nurbs { surface, .. } => {
                 let opts = ProjectionOptions::default();
                 let mut pr = project_to_surface(surface, p, hint, &opts);
                 // Newton from a hint can stall (next to the domain's edge);
                 // a result far off the surface is retried by the global search.
-                if hint.is_some() && pr.distance > 1e-4 * surface.bbox().diagonal() {
+                let far = 1e-4 * surface.bbox().diagonal();
+                if *retry && hint.is_some() && pr.distance > far {
                     let g = project_to_surface(surface, p, None, &opts);
                     if g.distance < pr.distance {
                         pr = g;
+                    }
+                    if pr.distance > far {
+                        *retry = false;
                     }
                 }
                 let d = surface.derivs(pr.uv);
@@ -194,7 +202,7 @@ impl SurfDef {
                 Native { q, free: [false, false] }
             }
             Self::Revolution(r) => r.invert(p, hint),
-            Self::Offset { base, .. } => base.invert(p, hint),
+            Self::Offset { base, .. } => base.invert(p, hint, retry),
         }
     }
 
