@@ -65,6 +65,20 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A mesh file (STL, OBJ) is malformed.
+    MeshFile {
+        /// e.g. `ASCII STL line 12`, `binary STL triangle 7`, `OBJ line 3`.
+        location: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A mesh cannot be repaired as given; `location` names the triangle, edge or vertex.
+    Repair {
+        /// e.g. `edge between vertices 3 and 7` or `vertex 12`.
+        location: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A limit guarding memory or time was hit.
     Limit(String),
     /// The caller's progress callback asked to stop.
@@ -102,6 +116,8 @@ impl fmt::Display for Error {
                 }
                 write!(f, ": {message}")
             }
+            Self::MeshFile { location, message } => write!(f, "{location}: {message}"),
+            Self::Repair { location, message } => write!(f, "repair: {location}: {message}"),
             Self::Limit(m) => write!(f, "limit: {m}"),
             Self::Cancelled => write!(f, "cancelled"),
             Self::Internal(m) => write!(f, "internal error (a bug in surfmesh): {m}"),

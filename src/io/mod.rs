@@ -1,8 +1,9 @@
-//! Readers (bytes in, [`Model`] out) and mesh writers (bytes out).
+//! Readers (bytes in, [`Model`] or [`crate::Mesh`] out) and mesh writers (bytes out).
 
 mod glb;
 mod iges;
 mod json;
+mod meshfile;
 mod obj;
 mod step;
 mod stl;
@@ -12,6 +13,8 @@ use alloc::format;
 pub use glb::write_glb;
 pub use iges::read_iges;
 pub use json::read_json;
+pub(crate) use meshfile::MAX_COORDINATE;
+pub use meshfile::{read_mesh, MeshFormat};
 pub use obj::write_obj;
 pub use stl::write_stl;
 

@@ -1,12 +1,14 @@
-//! Wavefront OBJ writer.
+//! Wavefront OBJ: writer and reader.
 
+use alloc::format;
 use alloc::string::String;
 use alloc::vec::Vec;
 use core::fmt::Write;
 use core::ops::Range;
 
+use super::meshfile::check_point;
 use super::stl::f32s;
-use crate::Mesh;
+use crate::{Error, Mesh};
 
 /// Encodes the mesh as OBJ text: `v` lines (full `f64` precision), `vn` lines
 /// (when there is one normal per vertex), then one group `g face_N` per face range holding its
@@ -58,4 +60,59 @@ pub(super) fn face_ranges(mesh: &Mesh) -> Vec<Range<usize>> {
             first..first.saturating_add(r.count as usize).min(n)
         })
         .collect()
+}
+
+/// Reads the vertices (`v x y z`, extra values such as w or colour ignored)
+/// and faces (`f a b c ...`, forms `v`, `v/vt`, `v//vn`, `v/vt/vn`,
+/// negative indices counting back from the last vertex) of an OBJ file.
+/// Polygons become fans; other statements are ignored.
+///
+/// # Errors
+/// [`Error::MeshFile`] naming the line: a bad number, an index out of
+/// range, a face with fewer than three vertices.
+pub(super) fn read_obj(bytes: &[u8]) -> Result<Mesh, Error> {
+    let at = |line: usize, message: String| Error::MeshFile { location: format!("OBJ line {line}"), message };
+    let mut positions: Vec<glam::DVec3> = Vec::new();
+    let mut indices: Vec<u32> = Vec::new();
+    let mut corners: Vec<u32> = Vec::new();
+    for (n, raw) in bytes.split(|&c| c == b'\n').enumerate() {
+        let line = n + 1;
+        let text = core::str::from_utf8(raw).map_err(|_| at(line, "not UTF-8 text".into()))?;
+        let text = text.split('#').next().unwrap_or("");
+        let mut words = text.split_ascii_whitespace();
+        match words.next() {
+            Some("v") => {
+                let mut xyz = [0.0; 3];
+                for x in &mut xyz {
+                    let w = words.next().ok_or_else(|| at(line, "'v' needs three coordinates".into()))?;
+                    *x = w.parse::<f64>().map_err(|_| at(line, format!("'{w}' is not a number")))?;
+                }
+                positions.push(check_point(xyz).map_err(|m| at(line, m))?);
+                if positions.len() > u32::MAX as usize {
+                    return Err(at(line, "more than 2^32 vertices".into()));
+                }
+            }
+            Some("f") => {
+                corners.clear();
+                for w in words {
+                    let first = w.split('/').next().unwrap_or("");
+                    let i: i64 = first.parse().map_err(|_| at(line, format!("'{w}' is not a vertex index")))?;
+                    let count = positions.len() as i64;
+                    let index = if i > 0 { i - 1 } else { count + i };
+                    if i == 0 || index < 0 || index >= count {
+                        return Err(at(line, format!("vertex index {i} is out of range (1 to {count} so far)")));
+                    }
+                    corners.push(index as u32);
+                }
+                if corners.len() < 3 {
+                    return Err(at(line, format!("face has {} vertices, needs at least 3", corners.len())));
+                }
+                for k in 1..corners.len() - 1 {
+                    indices.extend_from_slice(&[corners[0], corners[k], corners[k + 1]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(Mesh { positions, normals: Vec::new(), indices, face_ranges: Vec::new() })
 }

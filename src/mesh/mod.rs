@@ -9,7 +9,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 pub use metrics::{angle_stats, edge_counts, AngleStats, EdgeCounts};
-pub use weld::weld_positions;
+pub use weld::{weld_mesh, weld_positions};
 
 /// An indexed triangle mesh. Every face owns its vertices (so normals can break
 /// at face borders); watertightness is judged after welding coincident vertices.

@@ -45,3 +45,20 @@ pub fn weld_positions(positions: &[DVec3], tol: f64) -> (Vec<u32>, usize) {
     }
     (map, reps.len())
 }
+
+/// A copy of `mesh` with vertices closer than `tol` merged (first one's
+/// position kept, unused ones dropped) and normals dropped; triangles keep
+/// their order, including any that welding collapsed (two equal indices).
+pub fn weld_mesh(mesh: &super::Mesh, tol: f64) -> super::Mesh {
+    let (map, count) = weld_positions(&mesh.positions, tol);
+    let mut positions = alloc::vec![DVec3::ZERO; count];
+    let mut seen = alloc::vec![false; count];
+    for (i, &m) in map.iter().enumerate() {
+        if !seen[m as usize] {
+            seen[m as usize] = true;
+            positions[m as usize] = mesh.positions[i];
+        }
+    }
+    let indices = mesh.indices.iter().map(|&i| map.get(i as usize).copied().unwrap_or(u32::MAX)).collect();
+    super::Mesh { positions, normals: Vec::new(), indices, face_ranges: mesh.face_ranges.clone() }
+}
