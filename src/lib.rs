@@ -20,19 +20,24 @@ mod measure;
 mod mesh;
 mod model;
 mod nurbs;
+mod repair;
 mod reparam;
 mod tessellate;
 #[cfg(all(target_arch = "wasm32", target_os = "unknown"))]
 mod wasm;
 
 pub use error::Error;
-pub use io::{read_iges, read_json, read_model, write_glb, write_obj, write_stl, Format};
+pub use io::{read_iges, read_json, read_mesh, read_model, write_glb, write_obj, write_stl, Format, MeshFormat};
 pub use measure::{measure_mesh, MeasureOptions, MeshMeasure};
-pub use mesh::{angle_stats, edge_counts, weld_positions, AngleStats, EdgeCounts, FaceRange, Mesh, Report};
+pub use mesh::{angle_stats, edge_counts, weld_mesh, weld_positions, AngleStats, EdgeCounts, FaceRange, Mesh, Report};
 pub use model::{Face, FaceSurface, Model, TrimLoop};
 pub use nurbs::{
     project_to_surface, Aabb, BasisDers, CurveDerivs, KnotVector, NurbsCurve, NurbsError, NurbsSurface, Projection,
     ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
+};
+pub use repair::{
+    find_self_intersections, mesh_edge_census, mesh_volume, offset_mesh, repair_mesh, repair_mesh_timed, Bucketing,
+    EdgeCensus, RepairOptions, RepairReport, RepairResult, StageTimes,
 };
 pub use reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
 /// The mesher's stages one at a time, for the criterion benches; not a stable API.

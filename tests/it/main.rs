@@ -4,5 +4,6 @@ mod cli;
 mod iges;
 mod mesh;
 mod nurbs;
+mod repair;
 mod reparam;
 mod shapes;

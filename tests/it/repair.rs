@@ -1,0 +1,353 @@
+//! Mesh repair (paper 002): offsets of meshed shapes that self-intersect come
+//! out as closed, consistently oriented 2-manifolds without self-intersections
+//! (checked here by a brute-force test written independently of the library's,
+//! and by the library's exact BVH search); bad input gets clear errors.
+
+use std::path::Path;
+
+use glam::DVec3;
+use surfmesh::{
+    find_self_intersections, mesh_model, offset_mesh, read_iges, read_json, read_mesh, repair_mesh, weld_mesh,
+    write_obj, write_stl, Bucketing, Error, Mesh, MeshFormat, MeshOptions, RepairOptions, RepairResult,
+};
+
+fn data(name: &str) -> Vec<u8> {
+    std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)).unwrap()
+}
+
+/// A model from `tests/data` meshed at a relative tolerance, welded into one closed mesh.
+fn meshed(name: &str, rel: f64) -> Mesh {
+    let model = read_json(&data(name)).unwrap();
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(rel)).unwrap();
+    let diag = bbox_diagonal(&r.mesh);
+    let mut m = weld_mesh(&r.mesh, 1e-9 * diag);
+    drop_collapsed(&mut m);
+    m
+}
+
+fn drop_collapsed(m: &mut Mesh) {
+    let keep: Vec<u32> =
+        m.indices.chunks(3).filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0]).flatten().copied().collect();
+    m.indices = keep;
+}
+
+fn bbox_diagonal(m: &Mesh) -> f64 {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for p in &m.positions {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    (hi - lo).length()
+}
+
+fn scaled(mut m: Mesh, s: DVec3) -> Mesh {
+    for p in &mut m.positions {
+        *p *= s;
+    }
+    m
+}
+
+// ------------------------------------------------------------ independent checks
+
+/// Edge census by vertex index: (free, non-manifold, same-direction pairs).
+fn census(m: &Mesh) -> (usize, usize, usize) {
+    let mut uses: std::collections::HashMap<(u32, u32), (u32, u32)> = std::collections::HashMap::new();
+    for t in m.indices.chunks(3) {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let e = uses.entry((a.min(b), a.max(b))).or_default();
+            if a < b {
+                e.0 += 1
+            } else {
+                e.1 += 1
+            }
+        }
+    }
+    let free = uses.values().filter(|(f, r)| f + r == 1).count();
+    let nonmanifold = uses.values().filter(|(f, r)| f + r > 2).count();
+    let flipped = uses.values().filter(|(f, r)| f + r == 2 && *f != 1).count();
+    (free, nonmanifold, flipped)
+}
+
+fn volume(m: &Mesh) -> f64 {
+    m.indices
+        .chunks(3)
+        .map(|t| {
+            let [a, b, c] = [0, 1, 2].map(|k| m.positions[t[k] as usize]);
+            a.dot(b.cross(c)) / 6.0
+        })
+        .sum()
+}
+
+fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+    let c3 = |p: DVec3| robust::Coord3D { x: p.x, y: p.y, z: p.z };
+    robust::orient3d(c3(a), c3(b), c3(c), c3(d))
+}
+
+/// Whether segment `p q` crosses the interior of triangle `t` at one point
+/// strictly inside both (exact signs from the `robust` crate: an independent
+/// implementation of the predicates, not the library's).
+fn segment_crosses_triangle(p: DVec3, q: DVec3, t: [DVec3; 3]) -> bool {
+    let (sp, sq) = (orient(t[0], t[1], t[2], p), orient(t[0], t[1], t[2], q));
+    if !(sp > 0.0 && sq < 0.0 || sp < 0.0 && sq > 0.0) {
+        return false;
+    }
+    let s = [orient(p, q, t[0], t[1]), orient(p, q, t[1], t[2]), orient(p, q, t[2], t[0])];
+    s.iter().all(|&x| x > 0.0) || s.iter().all(|&x| x < 0.0)
+}
+
+/// Brute force over all pairs: triangles that share no edge must not cross.
+/// Two triangles cross along a segment exactly when an edge of one passes
+/// through the other; edges at a shared vertex can only touch there, so with
+/// one shared vertex only the two opposite edges are tried. O(n²): for small meshes.
+fn brute_force_intersections(m: &Mesh) -> usize {
+    let tris: Vec<[u32; 3]> = m.indices.chunks(3).map(|t| [t[0], t[1], t[2]]).collect();
+    let pos = |i: u32| m.positions[i as usize];
+    let mut count = 0;
+    let boxes: Vec<(DVec3, DVec3)> = tris
+        .iter()
+        .map(|t| {
+            let p = t.map(pos);
+            (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
+        })
+        .collect();
+    for i in 0..tris.len() {
+        let a = tris[i];
+        let pa = a.map(pos);
+        for (j, b) in tris.iter().enumerate().skip(i + 1) {
+            // Boxes apart: nothing to try (a filter, not a search structure).
+            if boxes[i].0.cmpgt(boxes[j].1).any() || boxes[j].0.cmpgt(boxes[i].1).any() {
+                continue;
+            }
+            let shared: Vec<u32> = a.iter().copied().filter(|v| b.contains(v)).collect();
+            if shared.len() >= 2 {
+                continue;
+            }
+            let pb = b.map(pos);
+            let free = |t: [u32; 3], k: usize| !shared.contains(&t[k]) && !shared.contains(&t[(k + 1) % 3]);
+            let hit = (0..3).any(|k| free(a, k) && segment_crosses_triangle(pa[k], pa[(k + 1) % 3], pb))
+                || (0..3).any(|k| free(*b, k) && segment_crosses_triangle(pb[k], pb[(k + 1) % 3], pa));
+            if hit {
+                count += 1;
+            }
+        }
+    }
+    count
+}
+
+/// Everything the acceptance asks of a repaired offset.
+fn assert_clean(name: &str, r: &RepairResult, brute: bool) {
+    let rep = &r.report;
+    eprintln!("{name}: {rep:?}");
+    let (free, nonmanifold, flipped) = census(&r.mesh);
+    assert!(r.mesh.triangle_count() > 0, "{name}: empty result");
+    assert_eq!(free, 0, "{name}: free edges");
+    assert_eq!(nonmanifold, 0, "{name}: non-manifold edges");
+    assert_eq!(flipped, 0, "{name}: inconsistent orientation");
+    assert!(volume(&r.mesh) > 0.0, "{name}: volume {}", volume(&r.mesh));
+    let exact = find_self_intersections(&r.mesh).unwrap();
+    assert!(exact.is_empty(), "{name}: {} pairs still meet, first {:?}", exact.len(), &exact[..exact.len().min(5)]);
+    if brute {
+        assert_eq!(brute_force_intersections(&r.mesh), 0, "{name}: brute force finds intersections");
+    }
+}
+
+// ------------------------------------------------------------ offsets
+
+#[test]
+fn repair_ellipsoid_offset_inward_past_the_tip_curvature() {
+    // The sphere of radius 10 stretched to semi-axes 25, 15, 10: at the x
+    // tips the radii of curvature are 15²/25 = 9 and 10²/25 = 4, so an inward
+    // offset of 6 folds them one way: a swallowtail fin along y, which crosses
+    // the body. (Equal y and z axes would fold both ways into a pinch point.)
+    let m = scaled(meshed("sphere.json", 2e-3), DVec3::new(2.5, 1.5, 1.0));
+    let off = offset_mesh(&m, -6.0).unwrap();
+    let raw = find_self_intersections(&off).unwrap();
+    assert!(raw.len() > 10, "the offset should self-intersect: {}", raw.len());
+    let r = repair_mesh(&off, &RepairOptions::default()).unwrap();
+    assert!(r.report.segments > 0);
+    assert_clean("ellipsoid", &r, true);
+    // The tips are cut back: the repaired x extent is below the raw offset's.
+    let xmax = |m: &Mesh| m.positions.iter().map(|p| p.x).fold(f64::NEG_INFINITY, f64::max);
+    assert!(xmax(&r.mesh) <= xmax(&off) + 1e-9);
+}
+
+#[test]
+fn repair_flattened_torus_offset_inward_past_the_tube_curvature() {
+    // Torus 20 / 5 squashed to a tube of semi-axes 5 (radial) and 2 (z): at
+    // its inner and outer equators the tube's radius of curvature is 2²/5 =
+    // 0.8, so an inward offset of 1.5 folds both into swallowtail fins that
+    // run around the axis.
+    let m = scaled(meshed("torus.json", 2e-3), DVec3::new(1.0, 1.0, 0.4));
+    let off = offset_mesh(&m, -1.5).unwrap();
+    assert!(!find_self_intersections(&off).unwrap().is_empty(), "the offset should self-intersect");
+    let r = repair_mesh(&off, &RepairOptions::default()).unwrap();
+    assert!(r.report.segments > 0);
+    assert_clean("torus", &r, false);
+    // Genus 1 survives: V - E + F = 0.
+    let edges = r.mesh.indices.len() / 2;
+    assert_eq!(r.mesh.positions.len() as i64 - edges as i64 + r.mesh.triangle_count() as i64, 0);
+}
+
+#[test]
+fn repair_outward_offset_of_a_sphere_is_already_clean_and_kept_whole() {
+    let m = meshed("sphere.json", 5e-3);
+    let off = offset_mesh(&m, 2.0).unwrap();
+    let r = repair_mesh(&off, &RepairOptions::default()).unwrap();
+    assert_eq!(r.report.segments, 0);
+    assert_eq!(r.mesh.triangle_count(), off.triangle_count());
+    assert_clean("sphere", &r, true);
+    // Radius 10 + 2: the volume is that of the inscribed polyhedron of radius 12, just below 4/3 π 12³.
+    let v = volume(&r.mesh);
+    let ball = 4.0 / 3.0 * std::f64::consts::PI * 12f64.powi(3);
+    assert!(v < ball && v > 0.97 * ball, "volume {v} vs {ball}");
+}
+
+#[test]
+fn repair_kd_tree_and_bvh_find_the_same_segments() {
+    let m = scaled(meshed("sphere.json", 5e-3), DVec3::new(2.5, 1.5, 1.0));
+    let off = offset_mesh(&m, -6.0).unwrap();
+    let kd =
+        repair_mesh(&off, &RepairOptions::default().with_bucketing(Bucketing::KdTree).with_bucket_capacity(8)).unwrap();
+    let bvh = repair_mesh(&off, &RepairOptions::default().with_bucketing(Bucketing::Bvh)).unwrap();
+    assert!(kd.report.kd_leaves > 1);
+    assert_eq!(kd.report.segments, bvh.report.segments);
+    assert_eq!(kd.mesh.triangle_count(), bvh.mesh.triangle_count());
+    assert_clean("kd", &kd, false);
+}
+
+#[test]
+fn repair_inward_offset_of_a_corpus_cube_folds_at_its_edges() {
+    // A 10 mm cube from Inventor, meshed finely: vertex normals along the
+    // edges point diagonally, so an inward offset larger than the mesh
+    // spacing folds the triangles next to every edge over each other.
+    let Ok(bytes) =
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus/cube_10x10_inventor.igs"))
+    else {
+        panic!("the corpus is expected beside the repository (../shared/corpus)");
+    };
+    let model = read_iges(&bytes).unwrap();
+    let opts = MeshOptions::default().with_max_edge(Some(1.5));
+    let r = mesh_model(&model, &opts).unwrap();
+    let mut m = weld_mesh(&r.mesh, 1e-6);
+    drop_collapsed(&mut m);
+    assert_eq!(census(&m), (0, 0, 0), "the meshed cube is closed");
+    let off = offset_mesh(&m, -2.0).unwrap();
+    assert!(!find_self_intersections(&off).unwrap().is_empty(), "the offset should self-intersect");
+    let rep = repair_mesh(&off, &RepairOptions::default()).unwrap();
+    assert_clean("cube", &rep, false);
+    // About the 6 mm cube that the exact inward offset is.
+    let v = volume(&rep.mesh);
+    assert!((v - 216.0).abs() < 0.15 * 216.0, "volume {v}");
+}
+
+// ------------------------------------------------------------ bad input
+
+#[test]
+fn repair_refuses_empty_nan_and_non_manifold_input_with_clear_errors() {
+    let empty = Mesh::default();
+    let e = repair_mesh(&empty, &RepairOptions::default()).unwrap_err().to_string();
+    assert!(e.contains("no triangles"), "{e}");
+
+    let mut nan = meshed("sphere.json", 2e-2);
+    nan.positions[3].y = f64::NAN;
+    let e = repair_mesh(&nan, &RepairOptions::default()).unwrap_err().to_string();
+    assert!(e.contains("vertex 3") && e.contains("not a finite number"), "{e}");
+
+    // A fin: a third triangle on an edge of a closed mesh.
+    let mut fin = meshed("sphere.json", 2e-2);
+    let (a, b) = (fin.indices[0], fin.indices[1]);
+    fin.positions.push(DVec3::new(100.0, 0.0, 0.0));
+    let c = (fin.positions.len() - 1) as u32;
+    fin.indices.extend([a, b, c]);
+    let e = repair_mesh(&fin, &RepairOptions::default()).unwrap_err();
+    assert!(matches!(e, Error::Repair { .. }), "{e:?}");
+    let e = e.to_string();
+    assert!(
+        e.contains(&format!("edge between vertices {} and {}", a.min(b), a.max(b))) && e.contains("not a 2-manifold"),
+        "{e}"
+    );
+
+    let mut bad_index = meshed("sphere.json", 2e-2);
+    bad_index.indices[5] = 1_000_000;
+    let e = repair_mesh(&bad_index, &RepairOptions::default()).unwrap_err().to_string();
+    assert!(e.contains("triangle 1") && e.contains("out of range"), "{e}");
+}
+
+#[test]
+fn repair_keeps_an_open_mesh_open_and_says_so() {
+    // A sphere with a few triangles cut out: best effort, the hole stays.
+    let mut m = meshed("sphere.json", 1e-2);
+    m.indices.truncate(m.indices.len() - 9);
+    let r = repair_mesh(&m, &RepairOptions::default()).unwrap();
+    assert!(r.report.free_edges_in > 0);
+    assert!(r.report.warnings.iter().any(|w| w.contains("open")), "{:?}", r.report.warnings);
+    assert_eq!(r.mesh.triangle_count(), m.triangle_count());
+    assert_eq!(census(&r.mesh).0, r.report.free_edges_in);
+}
+
+#[test]
+fn repair_turns_an_inside_out_mesh_outward() {
+    let mut m = meshed("sphere.json", 1e-2);
+    for t in m.indices.chunks_mut(3) {
+        t.swap(1, 2);
+    }
+    assert!(volume(&m) < 0.0);
+    let r = repair_mesh(&m, &RepairOptions::default()).unwrap();
+    assert!(volume(&r.mesh) > 0.0);
+    assert!(r.report.warnings.iter().any(|w| w.contains("inside out")), "{:?}", r.report.warnings);
+}
+
+// ------------------------------------------------------------ readers
+
+#[test]
+fn stl_and_obj_round_trip_through_the_readers_with_vertices_merged() {
+    let m = meshed("sphere.json", 1e-2);
+    let stl = read_mesh(&write_stl(&m), MeshFormat::Stl).unwrap();
+    // Binary STL stores f32 corners per triangle; identical ones become one vertex again.
+    assert_eq!(stl.triangle_count(), m.triangle_count());
+    assert_eq!(stl.positions.len(), m.positions.len());
+    assert_eq!(census(&stl), (0, 0, 0));
+    let obj = read_mesh(&write_obj(&m), MeshFormat::Obj).unwrap();
+    assert_eq!(obj.indices, m.indices);
+    assert_eq!(obj.positions, m.positions, "OBJ keeps full precision");
+    assert_eq!(MeshFormat::detect(&write_stl(&m)), Some(MeshFormat::Stl));
+    assert_eq!(MeshFormat::detect(&write_obj(&m)), Some(MeshFormat::Obj));
+}
+
+#[test]
+fn ascii_stl_reads_with_polygons_and_names_bad_lines() {
+    let text = b"solid t\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 1 1 0\n   vertex 0 1 0\n  endloop\n endfacet\nendsolid t\n";
+    let m = read_mesh(text, MeshFormat::Stl).unwrap();
+    assert_eq!(m.triangle_count(), 2, "a quad facet becomes a fan of two");
+    assert_eq!(m.positions.len(), 4);
+    let bad = b"solid t\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 zero\n";
+    let e = read_mesh(bad, MeshFormat::Stl).unwrap_err().to_string();
+    assert_eq!(e, "ASCII STL line 4: 'zero' is not a number");
+    let nan = b"solid t\nfacet\nvertex 0 0 nan\nvertex 1 0 0\nvertex 0 1 0\nendfacet\nendsolid\n";
+    let e = read_mesh(nan, MeshFormat::Stl).unwrap_err().to_string();
+    assert!(e.starts_with("ASCII STL line 3:") && e.contains("not a finite number"), "{e}");
+    let truncated = b"solid t\nfacet\nvertex 0 0 0\n";
+    let e = read_mesh(truncated, MeshFormat::Stl).unwrap_err().to_string();
+    assert!(e.contains("line 2") && e.contains("no 'endfacet'"), "{e}");
+    let e = read_mesh(b"", MeshFormat::Stl).unwrap_err().to_string();
+    assert!(e.contains("empty"), "{e}");
+    // A binary file cut short is neither binary nor ASCII.
+    let m = meshed("sphere.json", 5e-2);
+    let stl = write_stl(&m);
+    let e = read_mesh(&stl[..stl.len() - 7], MeshFormat::Stl).unwrap_err().to_string();
+    assert!(e.contains("header says") && e.contains("triangles"), "{e}");
+}
+
+#[test]
+fn obj_reader_handles_index_forms_and_names_bad_lines() {
+    let text = b"# quad\nv 0 0 0\nv 1 0 0\nv 1 1 0 0.5 0.5 0.5\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/1 2//1 3/1 -1\n";
+    let m = read_mesh(text, MeshFormat::Obj).unwrap();
+    assert_eq!(m.indices, vec![0, 1, 2, 0, 2, 3]);
+    let e = read_mesh(b"v 0 0 0\nv 1 0 0\nf 1 2 3\n", MeshFormat::Obj).unwrap_err().to_string();
+    assert_eq!(e, "OBJ line 3: vertex index 3 is out of range (1 to 2 so far)");
+    let e = read_mesh(b"v 0 0\n", MeshFormat::Obj).unwrap_err().to_string();
+    assert_eq!(e, "OBJ line 1: 'v' needs three coordinates");
+    let e = read_mesh(b"v 0 0 0\nf 1 1\n", MeshFormat::Obj).unwrap_err().to_string();
+    assert_eq!(e, "OBJ line 2: face has 2 vertices, needs at least 3");
+}
