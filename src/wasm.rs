@@ -15,6 +15,7 @@ use alloc::vec::Vec;
 use js_sys::{Array, Float32Array, Function, Object, Reflect, Uint32Array, JSON};
 use wasm_bindgen::prelude::*;
 
+use crate::{offset_mesh, read_mesh, repair_mesh_timed, Bucketing, MeshFormat, RepairOptions};
 use crate::{read_model, Error, Format, MeshOptions, MeshResult};
 // `tests/wasm_node.rs` compiles this file into a crate where `crate::` is the
 // test itself, which does not import this name; take it from the library there.
@@ -63,6 +64,43 @@ export interface MeshOutput {
  * Throws an `Error` whose message names the problem (the CLI's one-line error).
  */
 export function mesh(bytes: Uint8Array, format: string, options?: MeshOptions): MeshOutput;
+
+/** Options of `repair`; every field is optional. Lengths are fractions of the mesh's bounding-box diagonal. */
+export interface RepairOptions {
+  /** Candidate-pair search: "bvh" (default) or "kd" (the paper's k-d tree). */
+  bucketing?: "bvh" | "kd";
+  /** Triangles per k-d tree leaf (default 32). */
+  bucketCapacity?: number;
+  /** Vertices closer than this are welded (default 1e-9). */
+  weldTolerance?: number;
+  /** Size of the pseudo-random vertex moves that break exact coincidences (default 1e-9). */
+  perturbation?: number;
+  /** Also search the result for self-intersections (default false). */
+  verify?: boolean;
+}
+
+/** What `repair` returns. */
+export interface RepairOutput {
+  /** x, y, z per vertex. */
+  positions: Float32Array;
+  /** Three vertex indices per triangle, counter-clockwise seen from outside. */
+  indices: Uint32Array;
+  /** The report (triangles_in, triangles_out, segments, regions, census_out, time_ms, warnings, ...). */
+  report: Record<string, any>;
+}
+
+/**
+ * Repairs a triangle mesh (paper 002): `bytes` in `format` ("stl", "obj", or "" / "auto" to detect it).
+ * Returns a closed 2-manifold without degenerate or self-intersecting triangles.
+ * Throws an `Error` whose message names the problem (the CLI's one-line error).
+ */
+export function repair(bytes: Uint8Array, format: string, options?: RepairOptions): RepairOutput;
+
+/**
+ * Moves every vertex of a mesh (`format` as for `repair`) by `distance` along its normal (negative =
+ * inward): the kind of input `repair` is for. Returns `{ positions, indices }`.
+ */
+export function offset(bytes: Uint8Array, format: string, distance: number): { positions: Float32Array; indices: Uint32Array };
 
 /**
  * As `mesh`, calling `progress(facesDone, facesTotal)` after each face is meshed (sewing and
@@ -284,4 +322,128 @@ fn to_js(result: &MeshResult) -> Result<JsValue, Error> {
             .map_err(|_| Error::Internal(format!("cannot set result field {name}")))?;
     }
     Ok(out.into())
+}
+
+/// Option names `repair` accepts.
+const REPAIR_OPTION_NAMES: [&str; 5] = ["bucketing", "bucketCapacity", "weldTolerance", "perturbation", "verify"];
+
+/// Reads a mesh (`"stl"`, `"obj"`, or `""`/`"auto"` to detect it) and repairs it (paper 002).
+///
+/// # Errors
+/// Throws a JS `Error` with the one-line message of a bad option, a reader
+/// error with its line, or a mesh that cannot be repaired.
+#[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
+pub fn repair(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsError> {
+    let options = read_repair_options(&options).map_err(|e| JsError::new(&e))?;
+    run_repair(bytes, format, &options).map_err(|e| JsError::new(&one_line(&e.to_string())))
+}
+
+/// Reads a mesh (`format` as for [`repair`]) and offsets it by `distance` along its vertex normals.
+///
+/// # Errors
+/// Throws a JS `Error` with the reader's or the offset's one-line message.
+#[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
+pub fn offset(bytes: &[u8], format: &str, distance: f64) -> Result<JsValue, JsError> {
+    let run = || -> Result<JsValue, Error> {
+        let mesh = read_mesh(bytes, mesh_format(bytes, format)?)?;
+        let out = offset_mesh(&mesh, distance)?;
+        let positions: Vec<f32> = out.positions.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect();
+        let obj = Object::new();
+        for (name, value) in [
+            ("positions", JsValue::from(Float32Array::from(positions.as_slice()))),
+            ("indices", Uint32Array::from(out.indices.as_slice()).into()),
+        ] {
+            Reflect::set(&obj, &JsValue::from_str(name), &value)
+                .map_err(|_| Error::Internal(format!("cannot set result field {name}")))?;
+        }
+        Ok(obj.into())
+    };
+    run().map_err(|e| JsError::new(&one_line(&e.to_string())))
+}
+
+/// `""` and `"auto"` detect the mesh format from the bytes; anything else is a name.
+fn mesh_format(bytes: &[u8], name: &str) -> Result<MeshFormat, Error> {
+    if name.is_empty() || name.eq_ignore_ascii_case("auto") {
+        MeshFormat::detect(bytes).ok_or_else(|| {
+            Error::Format("cannot detect the mesh format from its first bytes (expected stl or obj)".into())
+        })
+    } else {
+        MeshFormat::from_name(name)
+    }
+}
+
+fn run_repair(bytes: &[u8], format: &str, options: &RepairOptions) -> Result<JsValue, Error> {
+    options.validate()?;
+    let format = mesh_format(bytes, format)?;
+    let t0 = now_ms().unwrap_or(0.0);
+    let mesh = read_mesh(bytes, format)?;
+    let t1 = now_ms().unwrap_or(0.0);
+    let result = repair_mesh_timed(&mesh, options, &mut || now_ms().unwrap_or(0.0) - t1)?;
+    let mut report =
+        serde_json::to_value(&result.report).map_err(|e| Error::Internal(format!("report to JSON: {e}")))?;
+    if let Some(o) = report.as_object_mut() {
+        o.insert("parse_ms".into(), (t1 - t0).into());
+    }
+    let report_json = serde_json::to_string(&report).map_err(|e| Error::Internal(format!("report to JSON: {e}")))?;
+    let report = JSON::parse(&report_json).map_err(|_| Error::Internal("report JSON rejected by JSON.parse".into()))?;
+    let positions: Vec<f32> = result.mesh.positions.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect();
+    let out = Object::new();
+    let fields: [(&str, JsValue); 3] = [
+        ("positions", Float32Array::from(positions.as_slice()).into()),
+        ("indices", Uint32Array::from(result.mesh.indices.as_slice()).into()),
+        ("report", report),
+    ];
+    for (name, value) in fields {
+        Reflect::set(&out, &JsValue::from_str(name), &value)
+            .map_err(|_| Error::Internal(format!("cannot set result field {name}")))?;
+    }
+    Ok(out.into())
+}
+
+/// Reads the JS options object of `repair`; every key must be known.
+fn read_repair_options(value: &JsValue) -> Result<RepairOptions, String> {
+    let mut options = RepairOptions::default();
+    if value.is_undefined() || value.is_null() {
+        return Ok(options);
+    }
+    if !value.is_object() || Array::is_array(value) {
+        return Err(format!("options: expected an object like {{ bucketing: \"kd\" }}, found {}", type_name(value)));
+    }
+    let object: &Object = value.unchecked_ref();
+    for key in Object::keys(object).iter() {
+        let key = key.as_string().unwrap_or_default();
+        if !REPAIR_OPTION_NAMES.contains(&key.as_str()) {
+            return Err(format!("option {key}: unknown option (known: {})", REPAIR_OPTION_NAMES.join(", ")));
+        }
+    }
+    let get = |name: &str| {
+        Reflect::get(object, &JsValue::from_str(name)).map_err(|_| format!("option {name}: cannot be read"))
+    };
+    let b = get("bucketing")?;
+    if !b.is_undefined() && !b.is_null() {
+        options = options.with_bucketing(match b.as_string().as_deref() {
+            Some("kd") => Bucketing::KdTree,
+            Some("bvh") => Bucketing::Bvh,
+            _ => return Err("option bucketing: expected \"kd\" or \"bvh\"".into()),
+        });
+    }
+    if let Some(n) = number(object, "bucketCapacity")? {
+        if !(n.fract() == 0.0 && n >= 0.0 && n <= u32::MAX as f64) {
+            return Err(format!("option bucketCapacity: expected a whole number, found {n}"));
+        }
+        options = options.with_bucket_capacity(n as usize);
+    }
+    if let Some(w) = number(object, "weldTolerance")? {
+        options = options.with_weld_tolerance(w);
+    }
+    if let Some(p) = number(object, "perturbation")? {
+        options.perturbation = p;
+    }
+    let v = get("verify")?;
+    if !v.is_undefined() && !v.is_null() {
+        options = options.with_verify(
+            v.as_bool().ok_or_else(|| format!("option verify: expected a boolean, found {}", type_name(&v)))?,
+        );
+    }
+    Ok(options)
 }

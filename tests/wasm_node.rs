@@ -11,7 +11,10 @@ extern crate alloc;
 
 // Names `src/wasm.rs` reaches through `crate::`.
 #[allow(unused_imports)]
-use surfmesh::{mesh_model, read_model, Error, Format, MeshOptions, MeshResult};
+use surfmesh::{
+    mesh_model, offset_mesh, read_mesh, read_model, repair_mesh_timed, Bucketing, Error, Format, MeshFormat,
+    MeshOptions, MeshResult, RepairOptions,
+};
 
 #[path = "../src/wasm.rs"]
 mod binding;
@@ -426,4 +429,81 @@ fn progress_exception_is_rethrown_as_it_is() {
     assert_eq!(calls.len(), 1);
     // The module is still usable afterwards.
     assert!(ok(&dome(), JsValue::UNDEFINED).triangles() >= 2);
+}
+
+/// The bundled sphere, meshed, stretched to semi-axes 25, 15, 10 and offset
+/// inward by 6: its x tips fold into self-intersecting fins. As binary STL.
+fn folded_ellipsoid_stl() -> Vec<u8> {
+    let model = read_model(include_bytes!("data/sphere.json"), Format::Json).expect("sphere model");
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(5e-3)).expect("sphere mesh");
+    let mut m = surfmesh::weld_mesh(&r.mesh, 1e-8);
+    for p in &mut m.positions {
+        *p *= glam::DVec3::new(2.5, 1.5, 1.0);
+    }
+    let off = surfmesh::offset_mesh(&m, -6.0).expect("offset");
+    assert!(!surfmesh::find_self_intersections(&off).expect("check").is_empty());
+    surfmesh::write_stl(&off)
+}
+
+#[wasm_bindgen_test]
+fn repair_returns_a_closed_mesh_without_self_intersections() {
+    let stl = folded_ellipsoid_stl();
+    let out = binding::repair(&stl, "auto", options(&[("bucketing", "kd".into()), ("verify", true.into())]))
+        .unwrap_or_else(|e| panic!("repair failed: {:?}", JsValue::from(e)));
+    let get = |name: &str| Reflect::get(&out, &name.into()).expect("result field");
+    let positions = get("positions").dyn_into::<Float32Array>().expect("positions").to_vec();
+    let indices = get("indices").dyn_into::<Uint32Array>().expect("indices").to_vec();
+    let report = get("report");
+    let field = |name: &str| Reflect::get(&report, &name.into()).expect("report field");
+    assert!(field("segments").as_f64().unwrap() > 0.0);
+    assert_eq!(field("self_intersections_out").as_f64(), Some(0.0));
+    assert_eq!(field("bucketing").as_string().as_deref(), Some("kd-tree"));
+    assert_eq!(field("triangles_out").as_f64(), Some((indices.len() / 3) as f64));
+    assert_eq!(positions.len() % 3, 0);
+    // Closed and consistently oriented: every directed edge has its reverse, once.
+    let mut directed = std::collections::HashMap::new();
+    for t in indices.chunks(3) {
+        for k in 0..3 {
+            *directed.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
+        }
+    }
+    for (&(a, b), &n) in &directed {
+        assert_eq!(n, 1, "edge {a}-{b} used {n} times the same way");
+        assert_eq!(directed.get(&(b, a)), Some(&1), "edge {a}-{b} has no twin");
+    }
+}
+
+#[wasm_bindgen_test]
+fn repair_errors_are_js_errors_with_the_cli_message() {
+    let message = |r: Result<JsValue, wasm_bindgen::JsError>| -> String {
+        let value = JsValue::from(r.expect_err("expected an error"));
+        assert!(value.is_instance_of::<js_sys::Error>());
+        value.unchecked_into::<js_sys::Error>().message().into()
+    };
+    let m = message(binding::repair(b"solid x\nendsolid x\n", "stl", JsValue::UNDEFINED));
+    assert_eq!(m, "repair: mesh: it has no triangles");
+    let m = message(binding::repair(b"v 0 0 0\nf 1 2 3\n", "obj", JsValue::UNDEFINED));
+    assert!(m.starts_with("OBJ line 2:"), "{m}");
+    let m = message(binding::repair(&folded_ellipsoid_stl(), "stl", options(&[("bucketing", "octree".into())])));
+    assert!(m.contains("bucketing"), "{m}");
+    let m = message(binding::repair(b"", "auto", JsValue::UNDEFINED));
+    assert!(m.starts_with("format:"), "{m}");
+}
+
+#[wasm_bindgen_test]
+fn offset_moves_every_vertex_by_the_distance() {
+    let model = read_model(include_bytes!("data/sphere.json"), Format::Json).expect("sphere model");
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(2e-2)).expect("sphere mesh");
+    let m = surfmesh::weld_mesh(&r.mesh, 1e-8);
+    let out =
+        binding::offset(&surfmesh::write_obj(&m), "obj", 2.0).unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+    let positions = Reflect::get(&out, &"positions".into()).unwrap().dyn_into::<Float32Array>().unwrap().to_vec();
+    let indices = Reflect::get(&out, &"indices".into()).unwrap().dyn_into::<Uint32Array>().unwrap().to_vec();
+    assert!(!indices.is_empty() && indices.len() % 3 == 0);
+    // The sphere of radius 10 becomes one of radius 12, up to how far the
+    // facet-averaged vertex normals of this coarse mesh turn from the radius.
+    for p in positions.chunks(3) {
+        let r = ((p[0] as f64).powi(2) + (p[1] as f64).powi(2) + (p[2] as f64).powi(2)).sqrt();
+        assert!((r - 12.0).abs() < 1e-2, "radius {r}");
+    }
 }

@@ -3,6 +3,8 @@
 
 #[path = "surfmesh/args.rs"]
 mod args;
+#[path = "surfmesh/repair.rs"]
+mod repair;
 
 use std::ffi::OsString;
 use std::fs;
@@ -17,7 +19,7 @@ use surfmesh::{mesh_model, read_model, write_glb, write_obj, write_stl, Error, F
 fn main() -> ExitCode {
     match args::parse(std::env::args_os().skip(1).collect()) {
         Ok(Command::Help) => {
-            print!("{}", args::USAGE);
+            print!("{}\n{}", args::USAGE, repair::USAGE);
             ExitCode::SUCCESS
         }
         Ok(Command::Version) => {
@@ -31,9 +33,22 @@ fn main() -> ExitCode {
                 ExitCode::from(1)
             }
         },
+        Ok(Command::Offset(a)) => finish(&a.input, repair::run_offset(&a)),
+        Ok(Command::Repair(a)) => finish(&a.input, repair::run_repair(&a)),
         Err(message) => {
             eprintln!("surfmesh: {}", one_line(&message));
             ExitCode::from(2)
+        }
+    }
+}
+
+/// Exit status of a command run on `input`: its error, if any, on one line after the file's name.
+fn finish(input: &Path, result: Result<(), String>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("surfmesh: {}: {}", input.display(), one_line(&message));
+            ExitCode::from(1)
         }
     }
 }

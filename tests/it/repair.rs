@@ -351,3 +351,51 @@ fn obj_reader_handles_index_forms_and_names_bad_lines() {
     let e = read_mesh(b"v 0 0 0\nf 1 1\n", MeshFormat::Obj).unwrap_err().to_string();
     assert_eq!(e, "OBJ line 2: face has 2 vertices, needs at least 3");
 }
+
+// ------------------------------------------------------------ command line
+
+#[test]
+fn cli_offset_then_repair_writes_a_clean_mesh_and_a_report() {
+    let bin = env!("CARGO_BIN_EXE_surfmesh");
+    let dir = std::env::temp_dir().join(format!("surfmesh-it-{}-repair-cli", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    // A stretched sphere as OBJ, offset inward by the command line.
+    let m = scaled(meshed("sphere.json", 5e-3), DVec3::new(2.5, 1.5, 1.0));
+    std::fs::write(dir.join("in.obj"), write_obj(&m)).unwrap();
+    let run = |args: &[&str]| std::process::Command::new(bin).args(args).current_dir(&dir).output().unwrap();
+    let out = run(&["offset", "in.obj", "-d", "-6", "-o", "off.stl"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let off = read_mesh(&std::fs::read(dir.join("off.stl")).unwrap(), MeshFormat::Stl).unwrap();
+    assert_eq!(off.triangle_count(), m.triangle_count());
+    assert!(!find_self_intersections(&off).unwrap().is_empty());
+
+    let out = run(&["repair", "off.stl", "-o", "fixed.obj", "--report", "r.json", "--verify"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let fixed = read_mesh(&std::fs::read(dir.join("fixed.obj")).unwrap(), MeshFormat::Obj).unwrap();
+    assert_eq!(census(&fixed), (0, 0, 0));
+    assert!(find_self_intersections(&fixed).unwrap().is_empty());
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("r.json")).unwrap()).unwrap();
+    assert_eq!(report["triangles_in"], off.triangle_count());
+    assert_eq!(report["triangles_out"], fixed.triangle_count());
+    assert_eq!(report["self_intersections_out"], 0);
+    assert!(report["segments"].as_u64().unwrap() > 0);
+    assert!(report["regions"].as_u64().unwrap() >= 1);
+    for stage in ["prepare", "degenerate", "intersect", "regions", "total"] {
+        assert!(report["time_ms"][stage].as_f64().unwrap() >= 0.0, "{stage}");
+    }
+
+    // Bad input: one line on stderr naming the file and the line, exit 1, nothing written.
+    std::fs::write(dir.join("bad.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 9\n").unwrap();
+    let out = run(&["repair", "bad.obj", "-o", "never.stl"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim(), "surfmesh: bad.obj: OBJ line 3: vertex index 9 is out of range (1 to 2 so far)");
+    assert!(!dir.join("never.stl").exists());
+    let out = run(&["repair", "off.stl", "--bucketing", "octree"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = run(&["offset", "in.obj", "-o", "x.stl"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("-d DIST"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -14,6 +14,10 @@ pub enum Command {
     Version,
     /// Mesh a model file.
     Mesh(MeshArgs),
+    /// Offset a mesh along its vertex normals.
+    Offset(crate::repair::OffsetArgs),
+    /// Repair a mesh (paper 002).
+    Repair(crate::repair::RepairArgs),
 }
 
 /// Arguments of `surfmesh mesh`.
@@ -80,6 +84,8 @@ pub fn parse(args: Vec<OsString>) -> Result<Command, String> {
         Some("-h" | "--help" | "help") => Ok(Command::Help),
         Some("-V" | "--version") => Ok(Command::Version),
         Some("mesh") => parse_mesh(args),
+        Some("offset") => crate::repair::parse_offset(args).map(Command::Offset),
+        Some("repair") => crate::repair::parse_repair(args).map(Command::Repair),
         _ => Err(format!("unknown command '{}'; try 'surfmesh --help'", first.to_string_lossy())),
     }
 }
@@ -168,7 +174,7 @@ fn number(name: &str, value: OsString) -> Result<f64, String> {
         .ok_or_else(|| format!("{name}: '{}' is not a number", value.to_string_lossy()))
 }
 
-fn output_format(path: &std::path::Path) -> Result<OutputFormat, String> {
+pub fn output_format(path: &std::path::Path) -> Result<OutputFormat, String> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     match ext.as_str() {
         "stl" => Ok(OutputFormat::Stl),
