@@ -67,7 +67,7 @@ export function mesh(bytes: Uint8Array, format: string, options?: MeshOptions): 
 
 /** Options of `repair`; every field is optional. Lengths are fractions of the mesh's bounding-box diagonal. */
 export interface RepairOptions {
-  /** Candidate-pair search: "bvh" (default) or "kd" (the paper's k-d tree). */
+  /** Candidate-pair search: "kd" (default, the paper's k-d tree) or "bvh". */
   bucketing?: "bvh" | "kd";
   /** Triangles per k-d tree leaf (default 32). */
   bucketCapacity?: number;
