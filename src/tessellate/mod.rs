@@ -132,7 +132,17 @@ pub fn mesh_model_with_progress(
         let auto = (0.5 * tol).min(1e-4 * diag.max(tol));
         model.tolerance.filter(|t| t.is_finite() && *t > 0.0).map_or(auto, |t| auto.max(t.min(0.5 * tol)))
     });
-    let changed = sew::conform(&mut works, sew_tol, aim + sew_tol);
+    let mut changed = sew::conform(&mut works, sew_tol, aim + sew_tol);
+    // Sewing may fold a thin triangle next to a moved or inserted border
+    // vertex: unfold by interior edge flips or by moving an inner vertex,
+    // which leaves the sewn borders as they are (a rebuilt face within what
+    // its fit error leaves of the tolerance).
+    for ((w, ch), fit_error) in works.iter_mut().zip(changed.iter_mut()).zip(&fit_errors) {
+        let share = if *fit_error > 0.0 { ((tol - fit_error) / tol).clamp(0.5, 1.0) } else { 1.0 };
+        ch.extend(w.mesh.repair_inverted(w.surface, &refine::Criteria { tol: crit.tol * share, ..crit }));
+        ch.sort_unstable();
+        ch.dedup();
+    }
     for (((w, out), ch), fit_error) in works.iter().zip(outcomes.iter_mut()).zip(&changed).zip(&fit_errors) {
         out.measures.resize(w.mesh.tris.len(), Default::default());
         out.turns.resize(w.mesh.tris.len(), 0.0);

@@ -333,6 +333,182 @@ impl WorkMesh {
         out
     }
 
+    /// Repairs folded triangles by edge flips: for each inverted triangle,
+    /// its interior edges (not trim edges) are tried in turn, and a flip is
+    /// kept when both new triangles face the surface's way, keep the (u,v)
+    /// orientation and pass the deviation and angle limits. Borders are not
+    /// touched, so a sewn border stays conforming. Returns the triangles
+    /// changed.
+    pub fn repair_inverted(&mut self, surface: &dyn Surface, c: &Criteria) -> Vec<u32> {
+        let mut changed = Vec::new();
+        let mut todo: Vec<u32> = (0..self.tris.len() as u32).filter(|&t| self.inverted(surface, t as usize)).collect();
+        for _ in 0..8 {
+            let mut next = Vec::new();
+            for t in todo {
+                if !self.inverted(surface, t as usize) {
+                    continue;
+                }
+                let v = self.tris[t as usize];
+                let mut fixed = false;
+                for k in 0..3 {
+                    if self.try_flip(surface, c, t, v[k], v[(k + 1) % 3]) {
+                        changed.push(t);
+                        if let Some(adj) = self.edges.get(&key(v[(k + 2) % 3], v[k])) {
+                            changed.extend(adj.iter().copied().filter(|&x| x != NONE));
+                        }
+                        fixed = true;
+                        break;
+                    }
+                }
+                if fixed {
+                    continue;
+                }
+                // No flip helps: move an inner vertex of the fold to the
+                // middle of its neighbours (borders stay where sewing put them).
+                for &x in &v {
+                    if let Some(moved) = self.try_smooth(surface, c, x) {
+                        changed.extend(moved.iter().copied());
+                        next.extend(moved);
+                        break;
+                    }
+                }
+            }
+            if next.is_empty() {
+                break;
+            }
+            todo = next;
+        }
+        changed.sort_unstable();
+        changed.dedup();
+        changed
+    }
+
+    /// Flips edge `a-b` of triangle `t` (where `t` runs a→b) if the result is better; see [`Self::repair_inverted`].
+    fn try_flip(&mut self, surface: &dyn Surface, c: &Criteria, t: u32, a: u32, b: u32) -> bool {
+        if self.trim.contains_key(&key(a, b)) {
+            return false;
+        }
+        let Some(&adj) = self.edges.get(&key(a, b)) else { return false };
+        let u = if adj[0] == t { adj[1] } else { adj[0] };
+        if u == NONE || adj[0] != t && adj[1] != t {
+            return false;
+        }
+        let (tv, tuv) = (self.tris[t as usize], self.uvs[t as usize]);
+        let (uv_, uuv) = (self.tris[u as usize], self.uvs[u as usize]);
+        let Some(i) = (0..3).find(|&k| tv[k] == a && tv[(k + 1) % 3] == b) else { return false };
+        let Some(j) = (0..3).find(|&k| uv_[k] == b && uv_[(k + 1) % 3] == a) else { return false };
+        let cv = tv[(i + 2) % 3];
+        let d = uv_[(j + 2) % 3];
+        if cv == d || self.edges.contains_key(&key(cv, d)) {
+            return false;
+        }
+        let (qa, qb, qc) = (tuv[i], tuv[(i + 1) % 3], tuv[(i + 2) % 3]);
+        let (qb2, qa2, qd) = (uuv[j], uuv[(j + 1) % 3], uuv[(j + 2) % 3]);
+        // One chart on both sides (not across a seam).
+        let span = (qa - qb).length().max(1e-300);
+        if (qa - qa2).length() > 1e-9 * span || (qb - qb2).length() > 1e-9 * span {
+            return false;
+        }
+        let area = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+        let sense = area(qb2, qa2, qd);
+        let (t1, t2) = ([a, d, cv], [d, b, cv]);
+        let (w1, w2) = ([qa, qd, qc], [qd, qb, qc]);
+        if !(area(w1[0], w1[1], w1[2]) * sense > 0.0 && area(w2[0], w2[1], w2[2]) * sense > 0.0) {
+            return false;
+        }
+        // Apply, then test; undo when worse.
+        let old = (tv, tuv, uv_, uuv);
+        self.retriangulate(t, u, [tv, uv_], [t1, t2], [w1, w2]);
+        let good = [t, u].iter().all(|&x| {
+            let (m, turn) = self.measure(surface, x as usize, c);
+            !self.inverted(surface, x as usize) && m.max <= c.tol && turn <= c.angle
+        });
+        if !good {
+            self.retriangulate(t, u, [t1, t2], [old.0, old.2], [old.1, old.3]);
+        }
+        good
+    }
+
+    /// Moves inner vertex `x` to the (u,v) centroid of its neighbours when
+    /// that leaves every triangle around it facing the surface's way, with
+    /// its (u,v) orientation, and within the limits; returns those triangles.
+    fn try_smooth(&mut self, surface: &dyn Surface, c: &Criteria, x: u32) -> Option<Vec<u32>> {
+        let ring: Vec<u32> = (0..self.tris.len() as u32).filter(|&t| self.tris[t as usize].contains(&x)).collect();
+        if ring.len() < 3 {
+            return None;
+        }
+        let mut centre = DVec2::ZERO;
+        let mut at: Option<DVec2> = None;
+        let mut n = 0.0;
+        for &t in &ring {
+            let (tv, tuv) = (self.tris[t as usize], self.uvs[t as usize]);
+            for k in 0..3 {
+                let (a, b) = (tv[k], tv[(k + 1) % 3]);
+                if (a == x || b == x) && self.edges.get(&key(a, b)).is_none_or(|e| e[1] == NONE) {
+                    return None; // on a border
+                }
+                if tv[k] == x {
+                    // One chart all around (not a seam or pole vertex).
+                    if at.is_some_and(|q| q.distance(tuv[k]) > 0.0) {
+                        return None;
+                    }
+                    at = Some(tuv[k]);
+                } else {
+                    centre += tuv[k];
+                    n += 1.0;
+                }
+            }
+        }
+        let old_uv = at?;
+        let new_uv = centre / n;
+        let area = |w: [DVec2; 3]| (w[1] - w[0]).perp_dot(w[2] - w[0]);
+        let signs: Vec<f64> = ring.iter().map(|&t| area(self.uvs[t as usize])).collect();
+        let sense = signs.iter().sum::<f64>();
+        let (old_p, old_n) = (self.pos[x as usize], self.normal[x as usize]);
+        let set = |m: &mut Self, q: DVec2, p: DVec3, nn: DVec3| {
+            m.pos[x as usize] = p;
+            m.normal[x as usize] = nn;
+            for &t in &ring {
+                let tv = m.tris[t as usize];
+                for k in 0..3 {
+                    if tv[k] == x {
+                        m.uvs[t as usize][k] = q;
+                    }
+                }
+            }
+        };
+        set(self, new_uv, surface.point(new_uv), surface.normal(new_uv));
+        let good = ring.iter().all(|&t| {
+            let (m, turn) = self.measure(surface, t as usize, c);
+            area(self.uvs[t as usize]) * sense > 0.0
+                && !self.inverted(surface, t as usize)
+                && m.max <= c.tol
+                && turn <= c.angle
+        });
+        if good {
+            Some(ring)
+        } else {
+            set(self, old_uv, old_p, old_n);
+            None
+        }
+    }
+
+    /// Replaces triangles `t` and `u` (vertices `from`) by `to` with corner (u,v)s `uvs`.
+    fn retriangulate(&mut self, t: u32, u: u32, from: [[u32; 3]; 2], to: [[u32; 3]; 2], uvs: [[DVec2; 3]; 2]) {
+        for (x, tri) in [t, u].into_iter().zip(from) {
+            for k in 0..3 {
+                self.detach(tri[k], tri[(k + 1) % 3], x);
+            }
+        }
+        for ((x, tri), w) in [t, u].into_iter().zip(to).zip(uvs) {
+            self.tris[x as usize] = tri;
+            self.uvs[x as usize] = w;
+            for k in 0..3 {
+                self.attach(tri[k], tri[(k + 1) % 3], x);
+            }
+        }
+    }
+
     /// Whether the facet normal opposes the surface normal at the centroid's (u,v).
     pub fn inverted(&self, surface: &dyn Surface, t: usize) -> bool {
         let v = self.tris[t];
