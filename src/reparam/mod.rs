@@ -191,7 +191,7 @@ fn sample_count(surface: &FaceSurface, along_u: bool, eps: f64) -> usize {
             prev = Some(d.point);
         }
         if length > 0.0 && length.is_finite() {
-            sum += length * (kappa / (8.0 * eps)).sqrt();
+            sum += length * libm::sqrt(kappa / (8.0 * eps));
             used += 1;
         }
     }
