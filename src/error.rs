@@ -79,6 +79,15 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A point file is malformed.
+    Points {
+        /// 1-based line of the file (0 when the problem has no single line).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// The points admit no fitted surface (too few, colinear, not finite).
+    Fit(String),
     /// A limit guarding memory or time was hit.
     Limit(String),
     /// The caller's progress callback asked to stop.
@@ -118,6 +127,9 @@ impl fmt::Display for Error {
             }
             Self::MeshFile { location, message } => write!(f, "{location}: {message}"),
             Self::Repair { location, message } => write!(f, "repair: {location}: {message}"),
+            Self::Points { line: 0, message } => write!(f, "points: {message}"),
+            Self::Points { line, message } => write!(f, "points line {line}: {message}"),
+            Self::Fit(m) => write!(f, "fit: {m}"),
             Self::Limit(m) => write!(f, "limit: {m}"),
             Self::Cancelled => write!(f, "cancelled"),
             Self::Internal(m) => write!(f, "internal error (a bug in surfmesh): {m}"),

@@ -14,6 +14,7 @@ extern crate alloc;
 extern crate std;
 
 mod error;
+mod fit;
 mod io;
 mod math;
 mod measure;
@@ -27,6 +28,7 @@ mod tessellate;
 mod wasm;
 
 pub use error::Error;
+pub use fit::{read_points, PointFormat, MAX_FILE_POINTS};
 pub use io::{read_iges, read_json, read_mesh, read_model, write_glb, write_obj, write_stl, Format, MeshFormat};
 pub use measure::{measure_mesh, MeasureOptions, MeshMeasure};
 pub use mesh::{angle_stats, edge_counts, weld_mesh, weld_positions, AngleStats, EdgeCounts, FaceRange, Mesh, Report};

@@ -1,6 +1,7 @@
 //! Native integration tests, one binary.
 
 mod cli;
+mod fit;
 mod iges;
 mod mesh;
 mod nurbs;
