@@ -28,7 +28,10 @@ mod tessellate;
 mod wasm;
 
 pub use error::Error;
-pub use fit::{read_points, PointFormat, MAX_FILE_POINTS};
+pub use fit::{
+    fit_points, read_points, Cubic, FitOptions, FitPolygon, FitReport, FitResult, FitSurface, PatchPoint, PointFormat,
+    TriPatch, MAX_FILE_POINTS,
+};
 pub use io::{read_iges, read_json, read_mesh, read_model, write_glb, write_obj, write_stl, Format, MeshFormat};
 pub use measure::{measure_mesh, MeasureOptions, MeshMeasure};
 pub use mesh::{angle_stats, edge_counts, weld_mesh, weld_positions, AngleStats, EdgeCounts, FaceRange, Mesh, Report};
