@@ -3,6 +3,8 @@
 
 #[path = "surfmesh/args.rs"]
 mod args;
+#[path = "surfmesh/fit.rs"]
+mod fit;
 #[path = "surfmesh/repair.rs"]
 mod repair;
 
@@ -19,7 +21,7 @@ use surfmesh::{mesh_model, read_model, write_glb, write_obj, write_stl, Error, F
 fn main() -> ExitCode {
     match args::parse(std::env::args_os().skip(1).collect()) {
         Ok(Command::Help) => {
-            print!("{}\n{}", args::USAGE, repair::USAGE);
+            print!("{}\n{}\n{}", args::USAGE, repair::USAGE, fit::USAGE);
             ExitCode::SUCCESS
         }
         Ok(Command::Version) => {
@@ -35,6 +37,7 @@ fn main() -> ExitCode {
         },
         Ok(Command::Offset(a)) => finish(&a.input, repair::run_offset(&a)),
         Ok(Command::Repair(a)) => finish(&a.input, repair::run_repair(&a)),
+        Ok(Command::Fit(a)) => finish(&a.input, fit::run(&a)),
         Err(message) => {
             eprintln!("surfmesh: {}", one_line(&message));
             ExitCode::from(2)

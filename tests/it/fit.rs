@@ -333,3 +333,89 @@ fn point_files_read_from_tests_data() {
     let e = read_points(b"0 0 0\n1 0 0\n0 1\n", PointFormat::Xyz).unwrap_err();
     assert_eq!(e.to_string(), "points line 3: expected 3 numbers (x y z), found 2");
 }
+
+// ---------------------------------------------------------------- command line
+
+const BIN: &str = env!("CARGO_BIN_EXE_surfmesh");
+
+/// A fresh, empty directory for one test's files.
+fn scratch(test: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("surfmesh-it-fit-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn cli_fit_writes_mesh_patches_and_report() {
+    let dir = scratch("cli");
+    let (pts, c, r) = sphere_points(80, 7);
+    let text: String = pts.iter().map(|p| format!("{} {} {}\n", p.x, p.y, p.z)).collect();
+    let input = dir.join("sphere.xyz");
+    std::fs::write(&input, text).unwrap();
+    let (stl, json, report) = (dir.join("s.stl"), dir.join("p.json"), dir.join("r.json"));
+    let out = std::process::Command::new(BIN)
+        .arg("fit")
+        .arg(&input)
+        .args(["--tol", "0.01", "-o"])
+        .arg(&stl)
+        .arg("--patches")
+        .arg(&json)
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("80 points") && err.contains("sub-patches"), "{err}");
+    let rep: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert_eq!(rep["points"], 80);
+    assert_eq!(rep["tolerance"], 0.01);
+    // Binary STL: 80-byte header, count, 50 bytes per triangle.
+    let bytes = std::fs::read(&stl).unwrap();
+    let n = u32::from_le_bytes(bytes[80..84].try_into().unwrap()) as usize;
+    assert_eq!(n as u64, rep["triangles"].as_u64().unwrap());
+    assert_eq!(bytes.len(), 84 + 50 * n);
+    // The patches: every control net has 15 points, corners are input points, all near the sphere.
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(doc["format"], "surfmesh-fit");
+    let polygons = doc["polygons"].as_array().unwrap();
+    assert_eq!(polygons.len() as u64, rep["polygons"].as_u64().unwrap());
+    let point =
+        |v: &serde_json::Value| DVec3::new(v[0].as_f64().unwrap(), v[1].as_f64().unwrap(), v[2].as_f64().unwrap());
+    for poly in polygons {
+        let corners = poly["corners"].as_array().unwrap();
+        let patches = poly["patches"].as_array().unwrap();
+        assert_eq!(corners.len(), patches.len());
+        for (k, patch) in patches.iter().enumerate() {
+            let cps = patch.as_array().unwrap();
+            assert_eq!(cps.len(), 15);
+            let corner = &doc["points"][corners[k].as_u64().unwrap() as usize];
+            assert_eq!(point(&cps[0]), point(corner));
+            assert!(((point(&cps[14]) - c).length() - r).abs() < 0.2 * r);
+        }
+    }
+    assert!(!doc["edges"].as_array().unwrap().is_empty());
+}
+
+#[test]
+fn cli_fit_errors_name_the_file_and_line() {
+    let dir = scratch("cli-errors");
+    let input = dir.join("bad.xyz");
+    std::fs::write(&input, "0 0 0\n1 0 0\n0 1\n").unwrap();
+    let out = std::process::Command::new(BIN).arg("fit").arg(&input).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        err.trim(),
+        format!("surfmesh: {}: points line 3: expected 3 numbers (x y z), found 2", input.display())
+    );
+    std::fs::write(&input, "0 0 0\n1 1 1\n2 2 2\n3 3 3\n4 4 4\n").unwrap();
+    let out = std::process::Command::new(BIN).arg("fit").arg(&input).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("fit: the 5 points lie on one line"));
+    let out = std::process::Command::new(BIN).args(["fit", "--tol"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(String::from_utf8_lossy(&out.stderr).trim(), "surfmesh: --tol needs a value");
+    assert!(!dir.join("out.stl").exists());
+}

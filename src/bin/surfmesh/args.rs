@@ -18,6 +18,8 @@ pub enum Command {
     Offset(crate::repair::OffsetArgs),
     /// Repair a mesh (paper 002).
     Repair(crate::repair::RepairArgs),
+    /// Fit a surface through a point file.
+    Fit(crate::fit::FitArgs),
 }
 
 /// Arguments of `surfmesh mesh`.
@@ -86,6 +88,7 @@ pub fn parse(args: Vec<OsString>) -> Result<Command, String> {
         Some("mesh") => parse_mesh(args),
         Some("offset") => crate::repair::parse_offset(args).map(Command::Offset),
         Some("repair") => crate::repair::parse_repair(args).map(Command::Repair),
+        Some("fit") => crate::fit::parse(args).map(Command::Fit),
         _ => Err(format!("unknown command '{}'; try 'surfmesh --help'", first.to_string_lossy())),
     }
 }
