@@ -90,19 +90,29 @@ impl EditMesh<'_> {
         if len[shortest] <= zero_length {
             return Some(Defect::Collapse(shortest));
         }
-        // Angle at corner i, between edges i (to i+1) and i+2 (from i+2).
-        let angle = |i: usize| crate::math::angle_between(p[(i + 1) % 3] - p[i], p[(i + 2) % 3] - p[i]);
-        let angles = [angle(0), angle(1), angle(2)];
-        let smallest = angles.iter().copied().fold(f64::INFINITY, f64::min);
-        if smallest >= zero_angle {
+        // Corner i spans the edges to i+1 and to i+2; its angle is below the
+        // tolerance when the cosine is positive and |sin| < tan(tol) cos
+        // (no arc tangents: this runs on every triangle).
+        let tan_tol = libm::tan(zero_angle.min(1.0));
+        let mut small = false;
+        let mut obtuse = None;
+        for i in 0..3 {
+            let (u, v) = (p[(i + 1) % 3] - p[i], p[(i + 2) % 3] - p[i]);
+            let (cos, sin) = (u.dot(v), u.cross(v).length());
+            if cos > 0.0 && sin < tan_tol * cos {
+                small = true;
+            }
+            if cos < 0.0 {
+                obtuse = Some(i);
+            }
+        }
+        if !small {
             return None;
         }
-        let largest = (0..3).max_by(|&a, &b| angles[a].total_cmp(&angles[b])).unwrap_or(0);
-        if angles[largest] > core::f64::consts::FRAC_PI_2 {
-            // Cap: the longest edge is opposite the largest angle: edge largest+1.
-            Some(Defect::Swap((largest + 1) % 3))
-        } else {
-            Some(Defect::Collapse(shortest))
+        match obtuse {
+            // Cap: the longest edge is opposite the obtuse corner: edge i+1.
+            Some(i) => Some(Defect::Swap((i + 1) % 3)),
+            None => Some(Defect::Collapse(shortest)),
         }
     }
 

@@ -28,16 +28,53 @@ pub(crate) fn key(a: u32, b: u32) -> (u32, u32) {
     }
 }
 
-/// The triangles on each undirected edge, as `3 * triangle + local edge`.
-fn edge_uses(tris: &[[u32; 3]]) -> hashbrown::HashMap<(u32, u32), Vec<u32>> {
-    let mut uses: hashbrown::HashMap<(u32, u32), Vec<u32>> = hashbrown::HashMap::with_capacity(tris.len() * 3 / 2);
+/// Every edge use `3 * triangle + local edge`, sorted by its undirected edge
+/// (sorting a flat list is much faster than a map of lists at this size).
+fn sorted_uses(tris: &[[u32; 3]]) -> Vec<(u64, u32)> {
+    let mut uses: Vec<(u64, u32)> = Vec::with_capacity(3 * tris.len());
     for (t, tri) in tris.iter().enumerate() {
         for k in 0..3 {
-            let (a, b) = edge(tri, k);
-            uses.entry(key(a, b)).or_default().push(3 * t as u32 + k as u32);
+            let (a, b) = key(tri[k], tri[(k + 1) % 3]);
+            uses.push(((u64::from(a) << 32) | u64::from(b), 3 * t as u32 + k as u32));
         }
     }
+    uses.sort_unstable();
     uses
+}
+
+/// The other use of each edge use when exactly two triangles share the edge
+/// ([`NONE`] for a free edge), or the first edge (lowest vertex ids) that more
+/// than two share, with its uses, and how many such edges there are.
+fn mates(tris: &[[u32; 3]]) -> Result<Vec<u32>, (u64, Vec<u32>, usize)> {
+    let uses = sorted_uses(tris);
+    let mut mate = alloc::vec![NONE; 3 * tris.len()];
+    let mut bad: Option<(u64, Vec<u32>)> = None;
+    let mut bad_count = 0;
+    let mut i = 0;
+    while i < uses.len() {
+        let mut j = i + 1;
+        while j < uses.len() && uses[j].0 == uses[i].0 {
+            j += 1;
+        }
+        match j - i {
+            1 => {}
+            2 => {
+                mate[uses[i].1 as usize] = uses[i + 1].1;
+                mate[uses[i + 1].1 as usize] = uses[i].1;
+            }
+            _ => {
+                bad_count += 1;
+                if bad.is_none() {
+                    bad = Some((uses[i].0, uses[i..j].iter().map(|u| u.1).collect()));
+                }
+            }
+        }
+        i = j;
+    }
+    match bad {
+        Some((k, list)) => Err((k, list, bad_count)),
+        None => Ok(mate),
+    }
 }
 
 /// Reverses triangles so that each connected component is consistently
@@ -49,18 +86,19 @@ fn edge_uses(tris: &[[u32; 3]]) -> hashbrown::HashMap<(u32, u32), Vec<u32>> {
 /// [`Error::Repair`] naming the edge when more than two triangles share it,
 /// or naming a triangle of a component that cannot be oriented (a Möbius band).
 pub(crate) fn orient_consistently(tris: &mut [[u32; 3]]) -> Result<usize, Error> {
-    let uses = edge_uses(tris);
-    if let Some(((a, b), list)) = uses.iter().filter(|(_, l)| l.len() > 2).min_by_key(|(k, _)| **k) {
-        let owners: Vec<u32> = list.iter().map(|u| u / 3).collect();
-        return Err(Error::Repair {
-            location: format!("edge between vertices {a} and {b}"),
-            message: format!(
-                "shared by {} triangles {owners:?}: the input is not a 2-manifold ({} such edges)",
-                list.len(),
-                uses.values().filter(|l| l.len() > 2).count()
-            ),
-        });
-    }
+    let mate = match mates(tris) {
+        Ok(m) => m,
+        Err((k, list, count)) => {
+            let owners: Vec<u32> = list.iter().map(|u| u / 3).collect();
+            return Err(Error::Repair {
+                location: format!("edge between vertices {} and {}", k >> 32, k & 0xFFFF_FFFF),
+                message: format!(
+                    "shared by {} triangles {owners:?}: the input is not a 2-manifold ({count} such edges)",
+                    list.len()
+                ),
+            });
+        }
+    };
     // flip[t]: 0 unknown, 1 keep, 2 reverse.
     let mut flip = alloc::vec![0u8; tris.len()];
     let mut queue = VecDeque::new();
@@ -72,26 +110,24 @@ pub(crate) fn orient_consistently(tris: &mut [[u32; 3]]) -> Result<usize, Error>
         queue.push_back(start);
         while let Some(t) = queue.pop_front() {
             for k in 0..3 {
-                let (a, b) = edge(&tris[t], k);
-                let Some(list) = uses.get(&key(a, b)) else { continue };
-                for &u in list {
-                    let n = (u / 3) as usize;
-                    if n == t {
-                        continue;
-                    }
-                    let (c, _) = edge(&tris[n], (u % 3) as usize);
-                    // Same direction means one of the two must be reversed.
-                    let same = c == a;
-                    let want = if same == (flip[t] == 1) { 2 } else { 1 };
-                    if flip[n] == 0 {
-                        flip[n] = want;
-                        queue.push_back(n);
-                    } else if flip[n] != want {
-                        return Err(Error::Repair {
-                            location: format!("triangle {n}"),
-                            message: "its component cannot be oriented consistently (a Möbius band or similar)".into(),
-                        });
-                    }
+                let u = mate[3 * t + k];
+                if u == NONE {
+                    continue;
+                }
+                let n = (u / 3) as usize;
+                let (a, _) = edge(&tris[t], k);
+                let (c, _) = edge(&tris[n], (u % 3) as usize);
+                // Same direction means one of the two must be reversed.
+                let same = c == a;
+                let want = if same == (flip[t] == 1) { 2 } else { 1 };
+                if flip[n] == 0 {
+                    flip[n] = want;
+                    queue.push_back(n);
+                } else if flip[n] != want {
+                    return Err(Error::Repair {
+                        location: format!("triangle {n}"),
+                        message: "its component cannot be oriented consistently (a Möbius band or similar)".into(),
+                    });
                 }
             }
         }
@@ -111,18 +147,19 @@ pub(crate) fn orient_consistently(tris: &mut [[u32; 3]]) -> Result<usize, Error>
 /// [`orient_consistently`] (at most two triangles, opposite directions);
 /// anything else is left free.
 pub(crate) fn adjacency(tris: &[[u32; 3]]) -> Vec<[u32; 3]> {
+    let mate = mates(tris).unwrap_or_else(|_| alloc::vec![NONE; 3 * tris.len()]);
     let mut nbr = alloc::vec![[NONE; 3]; tris.len()];
-    let mut open: hashbrown::HashMap<(u32, u32), u32> = hashbrown::HashMap::with_capacity(tris.len() * 3 / 2);
     for (t, tri) in tris.iter().enumerate() {
         for k in 0..3 {
+            let u = mate[3 * t + k];
+            if u == NONE {
+                continue;
+            }
             let (a, b) = edge(tri, k);
-            let me = 3 * t as u32 + k as u32;
-            // The twin runs b -> a.
-            if let Some(other) = open.remove(&(b, a)) {
-                nbr[t][k] = other;
-                nbr[(other / 3) as usize][(other % 3) as usize] = me;
-            } else {
-                open.insert((a, b), me);
+            let (c, d) = edge(&tris[(u / 3) as usize], (u % 3) as usize);
+            // Only a twin running the other way is a neighbour.
+            if (c, d) == (b, a) {
+                nbr[t][k] = u;
             }
         }
     }

@@ -81,21 +81,18 @@ fn meet_beyond_shared(a: &[(u32, DVec2)], b: &[(u32, DVec2)]) -> bool {
             return true;
         }
     }
-    let edges = |s: &[(u32, DVec2)]| -> alloc::vec::Vec<[(u32, DVec2); 2]> {
+    // Sides: a segment has one, a triangle three, a point none.
+    let edges = |s: &[(u32, DVec2)]| -> ([[(u32, DVec2); 2]; 3], usize) {
+        let none = (0, DVec2::ZERO);
         match s.len() {
-            2 => alloc::vec![[s[0], s[1]]],
-            3 => alloc::vec![[s[0], s[1]], [s[1], s[2]], [s[2], s[0]]],
-            _ => alloc::vec::Vec::new(),
+            2 => ([[s[0], s[1]], [none, none], [none, none]], 1),
+            3 => ([[s[0], s[1]], [s[1], s[2]], [s[2], s[0]]], 3),
+            _ => ([[none, none]; 3], 0),
         }
     };
-    for ea in edges(a) {
-        for eb in edges(b) {
-            if segments_meet_beyond_shared(ea, eb) {
-                return true;
-            }
-        }
-    }
-    false
+    let (ea, na) = edges(a);
+    let (eb, nb) = edges(b);
+    ea[..na].iter().any(|&x| eb[..nb].iter().any(|&y| segments_meet_beyond_shared(x, y)))
 }
 
 /// Whether `p` lies in the closed convex hull of 1 to 3 points.
@@ -125,8 +122,15 @@ fn on_segment(p: DVec2, a: DVec2, b: DVec2) -> bool {
 }
 
 fn segments_meet_beyond_shared(a: [(u32, DVec2); 2], b: [(u32, DVec2); 2]) -> bool {
-    let common: alloc::vec::Vec<u32> = a.iter().filter(|x| b.iter().any(|y| y.0 == x.0)).map(|x| x.0).collect();
-    match common.len() {
+    let mut common = [0u32; 2];
+    let mut n = 0;
+    for x in &a {
+        if b.iter().any(|y| y.0 == x.0) {
+            common[n] = x.0;
+            n += 1;
+        }
+    }
+    match n {
         2 => false,
         1 => {
             // They meet at the shared end; beyond it only if they run the same way along one line.
@@ -159,8 +163,9 @@ fn line_through_triangle(p: DVec3, q: DVec3, t: &[DVec3; 3]) -> Option<bool> {
     let s = [orient3d(p, q, t[0], t[1]), orient3d(p, q, t[1], t[2]), orient3d(p, q, t[2], t[0])];
     if s.contains(&Ordering::Equal) {
         // Zero with the other two agreeing is the boundary; disagreeing is outside.
-        let nz: alloc::vec::Vec<Ordering> = s.iter().copied().filter(|&x| x != Ordering::Equal).collect();
-        return if nz.windows(2).all(|w| w[0] == w[1]) { None } else { Some(false) };
+        let pos = s.contains(&Ordering::Greater);
+        let neg = s.contains(&Ordering::Less);
+        return if pos && neg { Some(false) } else { None };
     }
     Some(s[0] == s[1] && s[1] == s[2])
 }
@@ -182,8 +187,8 @@ pub(crate) fn contact(a: &Tri, b: &Tri) -> Contact {
     if sa.iter().all(|&s| s == Ordering::Equal) {
         // Coplanar.
         let axis = drop_axis((a.p[1] - a.p[0]).cross(a.p[2] - a.p[0]));
-        let pa: alloc::vec::Vec<(u32, DVec2)> = (0..3).map(|k| (a.v[k], project(a.p[k], axis))).collect();
-        let pb: alloc::vec::Vec<(u32, DVec2)> = (0..3).map(|k| (b.v[k], project(b.p[k], axis))).collect();
+        let pa: [(u32, DVec2); 3] = core::array::from_fn(|k| (a.v[k], project(a.p[k], axis)));
+        let pb: [(u32, DVec2); 3] = core::array::from_fn(|k| (b.v[k], project(b.p[k], axis)));
         return if meet_beyond_shared(&pa, &pb) { Contact::Degenerate } else { Contact::None };
     }
     if let Some(c) = one_sided(a, &sa, b) {
@@ -258,10 +263,17 @@ fn one_sided(t: &Tri, s: &[Ordering; 3], other: &Tri) -> Option<Contact> {
         return None;
     }
     let axis = drop_axis((other.p[1] - other.p[0]).cross(other.p[2] - other.p[0]));
-    let on: alloc::vec::Vec<(u32, DVec2)> =
-        (0..3).filter(|&k| s[k] == Ordering::Equal).map(|k| (t.v[k], project(t.p[k], axis))).collect();
-    let tri: alloc::vec::Vec<(u32, DVec2)> = (0..3).map(|k| (other.v[k], project(other.p[k], axis))).collect();
-    Some(if meet_beyond_shared(&on, &tri) { Contact::Degenerate } else { Contact::None })
+    let mut on = [(0u32, DVec2::ZERO); 3];
+    let mut n = 0;
+    for k in 0..3 {
+        if s[k] == Ordering::Equal {
+            on[n] = (t.v[k], project(t.p[k], axis));
+            n += 1;
+        }
+    }
+    let on = &on[..n];
+    let tri: [(u32, DVec2); 3] = core::array::from_fn(|k| (other.v[k], project(other.p[k], axis)));
+    Some(if meet_beyond_shared(on, &tri) { Contact::Degenerate } else { Contact::None })
 }
 
 fn edge_point(p: u32, q: u32, tri: u32) -> PointKey {
