@@ -15,6 +15,7 @@ use alloc::vec::Vec;
 use js_sys::{Array, Float32Array, Function, Object, Reflect, Uint32Array, JSON};
 use wasm_bindgen::prelude::*;
 
+use crate::{fit_points, read_points, FitOptions, FitResult, PointFormat};
 use crate::{offset_mesh, read_mesh, repair_mesh_timed, Bucketing, MeshFormat, RepairOptions};
 use crate::{read_model, Error, Format, MeshOptions, MeshResult};
 // `tests/wasm_node.rs` compiles this file into a crate where `crate::` is the
@@ -101,6 +102,43 @@ export function repair(bytes: Uint8Array, format: string, options?: RepairOption
  * inward): the kind of input `repair` is for. Returns `{ positions, indices }`.
  */
 export function offset(bytes: Uint8Array, format: string, distance: number): { positions: Float32Array; indices: Uint32Array };
+
+/** Options of `fit`; every field is optional. */
+export interface FitOptions {
+  /** Absolute chordal tolerance of the mesh (exclusive with toleranceRel). */
+  tolerance?: number;
+  /** Tolerance as a fraction of the points' bounding-box diagonal (default 1e-3). */
+  toleranceRel?: number;
+  /** Largest polygon of the net, 3 to 32 (default 8; 3 keeps the triangles). */
+  maxSides?: number;
+}
+
+/** What `fit` returns: the mesh of the fitted surface, its net and its patches. */
+export interface FitOutput {
+  /** x, y, z per mesh vertex. */
+  positions: Float32Array;
+  /** Unit surface normal per mesh vertex. */
+  normals: Float32Array;
+  /** Three vertex indices per triangle, counter-clockwise seen from the normal side. */
+  indices: Uint32Array;
+  /** Pairs (first triangle, triangle count), one pair per polygon of the net. */
+  faceRanges: Uint32Array;
+  /** x, y, z per net vertex: the input points, duplicates merged. */
+  points: Float32Array;
+  /** Pairs of indices into `points`: the edges of the polygon net. */
+  netEdges: Uint32Array;
+  /** The polygon net and its quartic sub-patches as JSON text (the CLI's --patches file). */
+  patches: string;
+  /** The report (points, polygons, sub_patches, sub_patches_triangular, max_g1_angle, warnings, ...). */
+  report: Record<string, any>;
+}
+
+/**
+ * Fits a G1 surface through the points of `bytes` in `format` ("xyz", "csv", "ply", or "" / "auto"
+ * to detect it) by paper 004's polygon curve net, and meshes it within the tolerance.
+ * Throws an `Error` whose message names the problem (the CLI's one-line error).
+ */
+export function fit(bytes: Uint8Array, format: string, options?: FitOptions): FitOutput;
 
 /**
  * As `mesh`, calling `progress(facesDone, facesTotal)` after each face is meshed (sewing and
@@ -446,4 +484,93 @@ fn read_repair_options(value: &JsValue) -> Result<RepairOptions, String> {
         );
     }
     Ok(options)
+}
+
+/// Option names `fit` accepts.
+const FIT_OPTION_NAMES: [&str; 3] = ["tolerance", "toleranceRel", "maxSides"];
+
+/// Reads points (`"xyz"`, `"csv"`, `"ply"`, or `""`/`"auto"` to detect them)
+/// and fits a surface through them (paper 004).
+///
+/// # Errors
+/// Throws a JS `Error` with the one-line message of a bad option, a reader
+/// error naming its line, or points no surface passes through.
+#[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
+pub fn fit(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsError> {
+    let options = read_fit_options(&options).map_err(|e| JsError::new(&e))?;
+    let run = || -> Result<JsValue, Error> {
+        let format = if format.is_empty() || format.eq_ignore_ascii_case("auto") {
+            PointFormat::detect(bytes)
+        } else {
+            PointFormat::from_name(format)?
+        };
+        let points = read_points(bytes, format)?;
+        let t0 = now_ms();
+        let mut result = fit_points(&points, &options)?;
+        if let (Some(t0), Some(t1)) = (t0, now_ms()) {
+            result.report.time_ms = t1 - t0;
+        }
+        fit_to_js(&result)
+    };
+    run().map_err(|e| JsError::new(&one_line(&e.to_string())))
+}
+
+/// Reads the JS options object of `fit`; every key must be known and every value a number.
+fn read_fit_options(value: &JsValue) -> Result<FitOptions, String> {
+    let mut options = FitOptions::default();
+    if value.is_undefined() || value.is_null() {
+        return Ok(options);
+    }
+    if !value.is_object() || Array::is_array(value) {
+        return Err(format!("options: expected an object like {{ toleranceRel: 0.001 }}, found {}", type_name(value)));
+    }
+    let object: &Object = value.unchecked_ref();
+    for key in Object::keys(object).iter() {
+        let key = key.as_string().unwrap_or_default();
+        if !FIT_OPTION_NAMES.contains(&key.as_str()) {
+            return Err(format!("option {key}: unknown option (known: {})", FIT_OPTION_NAMES.join(", ")));
+        }
+    }
+    match (number(object, "tolerance")?, number(object, "toleranceRel")?) {
+        (Some(_), Some(_)) => return Err("option tolerance: give tolerance or toleranceRel, not both".into()),
+        (Some(t), None) => options = options.with_tolerance(t),
+        (None, Some(r)) => options = options.with_relative_tolerance(r),
+        (None, None) => {}
+    }
+    if let Some(n) = number(object, "maxSides")? {
+        if !(n.fract() == 0.0 && (3.0..=32.0).contains(&n)) {
+            return Err(format!("option maxSides: expected a whole number from 3 to 32, found {n}"));
+        }
+        options = options.with_max_polygon_sides(n as usize);
+    }
+    options.validate().map_err(|e| e.to_string())?;
+    Ok(options)
+}
+
+/// Builds `{ positions, normals, indices, faceRanges, points, netEdges, patches, report }`.
+fn fit_to_js(result: &FitResult) -> Result<JsValue, Error> {
+    let flat =
+        |v: &[glam::DVec3]| -> Vec<f32> { v.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect() };
+    let mesh = &result.mesh;
+    let ranges: Vec<u32> = mesh.face_ranges.iter().flat_map(|r| [r.first, r.count]).collect();
+    let edges: Vec<u32> = result.surface.edges().iter().flat_map(|(a, b, _)| [*a, *b]).collect();
+    let report_json =
+        serde_json::to_string(&result.report).map_err(|e| Error::Internal(format!("report to JSON: {e}")))?;
+    let report = JSON::parse(&report_json).map_err(|_| Error::Internal("report JSON rejected by JSON.parse".into()))?;
+    let out = Object::new();
+    let fields: [(&str, JsValue); 8] = [
+        ("positions", Float32Array::from(flat(&mesh.positions).as_slice()).into()),
+        ("normals", Float32Array::from(flat(&mesh.normals).as_slice()).into()),
+        ("indices", Uint32Array::from(mesh.indices.as_slice()).into()),
+        ("faceRanges", Uint32Array::from(ranges.as_slice()).into()),
+        ("points", Float32Array::from(flat(&result.surface.points).as_slice()).into()),
+        ("netEdges", Uint32Array::from(edges.as_slice()).into()),
+        ("patches", JsValue::from_str(&result.surface.to_json())),
+        ("report", report),
+    ];
+    for (name, value) in fields {
+        Reflect::set(&out, &JsValue::from_str(name), &value)
+            .map_err(|_| Error::Internal(format!("cannot set result field {name}")))?;
+    }
+    Ok(out.into())
 }

@@ -12,8 +12,8 @@ extern crate alloc;
 // Names `src/wasm.rs` reaches through `crate::`.
 #[allow(unused_imports)]
 use surfmesh::{
-    mesh_model, offset_mesh, read_mesh, read_model, repair_mesh_timed, Bucketing, Error, Format, MeshFormat,
-    MeshOptions, MeshResult, RepairOptions,
+    fit_points, mesh_model, offset_mesh, read_mesh, read_model, read_points, repair_mesh_timed, Bucketing, Error,
+    FitOptions, FitResult, Format, MeshFormat, MeshOptions, MeshResult, PointFormat, RepairOptions,
 };
 
 #[path = "../src/wasm.rs"]
@@ -506,4 +506,74 @@ fn offset_moves_every_vertex_by_the_distance() {
         let r = ((p[0] as f64).powi(2) + (p[1] as f64).powi(2) + (p[2] as f64).powi(2)).sqrt();
         assert!((r - 12.0).abs() < 1e-2, "radius {r}");
     }
+}
+
+/// 60 points of the unit sphere (a Fibonacci spiral) as xyz text.
+fn sphere_xyz() -> String {
+    let n = 60;
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            let t = golden * i as f64;
+            format!("{} {} {}\n", r * t.cos(), r * t.sin(), z)
+        })
+        .collect()
+}
+
+#[wasm_bindgen_test]
+fn fit_returns_the_mesh_net_and_patches_of_a_surface_through_the_points() {
+    let xyz = sphere_xyz();
+    let out = binding::fit(xyz.as_bytes(), "auto", options(&[("toleranceRel", num(2e-3)), ("maxSides", num(6.0))]))
+        .unwrap_or_else(|e| panic!("fit failed: {:?}", JsValue::from(e)));
+    let get = |name: &str| Reflect::get(&out, &name.into()).expect("result field");
+    let positions = get("positions").dyn_into::<Float32Array>().expect("positions").to_vec();
+    let normals = get("normals").dyn_into::<Float32Array>().expect("normals").to_vec();
+    let indices = get("indices").dyn_into::<Uint32Array>().expect("indices").to_vec();
+    let points = get("points").dyn_into::<Float32Array>().expect("points").to_vec();
+    let edges = get("netEdges").dyn_into::<Uint32Array>().expect("netEdges").to_vec();
+    let report = get("report");
+    let field = |name: &str| Reflect::get(&report, &name.into()).expect("report field").as_f64().expect("number");
+    assert_eq!(field("points"), 60.0);
+    assert_eq!(points.len(), 3 * 60);
+    assert_eq!(field("triangles"), (indices.len() / 3) as f64);
+    assert_eq!(positions.len(), normals.len());
+    assert!(indices.iter().all(|&i| (i as usize) < positions.len() / 3));
+    assert!(field("max_g1_angle") < 1e-6);
+    assert!(field("sub_patches") < field("sub_patches_triangular"));
+    // A closed net: V - E + F = 2 over the polygons, edges as pairs below the point count.
+    assert!(edges.len() % 2 == 0 && edges.iter().all(|&i| i < 60));
+    assert_eq!(60.0 - (edges.len() / 2) as f64 + field("polygons"), 2.0);
+    // Every vertex near the unit sphere, every input point a mesh vertex.
+    for p in positions.chunks(3) {
+        let r = (p[0] as f64).hypot(p[1] as f64).hypot(p[2] as f64);
+        assert!((r - 1.0).abs() < 0.1, "radius {r}");
+    }
+    let patches = js_sys::JSON::parse(&get("patches").as_string().expect("patches text")).expect("patches JSON");
+    let polygons = Reflect::get(&patches, &"polygons".into()).unwrap().dyn_into::<Array>().unwrap();
+    assert_eq!(polygons.length() as f64, field("polygons"));
+}
+
+#[wasm_bindgen_test]
+fn fit_errors_are_js_errors_with_the_cli_message() {
+    let message = |r: Result<JsValue, wasm_bindgen::JsError>| -> String {
+        let value = JsValue::from(r.expect_err("expected an error"));
+        assert!(value.is_instance_of::<js_sys::Error>());
+        value.unchecked_into::<js_sys::Error>().message().into()
+    };
+    assert_eq!(
+        message(binding::fit(b"0 0 0\n1 0 0\n0 1\n", "xyz", JsValue::UNDEFINED)),
+        "points line 3: expected 3 numbers (x y z), found 2"
+    );
+    assert_eq!(
+        message(binding::fit(b"0 0 0\n1 0 0\n0 1 0\n", "", JsValue::UNDEFINED)),
+        "fit: at least 4 points are needed, found 3"
+    );
+    let m = message(binding::fit(sphere_xyz().as_bytes(), "xyz", options(&[("maxSides", num(2.0))])));
+    assert!(m.starts_with("option maxSides"), "{m}");
+    let m = message(binding::fit(sphere_xyz().as_bytes(), "xyz", options(&[("smooth", num(1.0))])));
+    assert!(m.starts_with("option smooth: unknown option"), "{m}");
+    let m = message(binding::fit(b"1 2 3", "las", JsValue::UNDEFINED));
+    assert!(m.starts_with("format: unknown point format"), "{m}");
 }
