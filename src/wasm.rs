@@ -70,7 +70,7 @@ export function mesh(bytes: Uint8Array, format: string, options?: MeshOptions): 
 export interface RepairOptions {
   /** Candidate-pair search: "kd" (default, the paper's k-d tree) or "bvh". */
   bucketing?: "bvh" | "kd";
-  /** Triangles per k-d tree leaf (default 32). */
+  /** Triangles per k-d tree leaf (default 128). */
   bucketCapacity?: number;
   /** Vertices closer than this are welded (default 1e-9). */
   weldTolerance?: number;
