@@ -39,7 +39,7 @@ pub const fn index(j: usize, k: usize) -> usize {
 /// and 1 are polygon corners `Z_i, Z_i+1`, corner 2 is the polygon's centre `O`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TriPatch {
-    /// Control points, row by row (see [`index`]).
+    /// Control points, row by row (ordered by the `index` function of this module).
     pub points: [DVec3; POINTS],
 }
 
