@@ -41,6 +41,8 @@ pub(crate) enum PatchError {
     Tangent,
     /// An even polygon whose centre conditions cannot be met (see [`fill_polygon`]).
     EvenClosure,
+    /// The corners turn clockwise about their normals.
+    Flipped,
     /// A non-finite control point.
     NotFinite,
 }
@@ -159,6 +161,11 @@ pub(crate) fn fill_polygon(
         return Err(PatchError::Shape);
     }
     let proj = project(z, max_angle)?;
+    // The corners must run counter-clockwise about their own normals, or the
+    // sub-patches would face against the neighbours'.
+    if normals.iter().any(|n| !(n.dot(proj.normal) > 0.0)) {
+        return Err(PatchError::Flipped);
+    }
     let (alpha, beta) = (&proj.alpha, &proj.beta);
     let prev = |i: usize| (i + n - 1) % n;
     let next = |i: usize| (i + 1) % n;

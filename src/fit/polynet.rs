@@ -35,6 +35,7 @@ pub(crate) struct PolyOptions {
 }
 
 /// Fills polygon `corners` with its sub-patches, edges by the curve construction.
+/// Triangles may have any corner angle below π; merged polygons at most `max_angle`.
 pub(crate) fn fill(
     points: &[DVec3],
     normals: &[DVec3],
@@ -49,7 +50,9 @@ pub(crate) fn fill(
         let j = (i + 1) % n;
         edges.push(edge_curve(z[i], nz[i], z[j], nz[j]).ok_or(PatchError::Tangent)?);
     }
-    fill_polygon(&z, &nz, &edges, opt.max_angle)
+    // A triangle of the net is filled whatever its angles (the limit is the merge's).
+    let max_angle = if n == 3 { core::f64::consts::PI } else { opt.max_angle };
+    fill_polygon(&z, &nz, &edges, max_angle)
 }
 
 /// Whether `corners` may be a polygon of the net.

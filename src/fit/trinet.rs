@@ -14,8 +14,11 @@
 //!    not overlap the triangles already there in that corner's tangent plane;
 //! 3. gaps left between accepted triangles (boundary loops that turn
 //!    clockwise about their normal, up to `max_hole_edges` edges) are filled
-//!    by ear clipping in their plane; loops that turn counter-clockwise are
-//!    the open boundary of a sheet and stay;
+//!    by ear clipping in their plane; a gap no ear clipping closes (the
+//!    triangles around it overlap) loses the triangles at its corners and is
+//!    filled again, with the points left bare, by a 2-D Delaunay triangulation
+//!    checked to close it exactly; loops that turn counter-clockwise are the
+//!    open boundary of a sheet and stay;
 //! 4. the smoothness criterion: an interior edge is swapped when the two
 //!    triangles after the swap agree clearly better with their corners'
 //!    tangent planes and stay well shaped.
@@ -43,7 +46,7 @@ pub(crate) struct NetOptions {
 pub(crate) struct TriNet {
     /// Counter-clockwise seen from the side the normals point to.
     pub tris: Vec<[u32; 3]>,
-    /// Gaps closed by ear clipping.
+    /// Gaps closed by ear clipping or the Delaunay fallback.
     pub holes_filled: usize,
     /// Boundary loops left open that turn like gaps (too large, or no ear found).
     pub holes_open: usize,
@@ -226,7 +229,10 @@ impl Net {
     }
 }
 
-/// Traces the boundary loops and fills those that are gaps. Returns (filled, left open, borders).
+/// Traces the boundary loops and fills those that are gaps. A gap no ear
+/// clipping can close (its diagonals already edges elsewhere: the triangles
+/// around it overlap) is widened by removing the triangles at its corners and
+/// filled again, up to [`HOLE_RETRIES`] times. Returns (filled, left open, borders).
 fn fill_holes(
     points: &[DVec3],
     normals: &[DVec3],
@@ -234,6 +240,54 @@ fn fill_holes(
     frames: &Frames,
     max_edges: usize,
 ) -> (usize, usize, usize) {
+    let mut filled = 0;
+    let mut pass = 0;
+    // Points the widening left without triangles: they go back in with the gap around them.
+    let mut orphans: Vec<u32> = Vec::new();
+    loop {
+        let (mut open, mut borders) = (0, 0);
+        let mut widen: HashSet<u32> = HashSet::new();
+        for lp in boundary_loops(net, frames) {
+            match classify(points, normals, &lp, max_edges) {
+                LoopKind::Border => borders += 1,
+                LoopKind::TooLarge => open += 1,
+                LoopKind::Gap(axis) => {
+                    let inner = inside_loop(points, normals, &lp, &orphans, axis);
+                    let tris =
+                        if inner.is_empty() { ear_clip(points, normals, &net.directed, &lp, axis) } else { None };
+                    match tris.or_else(|| delaunay_fill(points, normals, &net.directed, &lp, &inner, axis)) {
+                        Some(tris) => {
+                            tris.into_iter().for_each(|t| net.add(t, None));
+                            filled += 1;
+                        }
+                        None => {
+                            open += 1;
+                            widen.extend(lp.iter().copied());
+                        }
+                    }
+                }
+            }
+        }
+        if widen.is_empty() || pass == HOLE_RETRIES {
+            return (filled, open, borders);
+        }
+        pass += 1;
+        net.tris.retain(|t| !t.iter().any(|v| widen.contains(v)));
+        net.directed = net.tris.iter().flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]).collect();
+        let used: HashSet<u32> = net.tris.iter().flatten().copied().collect();
+        orphans.retain(|v| !used.contains(v));
+        orphans.extend(widen.iter().copied().filter(|v| !used.contains(v)));
+        orphans.sort_unstable();
+        orphans.dedup();
+    }
+}
+
+/// Times a stuck gap is widened and filled again.
+const HOLE_RETRIES: usize = 3;
+
+/// The closed boundary loops of the net (vertex lists in the direction of
+/// their boundary edges), split where a loop passes a vertex twice.
+fn boundary_loops(net: &Net, frames: &Frames) -> Vec<Vec<u32>> {
     let mut out: HashMap<u32, Vec<u32>> = HashMap::new();
     let mut boundary: Vec<(u32, u32)> =
         net.directed.iter().filter(|(a, b)| !net.directed.contains(&(*b, *a))).copied().collect();
@@ -274,21 +328,7 @@ fn fill_holes(
             split_repeats(lp, &mut loops);
         }
     }
-    let (mut filled, mut open, mut borders) = (0, 0, 0);
-    for lp in loops {
-        match classify(points, normals, &lp, max_edges) {
-            LoopKind::Border => borders += 1,
-            LoopKind::TooLarge => open += 1,
-            LoopKind::Gap(axis) => {
-                if ear_clip(points, net, &lp, axis) {
-                    filled += 1;
-                } else {
-                    open += 1;
-                }
-            }
-        }
-    }
-    (filled, open, borders)
+    loops
 }
 
 /// Splits a closed vertex loop that passes a vertex twice into simple loops.
@@ -348,12 +388,22 @@ const COS_HOLE_TILT: f64 = 0.34;
 
 /// Fills the gap bounded by `lp` (clockwise about `axis`) by ear clipping in
 /// the plane normal to `axis`, best-shaped ear first; an ear whose closing
-/// edge exists elsewhere in the net is never cut. False when it gets stuck.
-fn ear_clip(points: &[DVec3], net: &mut Net, lp: &[u32], axis: DVec3) -> bool {
+/// edge exists elsewhere in the net is never cut. The triangles, or `None`
+/// when it gets stuck.
+fn ear_clip(
+    points: &[DVec3],
+    normals: &[DVec3],
+    directed: &HashSet<(u32, u32)>,
+    lp: &[u32],
+    axis: DVec3,
+) -> Option<Vec<[u32; 3]>> {
     let (u, w) = frame(axis);
     // Counter-clockwise about the axis.
     let mut poly: Vec<u32> = lp.iter().rev().copied().collect();
     let flat = |v: u32| DVec2::new(points[v as usize].dot(u), points[v as usize].dot(w));
+    let mut tris = Vec::with_capacity(lp.len());
+    // Diagonals cut so far: an ear may not cut one again.
+    let mut cut: Vec<(u32, u32)> = Vec::new();
     while poly.len() > 3 {
         let m = poly.len();
         let mut best: Option<(usize, f64)> = None;
@@ -363,7 +413,11 @@ fn ear_clip(points: &[DVec3], net: &mut Net, lp: &[u32], axis: DVec3) -> bool {
             if orient(fa, fb, fc) <= 0.0 {
                 continue;
             }
-            if net.directed.contains(&(c, a)) || net.directed.contains(&(a, c)) {
+            if directed.contains(&(c, a))
+                || directed.contains(&(a, c))
+                || cut.contains(&(a, c))
+                || cut.contains(&(c, a))
+            {
                 continue;
             }
             let inside = poly.iter().any(|&v| {
@@ -372,7 +426,7 @@ fn ear_clip(points: &[DVec3], net: &mut Net, lp: &[u32], axis: DVec3) -> bool {
                     orient(fa, fb, f) > 0.0 && orient(fb, fc, f) > 0.0 && orient(fc, fa, f) > 0.0
                 }
             });
-            if inside {
+            if inside || !faces_like_normals(points, normals, [a, b, c]) {
                 continue;
             }
             let q = min_angle(points[a as usize], points[b as usize], points[c as usize]);
@@ -380,17 +434,107 @@ fn ear_clip(points: &[DVec3], net: &mut Net, lp: &[u32], axis: DVec3) -> bool {
                 best = Some((i, q));
             }
         }
-        let Some((i, _)) = best else { return false };
+        let (i, _) = best?;
         let (a, b, c) = (poly[(i + m - 1) % m], poly[i], poly[(i + 1) % m]);
-        net.add([a, b, c], None);
+        tris.push([a, b, c]);
+        cut.push((a, c));
         poly.remove(i);
     }
     let t = [poly[0], poly[1], poly[2]];
-    if orient(flat(t[0]), flat(t[1]), flat(t[2])) <= 0.0 {
-        return false;
+    if orient(flat(t[0]), flat(t[1]), flat(t[2])) <= 0.0 || !faces_like_normals(points, normals, t) {
+        return None;
     }
-    net.add(t, None);
-    true
+    tris.push(t);
+    Some(tris)
+}
+
+/// Whether triangle `t` faces the side its corners' normals point to.
+fn faces_like_normals(points: &[DVec3], normals: &[DVec3], t: [u32; 3]) -> bool {
+    let [a, b, c] = t.map(|v| points[v as usize]);
+    let n = (b - a).cross(c - a);
+    t.iter().all(|&v| n.dot(normals[v as usize]) > 0.0)
+}
+
+/// The `candidates` that lie inside loop `lp` seen along `axis` (even-odd
+/// rule), facing like the loop and within its reach (a point on the far side
+/// of a closed surface also projects inside).
+fn inside_loop(points: &[DVec3], normals: &[DVec3], lp: &[u32], candidates: &[u32], axis: DVec3) -> Vec<u32> {
+    if candidates.is_empty() || lp.is_empty() {
+        return Vec::new();
+    }
+    let (u, w) = frame(axis);
+    let flat = |v: u32| DVec2::new(points[v as usize].dot(u), points[v as usize].dot(w));
+    let poly: Vec<DVec2> = lp.iter().map(|&v| flat(v)).collect();
+    let centre = lp.iter().map(|&v| points[v as usize]).sum::<DVec3>() / lp.len() as f64;
+    let reach = lp.iter().map(|&v| points[v as usize].distance(centre)).fold(0.0, f64::max);
+    candidates
+        .iter()
+        .copied()
+        .filter(|&v| {
+            !lp.contains(&v)
+                && normals[v as usize].dot(axis) > COS_HOLE_TILT
+                && points[v as usize].distance(centre) <= reach
+                && point_in_polygon(flat(v), &poly)
+        })
+        .collect()
+}
+
+/// Even-odd test of `p` against the closed polygon `poly`.
+fn point_in_polygon(p: DVec2, poly: &[DVec2]) -> bool {
+    let mut inside = false;
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+/// Fills the gap bounded by `lp` together with the points `inner` inside it:
+/// the 2-D Delaunay triangulation of them all, seen along `axis`, keeping the
+/// triangles inside the loop. `None` unless it closes the gap exactly: every
+/// loop edge matched, every inner point used, no edge that exists elsewhere
+/// in the net, every triangle facing like its corners' normals.
+fn delaunay_fill(
+    points: &[DVec3],
+    normals: &[DVec3],
+    directed: &HashSet<(u32, u32)>,
+    lp: &[u32],
+    inner: &[u32],
+    axis: DVec3,
+) -> Option<Vec<[u32; 3]>> {
+    let (u, w) = frame(axis);
+    let flat = |v: u32| DVec2::new(points[v as usize].dot(u), points[v as usize].dot(w));
+    let verts: Vec<u32> = lp.iter().chain(inner).copied().collect();
+    let pts: Vec<DVec2> = verts.iter().map(|&v| flat(v)).collect();
+    let poly: Vec<DVec2> = pts[..lp.len()].to_vec();
+    let mut tris = Vec::new();
+    for t in triangulate(&pts) {
+        let c = (pts[t[0]] + pts[t[1]] + pts[t[2]]) / 3.0;
+        if point_in_polygon(c, &poly) {
+            tris.push([verts[t[0]], verts[t[1]], verts[t[2]]]);
+        }
+    }
+    let mut made: HashSet<(u32, u32)> = HashSet::new();
+    for t in &tris {
+        if !faces_like_normals(points, normals, *t) {
+            return None;
+        }
+        for k in 0..3 {
+            let e = (t[k], t[(k + 1) % 3]);
+            if directed.contains(&e) || !made.insert(e) {
+                return None;
+            }
+        }
+    }
+    // Every loop edge a→b (a boundary edge of the net) is closed by b→a; the
+    // other edges made are inner ones, each with its twin.
+    let m = lp.len();
+    let closes = (0..m).all(|i| made.contains(&(lp[(i + 1) % m], lp[i])));
+    let twins = made.iter().all(|&(a, b)| made.contains(&(b, a)) || directed.contains(&(b, a)));
+    let used: HashSet<u32> = tris.iter().flatten().copied().collect();
+    (closes && twins && inner.iter().all(|v| used.contains(v))).then_some(tris)
 }
 
 /// The smoothness criterion (see the module documentation). Returns the number of swaps.

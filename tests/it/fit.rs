@@ -201,6 +201,48 @@ fn torus_points_give_a_closed_g1_surface_of_genus_one() {
     assert_eq!(fit.surface.points.len() as i64 - edges as i64 + fit.net.len() as i64, 0);
 }
 
+/// Uniform random points with no spacing rule: clusters and gaps of every
+/// size, where the local umbrellas overlap and leave gaps ear clipping alone
+/// cannot close (the gap is widened and refilled).
+#[test]
+fn uniformly_random_points_with_clusters_and_gaps_give_closed_g1_surfaces() {
+    for seed in [1, 4] {
+        let mut rng = Rng(seed * 7919);
+        let pts: Vec<DVec3> = (0..500)
+            .map(|_| {
+                let z = 2.0 * rng.next() - 1.0;
+                let t = std::f64::consts::TAU * rng.next();
+                let s = (1.0 - z * z).sqrt();
+                DVec3::new(s * t.cos(), s * t.sin(), z)
+            })
+            .collect();
+        let fit = fit_points(&pts, &FitOptions::default()).unwrap();
+        let f = measure(&format!("uniform sphere seed {seed}"), &pts, &fit, 4, |p| (p.length() - 1.0).abs());
+        assert!(f.max_distance < 0.05, "distance {}", f.max_distance);
+        assert_eq!((fit.report.boundary_edges, fit.report.nonmanifold_edges, fit.report.holes_open), (0, 0, 0));
+        assert!(fit.report.warnings.is_empty(), "{:?}", fit.report.warnings);
+    }
+    // A torus uniform in its angles: twice as dense inside as outside.
+    let (big, small) = (2.0, 0.7);
+    let mut rng = Rng(31);
+    let pts: Vec<DVec3> = (0..1000)
+        .map(|_| {
+            let (u, v) = (std::f64::consts::TAU * rng.next(), std::f64::consts::TAU * rng.next());
+            let w = big + small * v.cos();
+            DVec3::new(w * u.cos(), w * u.sin(), small * v.sin())
+        })
+        .collect();
+    let fit = fit_points(&pts, &FitOptions::default()).unwrap();
+    let f = measure("uniform-angle torus", &pts, &fit, 4, |p| {
+        let q = DVec2::new(DVec2::new(p.x, p.y).length() - big, p.z);
+        (q.length() - small).abs()
+    });
+    // Sparse outside: the largest deviation is where the gaps are widest.
+    assert!(f.max_distance < 0.2 * small, "distance {}", f.max_distance);
+    assert_eq!((fit.report.boundary_edges, fit.report.nonmanifold_edges, fit.report.holes_open), (0, 0, 0));
+    assert!(fit.report.warnings.is_empty(), "{:?}", fit.report.warnings);
+}
+
 /// Two unit spheres at x = ±1.15 joined by a smooth-minimum blend (k = 3):
 /// `f = −ln(e^(−k d1) + e^(−k d2)) / k`, `d_i` the distance to sphere i; the
 /// surface is `f = 0`, with a neck of radius about 0.44 at x = 0.
