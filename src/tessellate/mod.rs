@@ -69,6 +69,7 @@ pub fn mesh_model_with_progress(
     let mut outcomes: Vec<refine::Outcome> = Vec::with_capacity(model.faces.len());
     let mut fit_errors: Vec<f64> = Vec::with_capacity(model.faces.len());
     let mut used = 0usize;
+    let mut first_failure: Option<Error> = None;
     for (index, original) in model.faces.iter().enumerate() {
         let (mut f, mut fit_error) = match rebuilt.get(index) {
             Some(Some(r)) => (&r.face, r.fit_error),
@@ -80,11 +81,13 @@ pub fn mesh_model_with_progress(
             report
                 .warnings
                 .push(format!("face {index}: skipped, the triangle budget {} is spent", options.max_triangles));
+            push_empty(&mut works, &mut outcomes, &mut fit_errors, f);
             continue;
         }
         if !face_is_supported(f) {
             report.faces_skipped += 1;
             report.warnings.push(format!("face {index}: trimmed faces need the default `std` feature (CDT); skipped"));
+            push_empty(&mut works, &mut outcomes, &mut fit_errors, f);
             continue;
         }
         // A rebuilt face is meshed within what its fit error leaves of the tolerance.
@@ -101,7 +104,22 @@ pub fn mesh_model_with_progress(
             (f, fit_error) = (original, 0.0);
             fr = face::mesh_face(index, f, &lim, &crit, budget);
         }
-        let mut fr = fr?;
+        let mut fr = match fr {
+            Ok(fr) => fr,
+            // One face that cannot be meshed does not sink the others; a
+            // model where none can is the first face's error.
+            Err(Error::Mesh { face, message }) if model.faces.len() > 1 => {
+                report.faces_skipped += 1;
+                report.warnings.push(format!("face {index}: skipped: {message}"));
+                first_failure.get_or_insert(Error::Mesh { face, message });
+                push_empty(&mut works, &mut outcomes, &mut fit_errors, f);
+                if !progress(index + 1, model.faces.len()) {
+                    return Err(Error::Cancelled);
+                }
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         if fit_error > 0.0 {
             // Reported against the original face: the mesh's distance to the new one plus the fit error.
             for m in &mut fr.outcome.measures {
@@ -126,6 +144,9 @@ pub fn mesh_model_with_progress(
         if !progress(index + 1, model.faces.len()) {
             return Err(Error::Cancelled);
         }
+    }
+    if let Some(e) = first_failure.filter(|_| works.iter().all(|w| w.mesh.tris.is_empty())) {
+        return Err(e);
     }
     // Make shared borders conform, then measure again what sewing touched.
     let sew_tol = options.sew.unwrap_or_else(|| {
@@ -270,6 +291,18 @@ fn setup(model: &Model, options: &MeshOptions) -> Result<Setup, Error> {
     let lim = params::Limits { tol: aim, angle: options.angle, max_edge, min_edge };
     let crit = refine::Criteria { tol: aim, angle: options.angle, max_edge, min_edge, steps: options.measure_steps };
     Ok(Setup { tol, diag, lim, crit })
+}
+
+/// Records a face that produced nothing, so face ranges still match faces.
+fn push_empty<'a>(
+    works: &mut Vec<sew::FaceWork<'a>>,
+    outcomes: &mut Vec<refine::Outcome>,
+    fit_errors: &mut Vec<f64>,
+    f: &'a crate::Face,
+) {
+    works.push(sew::FaceWork { surface: &f.surface, curves: Vec::new(), mesh: Default::default() });
+    outcomes.push(Default::default());
+    fit_errors.push(0.0);
 }
 
 fn face_is_supported(f: &crate::Face) -> bool {

@@ -227,6 +227,36 @@ fn mesh_rejects_crossing_loops() {
     assert!(msg.contains("crosses itself"), "{msg}");
 }
 
+/// One face whose loops cross does not sink a model of several: it is
+/// skipped with a warning naming it, its face range stays (empty) so ranges
+/// still match faces, and the others mesh. When no face meshes, the first
+/// face's error is the model's.
+#[test]
+fn mesh_skips_a_bad_face_among_good_ones() {
+    let outer = uv_polygon(&[(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9)]);
+    let a = uv_polygon(&[(0.3, 0.3), (0.6, 0.3), (0.6, 0.6), (0.3, 0.6)]);
+    let b = uv_polygon(&[(0.5, 0.5), (0.8, 0.5), (0.8, 0.8), (0.5, 0.8)]);
+    let bad = face_with_loops(vec![outer.clone(), a, b]).faces.remove(0);
+    let good = face_with_loops(vec![outer]).faces.remove(0);
+    let mut model = face_with_loops(vec![]);
+    model.faces = vec![good.clone(), bad.clone(), good];
+    let r = mesh_model(&model, &MeshOptions::default()).expect("the good faces mesh");
+    assert_eq!(r.report.faces_skipped, 1);
+    assert!(
+        r.report.warnings.iter().any(|w| w.starts_with("face 1: skipped") && w.contains("crosses")),
+        "{:?}",
+        r.report.warnings
+    );
+    let counts: Vec<u32> = r.mesh.face_ranges.iter().map(|f| f.count).collect();
+    assert_eq!(counts.len(), 3);
+    assert!(counts[0] > 0 && counts[1] == 0 && counts[2] == counts[0], "{counts:?}");
+    assert_eq!(r.report.triangles as u32, counts[0] + counts[2]);
+
+    model.faces = vec![bad.clone(), bad];
+    let err = mesh_model(&model, &MeshOptions::default()).expect_err("no face meshes");
+    assert!(matches!(err, Error::Mesh { face: 0, .. }), "{err}");
+}
+
 #[test]
 fn mesh_rejects_bad_options() {
     let model = shapes::freeform();
