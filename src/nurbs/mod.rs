@@ -110,7 +110,7 @@ fn collapsed_normal(d: &SurfaceDerivs) -> Option<DVec3> {
 /// product is below `1e-10 (|Su|² + |Sv|²)`, i.e. one derivative is ten
 /// orders of magnitude shorter than the other (a collapsed edge, where what is
 /// left of it is rounding noise pointing anywhere) or the two are parallel.
-fn regular_normal(d: &SurfaceDerivs) -> Option<DVec3> {
+pub(crate) fn regular_normal(d: &SurfaceDerivs) -> Option<DVec3> {
     const DEGENERATE: f64 = 1e-10;
     let n = d.su.cross(d.sv);
     let len = n.length();

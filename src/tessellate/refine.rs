@@ -9,7 +9,7 @@ use hashbrown::HashMap;
 
 use super::measure::{measure_projection, measure_triangle, TriMeasure};
 use crate::math::angle_between;
-use crate::nurbs::{project_to_surface, NurbsCurve, Surface};
+use crate::nurbs::{project_to_surface, regular_normal, NurbsCurve, Surface};
 
 const NONE: u32 = u32::MAX;
 
@@ -109,8 +109,31 @@ impl WorkMesh {
         let v = self.tris[t];
         let p = [self.pos[v[0] as usize], self.pos[v[1] as usize], self.pos[v[2] as usize]];
         let m = measure_triangle(surface, &p, &self.uvs[t], c.steps, &measure_projection());
-        let n = [self.normal[v[0] as usize], self.normal[v[1] as usize], self.normal[v[2] as usize]];
-        let turn = angle_between(n[0], n[1]).max(angle_between(n[1], n[2])).max(angle_between(n[2], n[0]));
+        let mut n = [self.normal[v[0] as usize], self.normal[v[1] as usize], self.normal[v[2] as usize]];
+        let turn_of =
+            |n: &[DVec3; 3]| angle_between(n[0], n[1]).max(angle_between(n[1], n[2])).max(angle_between(n[2], n[0]));
+        let mut turn = turn_of(&n);
+        if turn > c.angle {
+            // Where the surface collapses (a cone's apex) it has no one
+            // normal: a triangle there turns by what it sees from its side.
+            let uv = self.uvs[t];
+            let centre = (uv[0] + uv[1] + uv[2]) / 3.0;
+            let mut any = false;
+            for k in 0..3 {
+                if regular_normal(&surface.derivs(uv[k])).is_none() {
+                    let limit = [1e-6, 1e-4, 1e-2]
+                        .iter()
+                        .find_map(|f| regular_normal(&surface.derivs(uv[k] + (centre - uv[k]) * *f)));
+                    if let Some(l) = limit {
+                        n[k] = l;
+                        any = true;
+                    }
+                }
+            }
+            if any {
+                turn = turn_of(&n);
+            }
+        }
         (m, turn)
     }
 

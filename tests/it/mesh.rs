@@ -6,7 +6,7 @@
 use glam::{DVec2, DVec3};
 use surfmesh::{
     mesh_model, project_to_surface, Error, Face, FaceSurface, Mesh, MeshOptions, MeshResult, Model, NurbsCurve,
-    ProjectionOptions, Surface, TrimLoop,
+    NurbsSurface, ProjectionOptions, Surface, TrimLoop,
 };
 
 use crate::shapes;
@@ -255,6 +255,35 @@ fn mesh_skips_a_bad_face_among_good_ones() {
     model.faces = vec![bad.clone(), bad];
     let err = mesh_model(&model, &MeshOptions::default()).expect_err("no face meshes");
     assert!(matches!(err, Error::Mesh { face: 0, .. }), "{err}");
+}
+
+/// A right circular cone whose apex is a collapsed edge of its NURBS (radius
+/// 10, height 10: the normal jumps at the apex). The triangles round the
+/// apex are judged by the normals next to it on their own side, so they
+/// meet the angle limit instead of being split down to the minimum edge.
+#[test]
+fn mesh_cone_apex_meets_the_angle_limit() {
+    let (circle, cw) = shapes::unit_circle();
+    let points: Vec<Vec<DVec3>> =
+        circle.iter().map(|c| vec![DVec3::new(0.0, 0.0, 10.0), DVec3::new(10.0 * c.x, 10.0 * c.y, 0.0)]).collect();
+    let weights: Vec<Vec<f64>> = cw.iter().map(|&w| vec![w, w]).collect();
+    let surface =
+        NurbsSurface::try_new([2, 1], shapes::CIRCLE_KNOTS.to_vec(), vec![0.0, 0.0, 1.0, 1.0], &points, Some(&weights))
+            .expect("cone");
+    let mut model = face_with_loops(vec![]);
+    model.faces[0].surface = FaceSurface::Nurbs(surface);
+    for rel in RELS {
+        let r = mesh(&model, rel);
+        let rep = &r.report;
+        assert!(rep.warnings.iter().all(|w| !w.contains("exceed")), "{rel}: {:?}", rep.warnings);
+        assert!(rep.max_deviation <= rep.tolerance, "{rel}: {} > {}", rep.max_deviation, rep.tolerance);
+        assert_eq!(rep.inverted_triangles, 0);
+        // A cone is flat along its rulings: a fan of a few dozen to a few hundred triangles, not thousands.
+        assert!(rep.triangles < 400, "{rel}: {} triangles", rep.triangles);
+        // Exact distance to the cone's side: (ρ + z − 10)/√2 for ρ = |(x, y)|.
+        let dev = exact_deviation(&r.mesh, |p| ((p.x.hypot(p.y) + p.z - 10.0) / 2f64.sqrt()).abs());
+        assert!(dev <= rep.tolerance, "{rel}: exact deviation {dev} > {}", rep.tolerance);
+    }
 }
 
 #[test]
