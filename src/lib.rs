@@ -32,7 +32,10 @@ pub use fit::{
     fit_points, read_points, Cubic, FitOptions, FitPolygon, FitReport, FitResult, FitSurface, PatchPoint, PointFormat,
     TriPatch, MAX_FILE_POINTS,
 };
-pub use io::{read_iges, read_json, read_mesh, read_model, write_glb, write_obj, write_stl, Format, MeshFormat};
+pub use io::{
+    read_iges, read_json, read_mesh, read_model, read_msh, write_glb, write_msh, write_obj, write_stl, write_unv,
+    Format, MeshFormat, UNV_SHELL_TRIANGLE,
+};
 pub use measure::{measure_mesh, MeasureOptions, MeshMeasure};
 pub use mesh::{angle_stats, edge_counts, weld_mesh, weld_positions, AngleStats, EdgeCounts, FaceRange, Mesh, Report};
 pub use model::{Face, FaceSurface, Model, TrimLoop};

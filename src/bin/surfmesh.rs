@@ -16,7 +16,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use args::{Command, MeshArgs, OutputFormat};
-use surfmesh::{mesh_model, read_model, write_glb, write_obj, write_stl, Error, Format};
+use surfmesh::{mesh_model, read_model, write_glb, write_msh, write_obj, write_stl, write_unv, Error, Format};
 
 fn main() -> ExitCode {
     match args::parse(std::env::args_os().skip(1).collect()) {
@@ -90,6 +90,8 @@ fn mesh(m: &MeshArgs) -> Result<(), String> {
             OutputFormat::Stl => write_stl(&result.mesh),
             OutputFormat::Obj => write_obj(&result.mesh),
             OutputFormat::Glb => write_glb(&result.mesh),
+            OutputFormat::Msh => write_msh(&result.mesh),
+            OutputFormat::Unv => write_unv(&result.mesh),
         };
         files.push((path, bytes));
     }

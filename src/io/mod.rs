@@ -4,9 +4,11 @@ mod glb;
 mod iges;
 mod json;
 mod meshfile;
+mod msh;
 mod obj;
 mod step;
 mod stl;
+mod unv;
 
 use alloc::format;
 
@@ -15,8 +17,10 @@ pub use iges::read_iges;
 pub use json::read_json;
 pub(crate) use meshfile::MAX_COORDINATE;
 pub use meshfile::{read_mesh, MeshFormat};
+pub use msh::{read_msh, write_msh};
 pub use obj::write_obj;
 pub use stl::write_stl;
+pub use unv::{write_unv, UNV_SHELL_TRIANGLE};
 
 use crate::{Error, Model};
 

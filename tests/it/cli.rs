@@ -505,7 +505,7 @@ fn cli_usage_errors_exit_2() {
         (vec!["mesh", p, "--mode", "slow"], "--mode"),
         (vec!["mesh", p, "--reparam", "sometimes"], "--reparam must be auto, off or force"),
         (vec!["mesh", p, "--format", "dxf"], "--format"),
-        (vec!["mesh", p, "-o", "out.ply"], ".stl, .obj or .glb"),
+        (vec!["mesh", p, "-o", "out.ply"], ".stl, .obj, .glb, .msh or .unv"),
         (vec!["mesh", p, p], "more than one input"),
     ] {
         let out = Command::new(BIN).args(&args).output().unwrap();

@@ -5,6 +5,7 @@ mod fit;
 mod iges;
 mod mesh;
 mod nurbs;
+mod quality;
 mod repair;
 mod reparam;
 mod shapes;

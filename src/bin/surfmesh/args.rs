@@ -45,6 +45,10 @@ pub enum OutputFormat {
     Obj,
     /// Binary glTF 2.0.
     Glb,
+    /// Gmsh MSH 4.1 ASCII.
+    Msh,
+    /// I-DEAS universal file (datasets 2411, 2412).
+    Unv,
 }
 
 /// The usage text printed by `--help`.
@@ -66,7 +70,8 @@ Options of `mesh`:
   --reparam MODE      rebuild poorly parameterized faces before meshing: off
                       (default), auto (faces the step-ratio test flags), force
   --format json|iges  input format (default: from the extension, else from the content)
-  -o, --output FILE   write the mesh; .stl, .obj or .glb picks the format
+  -o, --output FILE   write the mesh; .stl, .obj, .glb, .msh (Gmsh 4.1) or
+                      .unv (universal file) picks the format
   --report FILE       write the JSON report (printed to stdout when neither
                       -o nor --report is given)
 
@@ -183,6 +188,8 @@ pub fn output_format(path: &std::path::Path) -> Result<OutputFormat, String> {
         "stl" => Ok(OutputFormat::Stl),
         "obj" => Ok(OutputFormat::Obj),
         "glb" => Ok(OutputFormat::Glb),
-        _ => Err(format!("-o {}: the file name must end in .stl, .obj or .glb", path.display())),
+        "msh" => Ok(OutputFormat::Msh),
+        "unv" => Ok(OutputFormat::Unv),
+        _ => Err(format!("-o {}: the file name must end in .stl, .obj, .glb, .msh or .unv", path.display())),
     }
 }

@@ -128,6 +128,8 @@ pub fn run(a: &FitArgs) -> Result<(), String> {
             OutputFormat::Stl => write_stl(&result.mesh),
             OutputFormat::Obj => write_obj(&result.mesh),
             OutputFormat::Glb => write_glb(&result.mesh),
+            OutputFormat::Msh => surfmesh::write_msh(&result.mesh),
+            OutputFormat::Unv => surfmesh::write_unv(&result.mesh),
         };
         files.push((path, bytes));
     }

@@ -157,6 +157,8 @@ fn encode(mesh: &Mesh, kind: OutputFormat) -> Vec<u8> {
         OutputFormat::Stl => write_stl(mesh),
         OutputFormat::Obj => write_obj(mesh),
         OutputFormat::Glb => write_glb(mesh),
+        OutputFormat::Msh => surfmesh::write_msh(mesh),
+        OutputFormat::Unv => surfmesh::write_unv(mesh),
     }
 }
 
