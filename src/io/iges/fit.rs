@@ -27,6 +27,10 @@ pub(super) struct Track {
     pub model: bool,
     pub ts: Vec<f64>,
     pub qs: Vec<DVec2>,
+    /// Coordinates that are arbitrary at the first and at the last sample
+    /// (on an axis or a pole): there the track may meet its neighbours at
+    /// another value of that coordinate.
+    pub free_ends: [[bool; 2]; 2],
     /// Whether a sample far off the surface may still be retried by a global search.
     retry: bool,
 }
@@ -46,11 +50,17 @@ pub(super) fn unwrap_near(mut q: DVec2, near: DVec2, periods: [Option<f64>; 2]) 
 impl Track {
     /// Native coordinates at `t`, continuous with `near` (free coordinates
     /// taken from it, periods unwrapped towards it).
-    fn at(&mut self, def: &SurfDef, t: f64, near: Option<DVec2>, periods: [Option<f64>; 2]) -> DVec2 {
+    pub(in crate::io) fn at(
+        &mut self,
+        def: &SurfDef,
+        t: f64,
+        near: Option<DVec2>,
+        periods: [Option<f64>; 2],
+    ) -> (DVec2, [bool; 2]) {
         let p = self.curve.point(t);
         if !self.model {
             let q = p.truncate();
-            return near.map_or(q, |n| unwrap_near(q, n, periods));
+            return (near.map_or(q, |n| unwrap_near(q, n, periods)), [false; 2]);
         }
         let nat = def.invert(p, near, &mut self.retry);
         let mut q = nat.q;
@@ -62,7 +72,74 @@ impl Track {
             }
             q = unwrap_near(q, n, periods);
         }
-        q
+        (q, nat.free)
+    }
+
+    /// A straight segment from `a` to `b` in native coordinates (a link
+    /// along a seam, a pole or a boundary that the file leaves implicit).
+    pub(in crate::io) fn link(a: DVec2, b: DVec2) -> Option<Self> {
+        let curve = crate::nurbs::analytic::line(a.extend(0.0), b.extend(0.0), 0.0, 1.0).ok()?;
+        let ts: Vec<f64> = (0..=16).map(|i| i as f64 / 16.0).collect();
+        let qs = ts.iter().map(|&t| a.lerp(b, t)).collect();
+        Some(Self { curve, model: false, ts, qs, free_ends: [[false; 2]; 2], retry: true })
+    }
+
+    /// The track cut where its coordinate `k` first crosses `c` modulo the
+    /// period `p` (found by bisection on the curve's parameter): the part
+    /// before and the part after, or `None` when it does not cross.
+    pub(in crate::io) fn split_at(
+        &mut self,
+        def: &SurfDef,
+        k: usize,
+        c: f64,
+        p: f64,
+        periods: [Option<f64>; 2],
+    ) -> Option<(Self, Self)> {
+        let cell = |x: f64| libm::floor((x - c) / p);
+        let i = (0..self.qs.len().saturating_sub(1)).find(|&i| cell(self.qs[i][k]) != cell(self.qs[i + 1][k]))?;
+        let (x0, x1) = (self.qs[i][k], self.qs[i + 1][k]);
+        let target = c + p * cell(x0).max(cell(x1));
+        let (mut lo, mut hi) = (self.ts[i], self.ts[i + 1]);
+        let mut near = self.qs[i];
+        let mut at_hi = self.qs[i + 1];
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            let (q, _) = self.at(def, mid, Some(near), periods);
+            if (q[k] - target) * (x0 - target) > 0.0 {
+                lo = mid;
+                near = q;
+            } else {
+                hi = mid;
+                at_hi = q;
+            }
+        }
+        let mut cut = at_hi;
+        cut[k] = target;
+        let t = hi;
+        let mut a = Self {
+            curve: self.curve.clone(),
+            model: self.model,
+            ts: self.ts[..=i].to_vec(),
+            qs: self.qs[..=i].to_vec(),
+            free_ends: [self.free_ends[0], [false; 2]],
+            retry: self.retry,
+        };
+        let mut b = Self {
+            curve: self.curve.clone(),
+            model: self.model,
+            ts: alloc::vec![t],
+            qs: alloc::vec![cut],
+            free_ends: [[false; 2], self.free_ends[1]],
+            retry: self.retry,
+        };
+        let after = if self.ts[i + 1] > t { i + 1 } else { i + 2 };
+        b.ts.extend_from_slice(self.ts.get(after..).unwrap_or(&[]));
+        b.qs.extend_from_slice(self.qs.get(after..).unwrap_or(&[]));
+        if t > self.ts[i] {
+            a.ts.push(t);
+            a.qs.push(cut);
+        }
+        (a.ts.len() >= 2 && b.ts.len() >= 2).then_some((a, b))
     }
 
     /// Samples `curve` at [`MIN_SAMPLES`] even parameters plus its inner
@@ -82,19 +159,33 @@ impl Track {
             ts.sort_by(f64::total_cmp);
             ts.dedup_by(|x, y| (*x - *y).abs() <= 1e-12 * (b - a));
         }
-        let mut tr = Self { curve, model, ts, qs: Vec::new(), retry: true };
-        // Coordinates free at a sample (on an axis, at a pole) follow the
-        // next sample that has them: first a backward pass for free starts.
+        let mut tr = Self { curve, model, ts, qs: Vec::new(), free_ends: [[false; 2]; 2], retry: true };
         let mut qs: Vec<DVec2> = Vec::with_capacity(tr.ts.len());
+        let mut free: Vec<[bool; 2]> = Vec::with_capacity(tr.ts.len());
         let mut near = start;
         for i in 0..tr.ts.len() {
-            let q = tr.at(def, tr.ts[i], near, periods);
+            let (q, f) = tr.at(def, tr.ts[i], near, periods);
             qs.push(q);
+            free.push(f);
             near = Some(q);
         }
-        if start.is_none() && model && qs.len() > 1 {
-            // The first sample had no neighbour: redo it from the second.
-            qs[0] = tr.at(def, tr.ts[0], Some(qs[1]), periods);
+        // A coordinate free at the ends (the curve starts or ends on an
+        // axis, at a pole) takes the value of the nearest sample that has
+        // one, so the track leaves the pole along its own direction.
+        for k in 0..2 {
+            if let Some(i0) = free.iter().position(|f| !f[k]) {
+                for i in 0..i0 {
+                    qs[i][k] = qs[i0][k];
+                }
+            }
+            if let Some(i1) = free.iter().rposition(|f| !f[k]) {
+                for i in i1 + 1..qs.len() {
+                    qs[i][k] = qs[i1][k];
+                }
+            }
+        }
+        if let (Some(f0), Some(f1)) = (free.first(), free.last()) {
+            tr.free_ends = [*f0, *f1];
         }
         tr.qs = qs;
         tr
@@ -148,7 +239,7 @@ impl Track {
                     continue;
                 }
                 let tm = 0.5 * (t0 + t1);
-                let qm = self.at(def, tm, Some(0.5 * (self.qs[i] + self.qs[i + 1])), periods);
+                let (qm, _) = self.at(def, tm, Some(0.5 * (self.qs[i] + self.qs[i + 1])), periods);
                 let exact = surface.point(map(qm));
                 let hm = (ws[i] + ws[i + 1]) * 0.5 + (ms[i] - ms[i + 1]) * (h / 8.0);
                 if surface.point(hm).distance(exact) > tol {

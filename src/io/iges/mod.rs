@@ -17,8 +17,8 @@ mod directory;
 mod faces;
 mod fit;
 mod lexer;
-mod loops;
-mod surfaces;
+pub(super) mod loops;
+pub(super) mod surfaces;
 mod untangle;
 mod xform;
 

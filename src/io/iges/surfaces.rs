@@ -30,7 +30,7 @@ const TAU: f64 = core::f64::consts::TAU;
 
 /// A surface as read, before its NURBS is fixed.
 #[derive(Debug, Clone)]
-pub(super) enum SurfDef {
+pub(in crate::io) enum SurfDef {
     /// A B-spline surface whose parameters are its native coordinates.
     Nurbs {
         surface: NurbsSurface,
@@ -50,7 +50,7 @@ pub(super) enum SurfDef {
 /// A surface of revolution: `profile` lies in the half-plane spanned by
 /// `axis` and `xref` (angle 0); angles turn right-handed about `axis`.
 #[derive(Debug, Clone)]
-pub(super) struct Revolution {
+pub(in crate::io) struct Revolution {
     pub origin: DVec3,
     pub axis: DVec3,
     pub xref: DVec3,
@@ -62,7 +62,7 @@ pub(super) struct Revolution {
 /// The meridian curve of a [`Revolution`], in half-plane coordinates
 /// `(r, h)` = (distance from the axis, height along it).
 #[derive(Debug, Clone)]
-pub(super) enum Profile {
+pub(in crate::io) enum Profile {
     /// `p0 + t·d`, `t` unbounded (cylinder, cone).
     Line { p0: DVec2, d: DVec2 },
     /// `c + ρ·(cos φ, sin φ)`; `range` bounds φ (`None`: whole turns).
@@ -73,7 +73,7 @@ pub(super) enum Profile {
 
 /// How a native coordinate becomes the NURBS parameter.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) enum AxisMap {
+pub(in crate::io) enum AxisMap {
     Identity,
     Arc(ArcParam),
 }
@@ -90,7 +90,7 @@ impl AxisMap {
 /// A point's native coordinates, and which of them are arbitrary there
 /// (the angle on the axis, the parameter along a collapsed edge).
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Native {
+pub(in crate::io) struct Native {
     pub q: DVec2,
     pub free: [bool; 2],
 }
@@ -365,7 +365,7 @@ fn plane(m: &DAffine3, o: DVec3, x: DVec3, y: DVec3) -> SurfDef {
 }
 
 /// A B-spline surface definition, with its closedness detected.
-fn nurbs_def(surface: NurbsSurface) -> SurfDef {
+pub(in crate::io) fn nurbs_def(surface: NurbsSurface) -> SurfDef {
     let periods = closed_periods(&surface);
     SurfDef::Nurbs { surface, periods, natural: None }
 }
@@ -523,7 +523,7 @@ fn power_to_bezier_2d(c: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
 }
 
 /// A NURBS surface with control points mapped by `m` (exact: affine).
-pub(super) fn map_surface(s: &NurbsSurface, m: &DAffine3) -> Result<NurbsSurface, crate::NurbsError> {
+pub(in crate::io) fn map_surface(s: &NurbsSurface, m: &DAffine3) -> Result<NurbsSurface, crate::NurbsError> {
     let [nu, nv] = s.counts();
     let mut pts = Vec::with_capacity(nu);
     let mut ws = Vec::with_capacity(nu);
