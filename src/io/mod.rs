@@ -19,6 +19,7 @@ pub(crate) use meshfile::MAX_COORDINATE;
 pub use meshfile::{read_mesh, MeshFormat};
 pub use msh::{read_msh, write_msh};
 pub use obj::write_obj;
+pub use step::{read_step, read_step_with_shells, StepShell};
 pub use stl::write_stl;
 pub use unv::{write_unv, UNV_SHELL_TRIANGLE};
 
@@ -32,6 +33,8 @@ pub enum Format {
     Json,
     /// IGES 5.3, fixed 80-column ASCII form (`.igs`, `.iges`).
     Iges,
+    /// STEP, ISO 10303-21 exchange structure (`.stp`, `.step`, `.p21`): AP203, AP214, AP242 B-reps.
+    Step,
 }
 
 impl Format {
@@ -45,18 +48,24 @@ impl Format {
             Ok(Self::Json)
         } else if n.eq_ignore_ascii_case("igs") || n.eq_ignore_ascii_case("iges") {
             Ok(Self::Iges)
+        } else if ["stp", "step", "p21"].iter().any(|x| n.eq_ignore_ascii_case(x)) {
+            Ok(Self::Step)
         } else {
-            Err(Error::Format(format!("unknown input format '{name}' (expected json, igs or iges)")))
+            Err(Error::Format(format!("unknown input format '{name}' (expected json, igs, iges, stp, step or p21)")))
         }
     }
 
     /// Guesses the format from the first bytes: `{` after white space is
-    /// JSON; a first line of at least 73 columns with `S` or `G` in column 73
+    /// JSON; `ISO-10303-21;` after white space is STEP; a first line of at least 73 columns with `S` or `G` in column 73
     /// (and a sequence number after it, when the line is 80 columns) is IGES.
     pub fn detect(bytes: &[u8]) -> Option<Self> {
         let first = bytes.iter().find(|b| !b.is_ascii_whitespace())?;
         if *first == b'{' {
             return Some(Self::Json);
+        }
+        let start = bytes.iter().position(|b| !b.is_ascii_whitespace()).unwrap_or(0);
+        if bytes.get(start..start + 13).is_some_and(|m| m == b"ISO-10303-21;") {
+            return Some(Self::Step);
         }
         let line = bytes.split(|&b| b == b'\n').next()?;
         let line = line.strip_suffix(b"\r").unwrap_or(line);
@@ -74,5 +83,6 @@ pub fn read_model(bytes: &[u8], format: Format) -> Result<Model, Error> {
     match format {
         Format::Json => read_json(bytes),
         Format::Iges => read_iges(bytes),
+        Format::Step => read_step(bytes),
     }
 }

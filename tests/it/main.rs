@@ -9,3 +9,4 @@ mod quality;
 mod repair;
 mod reparam;
 mod shapes;
+mod step;

@@ -220,6 +220,10 @@ impl<'g> Ent<'g> {
         for &(name, n) in chain {
             match self.part(name) {
                 Some(p) if p.vals.len() >= n => vals.extend_from_slice(&p.vals[..n]),
+                // Some writers leave the name out: `REPRESENTATION_ITEM()`.
+                Some(p) if name == "REPRESENTATION_ITEM" && p.vals.is_empty() => {
+                    vals.extend(core::iter::repeat_n(Value::Omitted, n));
+                }
                 Some(p) => {
                     return Err(self.error(format!("part {name} has {} parameters, {n} expected", p.vals.len())));
                 }
@@ -280,6 +284,7 @@ impl<'g> Attrs<'g> {
     }
 
     /// Value `i` as is.
+    #[cfg(test)]
     pub fn value(&self, i: usize) -> Result<Value, Error> {
         self.at(i)
     }
@@ -432,14 +437,6 @@ impl Graph {
                 Value::List { start, len } => Some(self.slice(*start, *len)),
                 _ => None,
             },
-            _ => None,
-        }
-    }
-
-    /// The string of a string value.
-    pub fn string(&self, v: Value) -> Option<&str> {
-        match v {
-            Value::Str { start, len } => Some(self.str_of(start, len)),
             _ => None,
         }
     }

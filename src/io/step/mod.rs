@@ -1,22 +1,106 @@
 //! STEP reader (ISO 10303-21, AP203 / AP214 / AP242 boundary representations
-//! with assemblies): bytes in, [`crate::Model`] out.
+//! with assemblies): bytes in, [`Model`] out.
 //!
 //! The exchange structure is parsed into a flat graph ([`parser`],
 //! [`graph`]) whose checked accessors name the `#id` and line of any
-//! problem. Nesting, counts and sizes are capped, so no input can make the
-//! reader loop or allocate without bound.
+//! problem. Representations, their items and the assembly relations between
+//! them give every solid, shell and surface set with its placement and unit
+//! ([`assembly`]); each face of a shell becomes a surface definition shared
+//! with the IGES reader ([`surfaces`]) bounded by its edges' model-space
+//! curves, cut between their vertices ([`curves`], [`edges`]), which the
+//! shared face builder projects into the surface's parameters ([`shapes`]).
+//! A face that cannot be read is skipped with a warning naming its `#id`; a
+//! malformed file is an [`Error::Step`] naming the instance and line.
+//! Nesting, counts and sizes are capped, so no input can make the reader
+//! loop or allocate without bound.
 
-// The geometry reader that uses the graph lands next.
-#![allow(dead_code)]
-
+mod assembly;
+mod curves;
+mod edges;
 mod graph;
 mod parser;
+mod shapes;
+mod surfaces;
 
 use alloc::string::String;
+use alloc::vec::Vec;
+use core::ops::Range;
 
-use crate::Error;
+use crate::{Error, Model};
+
+/// Deepest chain of references followed (composite curves, offsets,
+/// trimmed curves of trimmed curves, assembly levels).
+const MAX_DEPTH: usize = 32;
+/// Most faces the reader produces (after assembly instancing).
+const MAX_FACES: usize = 1_000_000;
+/// Most control points of one curve or surface.
+const MAX_CONTROL_POINTS: usize = 4_000_000;
 
 /// A [`Error::Step`] about instance `#id` (0: none) at `line` (0: unknown).
 fn step_error(id: u64, line: usize, message: impl Into<String>) -> Error {
     Error::Step { id, line, message: message.into() }
+}
+
+/// One shell (or surface set) of the model as read: which faces came from it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct StepShell {
+    /// The shell's `#id` (or the set's, for loose surfaces).
+    pub id: u64,
+    /// Whether the file says the shell is closed (`CLOSED_SHELL`): its mesh
+    /// should have no boundary edge.
+    pub closed: bool,
+    /// The faces of [`Model::faces`] made from it (one shell per instance
+    /// of it in an assembly).
+    pub faces: Range<usize>,
+    /// How many faces the file lists in the shell; fewer in `faces` means
+    /// some were skipped (see [`Model::warnings`]).
+    pub listed: usize,
+}
+
+/// Reads a STEP file (ISO 10303-21).
+///
+/// Solids (`MANIFOLD_SOLID_BREP`, `BREP_WITH_VOIDS`), shells of surface
+/// models and loose surfaces of geometric sets are placed by their assembly
+/// relations (`NEXT_ASSEMBLY_USAGE_OCCURRENCE` through
+/// `CONTEXT_DEPENDENT_SHAPE_REPRESENTATION` with an
+/// `ITEM_DEFINED_TRANSFORMATION`, and `MAPPED_ITEM`s), each instance getting
+/// its own transformed faces. Lengths are in the unit of the first root
+/// representation ([`Model::units`]); parts in other units are scaled to it.
+/// Face names are the part's product name (and the face's own, if any).
+/// [`Model::tolerance`] is the largest uncertainty the file states.
+///
+/// # Errors
+/// [`Error::Step`] for a malformed exchange structure (instance and line
+/// named), or when no face at all could be read (the first face's error).
+pub fn read_step(bytes: &[u8]) -> Result<Model, Error> {
+    read_step_with_shells(bytes).map(|(m, _)| m)
+}
+
+/// As [`read_step`], also telling which faces came from which shell, so a
+/// caller can check that closed shells mesh without boundary edges.
+///
+/// # Errors
+/// As [`read_step`].
+pub fn read_step_with_shells(bytes: &[u8]) -> Result<(Model, Vec<StepShell>), Error> {
+    let g = parser::parse(bytes)?;
+    let mut warnings = Vec::new();
+    let plan = assembly::plan(&g, &mut warnings)?;
+    let shapes = shapes::read_shapes(&g, &plan, &mut warnings)?;
+    if shapes.faces.is_empty() {
+        return Err(shapes.first_error.unwrap_or_else(|| {
+            step_error(0, 0, "no faces, shells, solids or surfaces in the file (only curves, points or annotations?)")
+        }));
+    }
+    let mut faces = shapes.faces;
+    for (f, &p) in faces.iter_mut().zip(&shapes.placement) {
+        let part = plan.placed.get(p).and_then(|p| p.name.as_ref());
+        f.name = match (part, f.name.take()) {
+            (Some(part), Some(own)) => Some(alloc::format!("{part}/{own}")),
+            (Some(part), None) => Some(part.clone()),
+            (None, own) => own,
+        };
+    }
+    let model = Model { units: plan.units.clone(), faces, warnings, tolerance: plan.tolerance };
+    Ok((model, shapes.shells))
 }

@@ -1,0 +1,490 @@
+//! Which shapes the file holds and where: representations and their items,
+//! the relations that place one representation in another (assemblies:
+//! `CONTEXT_DEPENDENT_SHAPE_REPRESENTATION` with a transformed
+//! `SHAPE_REPRESENTATION_RELATIONSHIP` for each
+//! `NEXT_ASSEMBLY_USAGE_OCCURRENCE`, and `MAPPED_ITEM`s), the units of each
+//! representation's context and the product names.
+//!
+//! Representations related without a transformation share one coordinate
+//! system and form a group; groups that are nobody's child are roots, and
+//! every path from a root down the placements is one instance of the shapes
+//! below it. Everything is computed in millimetres, then expressed in the
+//! unit of the first root, so parts in other units are scaled to it.
+
+use alloc::format;
+use alloc::string::String;
+use alloc::vec::Vec;
+use glam::{DAffine3, DVec3};
+use hashbrown::{HashMap, HashSet};
+
+use super::curves::Geo;
+use super::graph::{Ent, Graph, Value};
+use super::{MAX_DEPTH, MAX_FACES};
+use crate::Error;
+
+/// One shape item to read, placed.
+#[derive(Debug, Clone)]
+pub(super) struct Placed {
+    /// The solid, shell, surface model, set or surface.
+    pub item: u64,
+    /// From the item's coordinates (its context's unit) to the output's.
+    pub m: DAffine3,
+    /// Radians per angle unit of the item's context.
+    pub angle: f64,
+    /// The context's uncertainty in its own length unit (0 when not stated).
+    pub uncertainty: f64,
+    /// Product name of the part.
+    pub name: Option<String>,
+}
+
+/// What to read.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Plan {
+    pub placed: Vec<Placed>,
+    pub units: String,
+    pub tolerance: Option<f64>,
+}
+
+/// Units of one representation context.
+#[derive(Debug, Clone, Copy)]
+struct Units {
+    /// Millimetres per length unit.
+    mm: f64,
+    /// Radians per angle unit.
+    rad: f64,
+    /// Uncertainty in millimetres (0: none stated).
+    uncertainty: f64,
+}
+
+impl Default for Units {
+    fn default() -> Self {
+        Self { mm: 1.0, rad: 1.0, uncertainty: 0.0 }
+    }
+}
+
+/// Entity names of the items this reader turns into faces.
+pub(super) const SHAPES: [&str; 12] = [
+    "MANIFOLD_SOLID_BREP",
+    "BREP_WITH_VOIDS",
+    "FACETED_BREP",
+    "SHELL_BASED_SURFACE_MODEL",
+    "FACE_BASED_SURFACE_MODEL",
+    "GEOMETRIC_SET",
+    "GEOMETRIC_CURVE_SET",
+    "CLOSED_SHELL",
+    "OPEN_SHELL",
+    "ADVANCED_FACE",
+    "FACE_SURFACE",
+    "CONNECTED_FACE_SET",
+];
+
+fn is_shape(e: Ent<'_>) -> bool {
+    SHAPES.iter().any(|n| e.has(n)) || super::surfaces::is_bspline_surface(e)
+}
+
+/// The `(name, items, context)` of a representation, if `e` is one.
+fn representation<'g>(e: Ent<'g>) -> Option<(Vec<u64>, u64)> {
+    let a = if e.is_complex() {
+        e.part("REPRESENTATION")?
+    } else {
+        let n = e.name();
+        if !n.ends_with("REPRESENTATION") || n == "DEFINITIONAL_REPRESENTATION" {
+            return None;
+        }
+        e.attrs()
+    };
+    if a.len() != 3 {
+        return None;
+    }
+    Some((a.refs(1).ok()?, a.refr(2).ok()?))
+}
+
+/// Union-find root.
+fn root(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+/// Works out every placed shape.
+///
+/// # Errors
+/// Malformed relations (bad references, placements that are not placements).
+pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error> {
+    // Representations.
+    let mut reps: Vec<(u64, Vec<u64>, u64)> = Vec::new();
+    let mut rep_index: HashMap<u64, usize> = HashMap::new();
+    for e in g.all() {
+        if let Some((items, ctx)) = representation(e) {
+            rep_index.insert(e.id(), reps.len());
+            reps.push((e.id(), items, ctx));
+        }
+    }
+    let mut unit_cache: HashMap<u64, Units> = HashMap::new();
+    let units: Vec<Units> = reps
+        .iter()
+        .map(|(_, _, ctx)| *unit_cache.entry(*ctx).or_insert_with(|| context_units(g, *ctx, warnings)))
+        .collect();
+    // Groups: representations related without a transformation.
+    let n = reps.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    let mut edges: Vec<(u64, u64, DAffine3, Option<String>)> = Vec::new(); // parent rep, child rep, child→parent (mm)
+    let cdsr = cdsr_products(g);
+    let product_of_rep = rep_products(g);
+    for e in g.all() {
+        if !(e.has("REPRESENTATION_RELATIONSHIP") || e.has("SHAPE_REPRESENTATION_RELATIONSHIP")) {
+            continue;
+        }
+        let a = match e.part("REPRESENTATION_RELATIONSHIP") {
+            Some(a) => a,
+            None => e.attrs(),
+        };
+        let (Ok(r1), Ok(r2)) = (a.refr(2), a.refr(3)) else { continue };
+        let (Some(&i1), Some(&i2)) = (rep_index.get(&r1), rep_index.get(&r2)) else { continue };
+        let Some(t) = e.part("REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION") else {
+            let (x, y) = (root(&mut parent, i1), root(&mut parent, i2));
+            parent[x] = y;
+            continue;
+        };
+        let op = t.ent(0)?;
+        let geo1 = Geo { g, angle: units[i1].rad, uncertainty: 0.0 };
+        let geo2 = Geo { g, angle: units[i2].rad, uncertainty: 0.0 };
+        let (m1, m2) = if op.has("ITEM_DEFINED_TRANSFORMATION") {
+            let ia = op.attrs();
+            let (p1, p2) = (ia.ent(2)?, ia.ent(3)?);
+            (in_mm(geo1.transform(p1)?, units[i1].mm), in_mm(geo2.transform(p2)?, units[i2].mm))
+        } else {
+            (DAffine3::IDENTITY, in_mm(geo2.transform(op)?, units[i2].mm))
+        };
+        // rep_1 is the child unless the product structure says otherwise.
+        let (child, par, m) = match cdsr.get(&e.id()) {
+            Some((_, child_pd)) if product_of_rep.get(&r2).is_some_and(|(pd, _)| pd == child_pd) => {
+                (r2, r1, m1 * m2.inverse())
+            }
+            _ => (r1, r2, m2 * m1.inverse()),
+        };
+        let name = cdsr.get(&e.id()).and_then(|(n, _)| n.clone());
+        edges.push((par, child, m, name));
+    }
+    // Mapped items.
+    for (ri, (rid, items, _)) in reps.iter().enumerate() {
+        for &it in items {
+            let Some(e) = g.find(it) else { continue };
+            if !e.has("MAPPED_ITEM") {
+                continue;
+            }
+            let a = e.chain(&[("REPRESENTATION_ITEM", 1), ("MAPPED_ITEM", 2)])?;
+            let map = a.ent(1)?;
+            let ma = map.attrs();
+            let origin = ma.ent(0)?;
+            let child = ma.refr(1)?;
+            let Some(&ci) = rep_index.get(&child) else { continue };
+            let go = Geo { g, angle: units[ci].rad, uncertainty: 0.0 };
+            let gt = Geo { g, angle: units[ri].rad, uncertainty: 0.0 };
+            let m =
+                in_mm(gt.transform(a.ent(2)?)?, units[ri].mm) * in_mm(go.transform(origin)?, units[ci].mm).inverse();
+            edges.push((*rid, child, m, None));
+        }
+    }
+    // Groups and their children.
+    let group = |parent: &mut Vec<usize>, rep: u64| rep_index.get(&rep).map(|&i| root(parent, i));
+    let mut children: HashMap<usize, Vec<(usize, DAffine3, Option<String>)>> = HashMap::new();
+    let mut is_child: HashSet<usize> = HashSet::new();
+    for (p, c, m, name) in &edges {
+        let (Some(gp), Some(gc)) = (group(&mut parent, *p), group(&mut parent, *c)) else { continue };
+        if gp == gc {
+            continue;
+        }
+        children.entry(gp).or_default().push((gc, *m, name.clone()));
+        is_child.insert(gc);
+    }
+    let mut members: HashMap<usize, Vec<usize>> = HashMap::new();
+    for i in 0..n {
+        let r = root(&mut parent, i);
+        members.entry(r).or_default().push(i);
+    }
+    let mut roots: Vec<usize> = (0..n).map(|i| root(&mut parent, i)).filter(|r| !is_child.contains(r)).collect();
+    roots.sort_unstable();
+    roots.dedup();
+    // Output unit: the first root that holds shapes.
+    let holds_shapes = |gi: usize| {
+        members.get(&gi).is_some_and(|ms| {
+            ms.iter()
+                .any(|&i| reps[i].1.iter().any(|&it| g.find(it).is_some_and(|e| is_shape(e) || e.has("MAPPED_ITEM"))))
+        }) || children.contains_key(&gi)
+    };
+    let out_mm = roots
+        .iter()
+        .find(|&&r| holds_shapes(r))
+        .and_then(|r| members.get(r))
+        .and_then(|ms| ms.first())
+        .map_or(1.0, |&i| units[i].mm);
+    let mut plan = Plan { units: unit_name(out_mm), ..Plan::default() };
+    let mut seen: HashSet<(u64, [u64; 12])> = HashSet::new();
+    let mut emitted: HashSet<u64> = HashSet::new();
+    let mut tol: f64 = 0.0;
+    let scale_out = DAffine3::from_scale(DVec3::splat(1.0 / out_mm));
+    // Depth-first over placements, with the path kept to refuse cycles.
+    // Roots in the product structure first: a representation no product
+    // owns (validation properties, presentation) that lists their shapes
+    // again adds nothing.
+    let in_products = |gi: usize| {
+        children.contains_key(&gi)
+            || members.get(&gi).is_some_and(|ms| ms.iter().any(|&i| product_of_rep.contains_key(&reps[i].0)))
+    };
+    roots.sort_by_key(|&r| !in_products(r));
+    let mut stack: Vec<(usize, DAffine3, Option<String>, usize)> =
+        roots.iter().rev().map(|&r| (r, DAffine3::IDENTITY, None, 0)).collect();
+    let mut visits = 0usize;
+    while let Some((gi, m, name, depth)) = stack.pop() {
+        visits += 1;
+        if depth > MAX_DEPTH || visits > MAX_FACES {
+            warnings.push(format!(
+                "assembly deeper than {MAX_DEPTH} levels or with more than {MAX_FACES} instances: the rest is skipped"
+            ));
+            break;
+        }
+        let orphan = depth == 0 && !in_products(gi);
+        let own_name = members
+            .get(&gi)
+            .and_then(|ms| ms.iter().find_map(|&i| product_of_rep.get(&reps[i].0).and_then(|(_, n)| n.clone())));
+        let name = own_name.or(name);
+        for &i in members.get(&gi).map_or(&[][..], Vec::as_slice) {
+            let u = units[i];
+            for &it in &reps[i].1 {
+                let Some(e) = g.find(it) else {
+                    warnings.push(format!("#{}: item #{it} is not defined; skipped", reps[i].0));
+                    continue;
+                };
+                if !is_shape(e) || (orphan && emitted.contains(&it)) {
+                    continue;
+                }
+                let full = scale_out * m * DAffine3::from_scale(DVec3::splat(u.mm));
+                let key = (it, matrix_key(&full));
+                if !seen.insert(key) {
+                    continue;
+                }
+                emitted.insert(it);
+                tol = tol.max(u.uncertainty / out_mm);
+                plan.placed.push(Placed {
+                    item: it,
+                    m: full,
+                    angle: u.rad,
+                    uncertainty: u.uncertainty / u.mm,
+                    name: name.clone(),
+                });
+            }
+        }
+        if let Some(kids) = children.get(&gi) {
+            for (c, cm, cname) in kids.iter().rev() {
+                stack.push((*c, m * *cm, cname.clone().or(name.clone()), depth + 1));
+            }
+        }
+    }
+    // Solids and surface models no representation lists.
+    let mut nested: HashSet<u64> = HashSet::new();
+    for p in &plan.placed {
+        if let Some(e) = g.find(p.item) {
+            if e.has("SHELL_BASED_SURFACE_MODEL") || e.has("MANIFOLD_SOLID_BREP") || e.has("BREP_WITH_VOIDS") {
+                if let Ok(a) = e.chain(&[("REPRESENTATION_ITEM", 1)]) {
+                    for v in &a.vals {
+                        if let Value::Ref(r) = v {
+                            nested.insert(*r);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    for e in g.all() {
+        let top = ["MANIFOLD_SOLID_BREP", "BREP_WITH_VOIDS", "FACETED_BREP", "SHELL_BASED_SURFACE_MODEL"];
+        if top.iter().any(|n| e.has(n)) && !emitted.contains(&e.id()) && !nested.contains(&e.id()) {
+            warnings.push(format!("#{} {}: not in any representation; read in place", e.id(), e.type_name()));
+            plan.placed.push(Placed { item: e.id(), m: DAffine3::IDENTITY, angle: 1.0, uncertainty: 0.0, name: None });
+        }
+    }
+    // Faces that a representation lists on their own but that a shell also
+    // holds are references (annotations, PMI), not more geometry.
+    let mut in_shells: HashSet<u64> = HashSet::new();
+    for e in g.all() {
+        if e.has("CLOSED_SHELL") || e.has("OPEN_SHELL") || e.has("CONNECTED_FACE_SET") {
+            if let Ok(a) = e.chain(&[("REPRESENTATION_ITEM", 1), ("CONNECTED_FACE_SET", 1)]) {
+                in_shells.extend(a.refs(1).unwrap_or_default());
+            }
+        }
+    }
+    plan.placed.retain(|p| {
+        let face = g.find(p.item).is_some_and(|e| e.has("ADVANCED_FACE") || e.has("FACE_SURFACE"));
+        !(face && in_shells.contains(&p.item))
+    });
+    plan.tolerance = (tol > 0.0 && tol.is_finite()).then_some(tol);
+    Ok(plan)
+}
+
+/// The affine map with its translation turned from `mm` per unit into millimetres.
+fn in_mm(m: DAffine3, mm: f64) -> DAffine3 {
+    DAffine3 { matrix3: m.matrix3, translation: m.translation * mm }
+}
+
+fn matrix_key(m: &DAffine3) -> [u64; 12] {
+    let c = m.to_cols_array();
+    let mut k = [0u64; 12];
+    for (o, x) in k.iter_mut().zip(c) {
+        *o = x.to_bits();
+    }
+    k
+}
+
+/// A short unit name for `mm` millimetres.
+fn unit_name(mm: f64) -> String {
+    let close = |x: f64| (mm / x - 1.0).abs() < 1e-9;
+    let known = [
+        (1.0, "mm"),
+        (10.0, "cm"),
+        (1000.0, "m"),
+        (1e6, "km"),
+        (1e-3, "um"),
+        (25.4, "in"),
+        (304.8, "ft"),
+        (0.0254, "mil"),
+    ];
+    for (f, n) in known {
+        if close(f) {
+            return n.into();
+        }
+    }
+    format!("{mm} mm")
+}
+
+/// Units and uncertainty of a representation context.
+fn context_units(g: &Graph, ctx: u64, warnings: &mut Vec<String>) -> Units {
+    let mut u = Units::default();
+    let Some(c) = g.find(ctx) else { return u };
+    if let Some(a) = c.part("GLOBAL_UNIT_ASSIGNED_CONTEXT") {
+        for r in a.refs(0).unwrap_or_default() {
+            let Some(e) = g.find(r) else { continue };
+            if e.has("LENGTH_UNIT") {
+                match unit_factor(e, 0) {
+                    Some(f) => u.mm = f,
+                    None => warnings.push(format!("#{r}: length unit not understood; millimetres assumed")),
+                }
+            } else if e.has("PLANE_ANGLE_UNIT") {
+                if let Some(f) = unit_factor(e, 0) {
+                    u.rad = f;
+                }
+            }
+        }
+    }
+    if let Some(a) = c.part("GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT") {
+        for r in a.refs(0).unwrap_or_default() {
+            let Some(e) = g.find(r) else { continue };
+            let m = e.attrs();
+            let (Ok(v), Ok(unit)) = (m.real(0), m.ent(1)) else { continue };
+            let f = if unit.has("LENGTH_UNIT") { unit_factor(unit, 0).unwrap_or(u.mm) } else { continue };
+            let x = v.abs() * f;
+            if x.is_finite() {
+                u.uncertainty = u.uncertainty.max(x);
+            }
+        }
+    }
+    u
+}
+
+/// Millimetres (length units) or radians (angle units) per unit.
+fn unit_factor(e: Ent<'_>, depth: usize) -> Option<f64> {
+    if depth > 8 {
+        return None;
+    }
+    if let Some(si) = e.part("SI_UNIT") {
+        let prefix = match si.enumeration(0).ok() {
+            Some(p) => si_prefix(p)?,
+            None => 1.0,
+        };
+        return match si.enumeration(1).ok()? {
+            "METRE" => Some(1000.0 * prefix),
+            "RADIAN" => Some(prefix),
+            _ => None,
+        };
+    }
+    let conv = e.part("CONVERSION_BASED_UNIT")?;
+    let m = conv.ent(1).ok()?;
+    let ma = if m.is_complex() { m.part("MEASURE_WITH_UNIT")? } else { m.attrs() };
+    let value = ma.real(0).ok()?;
+    let base = unit_factor(ma.ent(1).ok()?, depth + 1)?;
+    let f = value * base;
+    (f > 0.0 && f.is_finite()).then_some(f)
+}
+
+fn si_prefix(p: &str) -> Option<f64> {
+    Some(match p {
+        "EXA" => 1e18,
+        "PETA" => 1e15,
+        "TERA" => 1e12,
+        "GIGA" => 1e9,
+        "MEGA" => 1e6,
+        "KILO" => 1e3,
+        "HECTO" => 1e2,
+        "DECA" => 1e1,
+        "DECI" => 1e-1,
+        "CENTI" => 1e-2,
+        "MILLI" => 1e-3,
+        "MICRO" => 1e-6,
+        "NANO" => 1e-9,
+        "PICO" => 1e-12,
+        "FEMTO" => 1e-15,
+        "ATTO" => 1e-18,
+        _ => return None,
+    })
+}
+
+/// Product definition and name of each representation a
+/// `SHAPE_DEFINITION_REPRESENTATION` ties to a product.
+fn rep_products(g: &Graph) -> HashMap<u64, (u64, Option<String>)> {
+    let mut out = HashMap::new();
+    for e in g.all() {
+        if !e.has("SHAPE_DEFINITION_REPRESENTATION") {
+            continue;
+        }
+        let a = e.attrs();
+        let (Ok(pds), Ok(rep)) = (a.ent(0), a.refr(1)) else { continue };
+        let Ok(pd) = pds.attrs().ent(2) else { continue };
+        if !pd.has("PRODUCT_DEFINITION") {
+            continue;
+        }
+        out.insert(rep, (pd.id(), product_name(pd)));
+    }
+    out
+}
+
+/// For each transformed relation a `CONTEXT_DEPENDENT_SHAPE_REPRESENTATION`
+/// names: the child part's name and product definition.
+fn cdsr_products(g: &Graph) -> HashMap<u64, (Option<String>, u64)> {
+    let mut out = HashMap::new();
+    for e in g.all() {
+        if !e.has("CONTEXT_DEPENDENT_SHAPE_REPRESENTATION") {
+            continue;
+        }
+        let a = e.attrs();
+        let (Ok(rel), Ok(pds)) = (a.refr(0), a.ent(1)) else { continue };
+        let Ok(nauo) = pds.attrs().ent(2) else { continue };
+        if !nauo.has("NEXT_ASSEMBLY_USAGE_OCCURRENCE") && !nauo.has("PRODUCT_DEFINITION_USAGE") {
+            continue;
+        }
+        let na = nauo.attrs();
+        let Ok(child) = na.ent(4) else { continue };
+        out.insert(rel, (product_name(child), child.id()));
+    }
+    out
+}
+
+/// `PRODUCT.name` (or its id) of a product definition.
+fn product_name(pd: Ent<'_>) -> Option<String> {
+    let pdf = pd.attrs().ent(2).ok()?;
+    let prod = pdf.attrs().ent(2).ok()?;
+    let a = prod.attrs();
+    let name = a.string(1).ok().filter(|s| !s.trim().is_empty()).or_else(|| a.string(0).ok())?;
+    let name = name.trim();
+    (!name.is_empty()).then(|| name.into())
+}

@@ -1,0 +1,194 @@
+//! Edges: an `EDGE_CURVE`'s curve cut between its two vertices, in the
+//! edge's direction, as exact NURBS pieces whose ends are the vertex points
+//! (so the faces on both sides start from the same points). Each edge is
+//! read once and shared by the faces that use it.
+
+use alloc::format;
+use alloc::string::String;
+use alloc::vec::Vec;
+use glam::DVec3;
+use hashbrown::HashMap;
+
+use super::curves::{move_ends, param_of, period, pieces_between, rev_all, Curve3, CurveDef, Geo};
+use super::graph::Ent;
+use crate::nurbs::NurbsCurve;
+use crate::Error;
+
+/// An edge in its own direction (start vertex to end vertex).
+#[derive(Debug, Clone)]
+pub(super) struct Edge {
+    /// Pieces from the start vertex to the end vertex (empty: degenerate edge).
+    pub pieces: Vec<NurbsCurve>,
+    /// What was repaired, if anything (reported once per edge).
+    pub repaired: Option<String>,
+}
+
+/// Edges read so far, by `#id`.
+#[derive(Default)]
+pub(super) struct Edges {
+    done: HashMap<(u64, bool), Result<Edge, Error>>,
+}
+
+impl Edges {
+    /// The edge `e` (an `EDGE_CURVE`); `alone`: it is the only edge of its
+    /// loop, so on a closed curve it is the whole curve even where its two
+    /// vertices differ by a rounding.
+    pub fn get(&mut self, geo: &Geo<'_>, e: Ent<'_>, alone: bool) -> Result<Edge, Error> {
+        if let Some(r) = self.done.get(&(e.id(), alone)) {
+            return r.clone();
+        }
+        let r = read_edge(geo, e, alone);
+        self.done.insert((e.id(), alone), r.clone());
+        r
+    }
+}
+
+/// A `VERTEX_POINT`'s point.
+pub(super) fn vertex(geo: &Geo<'_>, e: Ent<'_>) -> Result<DVec3, Error> {
+    if !e.has("VERTEX_POINT") {
+        return Err(e.error("expected a VERTEX_POINT"));
+    }
+    let a = e.chain(&[("REPRESENTATION_ITEM", 1), ("VERTEX_POINT", 1)])?;
+    geo.point(a.ent(1)?)
+}
+
+fn read_edge(geo: &Geo<'_>, e: Ent<'_>, alone: bool) -> Result<Edge, Error> {
+    if !e.has("EDGE_CURVE") {
+        return Err(e.error("expected an EDGE_CURVE"));
+    }
+    let a = e.chain(&[("REPRESENTATION_ITEM", 1), ("EDGE", 2), ("EDGE_CURVE", 2)])?;
+    let (vs, ve) = (a.refr(1)?, a.refr(2)?);
+    let ps = vertex(geo, a.ent(1)?)?;
+    let pe = if ve == vs { ps } else { vertex(geo, a.ent(2)?)? };
+    let def = geo.curve(a.ent(3)?, 0)?;
+    let same_sense = a.boolean(4, true)?;
+    let (pieces, repaired) =
+        cut(&def, ps, pe, same_sense, vs == ve || alone, geo.uncertainty).map_err(|m| e.error(m))?;
+    Ok(Edge { pieces, repaired })
+}
+
+/// Approximate length of a curve from 16 chords.
+pub(super) fn length(c: &NurbsCurve) -> f64 {
+    let (a, b) = c.domain();
+    let mut prev = c.point(a);
+    let mut len = 0.0;
+    for k in 1..=16 {
+        let p = c.point(a + (b - a) * k as f64 / 16.0);
+        len += p.distance(prev);
+        prev = p;
+    }
+    len
+}
+
+/// The part of the curve from `ps` to `pe`, along the curve's direction when
+/// `same_sense` (against it otherwise); a whole turn when `closed`. Ends
+/// within the uncertainty (or 5% of the length) of a vertex are moved onto
+/// it, so the faces on both sides of the edge meet at the same points; a
+/// vertex farther from the curve is reported as a repair.
+fn cut(
+    def: &CurveDef,
+    ps: DVec3,
+    pe: DVec3,
+    same_sense: bool,
+    closed: bool,
+    uncertainty: f64,
+) -> Result<(Vec<NurbsCurve>, Option<String>), String> {
+    let forward = same_sense != def.reversed;
+    let (a, b) = if forward { (ps, pe) } else { (pe, ps) };
+    let size = a.distance(b);
+    let mut pieces = match &def.curve {
+        Curve3::Line { .. } => {
+            if size == 0.0 {
+                return Ok((Vec::new(), None));
+            }
+            alloc::vec![crate::nurbs::analytic::line(a, b, 0.0, 1.0).map_err(|x| format!("{x}"))?]
+        }
+        c => {
+            let mut ta = param_of(c, a);
+            let mut tb = param_of(c, b);
+            let whole = closed || (size <= 1e-9 * curve_scale(c) && period(c).is_some());
+            match period(c) {
+                Some(p) if whole => tb = ta + p,
+                // A closed edge on a curve that does not quite close (its
+                // ends a rounding apart): the whole curve.
+                None if closed => {
+                    if let Curve3::Nurbs { c: n, .. } = c {
+                        let (x, y) = n.domain();
+                        (ta, tb) = (x, y);
+                    }
+                }
+                Some(p) => {
+                    tb = ta + (tb - ta) - p * libm::floor((tb - ta) / p);
+                    if tb <= ta + 1e-12 * p {
+                        tb += p;
+                    }
+                }
+                None => {}
+            }
+            let scale = match c {
+                Curve3::Nurbs { c, .. } => {
+                    let (x, y) = c.domain();
+                    (y - x).abs()
+                }
+                _ => 1.0,
+            };
+            if (tb - ta).abs() <= 1e-10 * scale {
+                return Ok((Vec::new(), None)); // a degenerate edge (both vertices at one parameter)
+            } else if tb > ta {
+                pieces_between(c, ta, tb)?
+            } else if ta > tb {
+                // The vertices come in the other order along the curve.
+                let mut v = pieces_between(c, tb, ta)?;
+                rev_all(&mut v)?;
+                v
+            } else {
+                return Ok((Vec::new(), None)); // a degenerate edge (both vertices at one parameter)
+            }
+        }
+    };
+    if !forward {
+        rev_all(&mut pieces)?;
+    }
+    // Ends exactly at the vertices.
+    let total: f64 = pieces.iter().map(length).sum();
+    if total <= 1e-12 * ps.length().max(pe.length()).max(1e-300) {
+        return Ok((Vec::new(), None));
+    }
+    // Within the uncertainty, but never a fair part of the edge itself.
+    let snap = (0.05 * total).max((2.0 * uncertainty).min(0.25 * total));
+    let mut repaired = None;
+    let ends = |c: &NurbsCurve| {
+        let (t0, t1) = c.domain();
+        (c.point(t0), c.point(t1))
+    };
+    // A vertex farther than that from the curve is wrong in the file (a
+    // writer that reuses one vertex for both ends of an open curve): the
+    // curve's own end is kept, and the loop bridges what gap is left.
+    if let Some(first) = pieces.first_mut() {
+        let (s, e) = ends(first);
+        let gap = s.distance(ps);
+        if gap <= snap {
+            *first = move_ends(first, ps, e)?;
+        } else {
+            repaired = Some(format!("its start vertex lies {gap:.3e} from its curve; the curve's end is used"));
+        }
+    }
+    if let Some(last) = pieces.last_mut() {
+        let (s, e) = ends(last);
+        let gap = e.distance(pe);
+        if gap <= snap {
+            *last = move_ends(last, s, pe)?;
+        } else {
+            repaired = Some(format!("its end vertex lies {gap:.3e} from its curve; the curve's end is used"));
+        }
+    }
+    Ok((pieces, repaired))
+}
+
+fn curve_scale(c: &Curve3) -> f64 {
+    match c {
+        Curve3::Line { d, .. } => d.length(),
+        Curve3::Conic { x, y, .. } => x.length().max(y.length()),
+        Curve3::Nurbs { c, .. } => c.bbox().diagonal(),
+    }
+}

@@ -1,0 +1,253 @@
+//! STEP: small files written for these tests (tests/data/step_*.stp) check
+//! units, assemblies, analytic surfaces, seams, poles and apexes, skipped
+//! faces and hostile input; the shared corpus (`../shared/corpus`, see its
+//! SOURCES.md) checks real files: every face read, and the files listed in
+//! [`MESHED`] meshed within tolerance and watertight.
+
+use std::path::{Path, PathBuf};
+
+use surfmesh::{
+    edge_counts, mesh_model, read_model, read_step, read_step_with_shells, Format, Mesh, MeshOptions, MeshResult,
+    Model, StepShell,
+};
+
+fn data(name: &str) -> Vec<u8> {
+    std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join("data").join(name)).unwrap()
+}
+
+fn corpus_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("shared").join("corpus")
+}
+
+/// The triangles of the given faces as one mesh.
+fn sub_mesh(mesh: &Mesh, faces: std::ops::Range<usize>) -> Mesh {
+    let mut out = Mesh { positions: mesh.positions.clone(), ..Mesh::default() };
+    for r in &mesh.face_ranges[faces] {
+        let (a, b) = (3 * r.first as usize, 3 * (r.first + r.count) as usize);
+        out.indices.extend_from_slice(&mesh.indices[a..b]);
+    }
+    out
+}
+
+/// Boundary and misoriented edges of each closed shell's own mesh, summed.
+fn closed_shell_defects(r: &MeshResult, shells: &[StepShell]) -> (usize, usize) {
+    let tol = r.report.tolerance;
+    let (mut boundary, mut misoriented) = (0, 0);
+    for s in shells.iter().filter(|s| s.closed && !s.faces.is_empty()) {
+        let c = edge_counts(&sub_mesh(&r.mesh, s.faces.clone()), tol * 1e-3, tol);
+        boundary += c.boundary_edges;
+        misoriented += c.misoriented_edges;
+    }
+    (boundary, misoriented)
+}
+
+/// Volume enclosed by a closed, outward-oriented mesh (divergence theorem).
+fn volume(mesh: &Mesh, faces: std::ops::Range<usize>) -> f64 {
+    let m = sub_mesh(mesh, faces);
+    m.indices
+        .chunks_exact(3)
+        .map(|t| {
+            let [a, b, c] = [0, 1, 2].map(|k| m.positions[t[k] as usize]);
+            a.dot(b.cross(c)) / 6.0
+        })
+        .sum()
+}
+
+/// Meshes at relative tolerance `rel` and checks what every STEP mesh must
+/// meet: deviation within tolerance, no inverted triangle, no crack, closed
+/// shells closed and consistently oriented, one face range per face.
+fn mesh_checked(name: &str, model: &Model, shells: &[StepShell], rel: f64) -> MeshResult {
+    let r = mesh_model(model, &MeshOptions::default().with_relative_tolerance(rel)).unwrap();
+    let rep = &r.report;
+    assert_eq!(r.mesh.face_ranges.len(), model.faces.len(), "{name}: one face range per face");
+    assert_eq!(rep.faces_skipped, 0, "{name}: faces skipped: {:?}", rep.warnings);
+    assert!(rep.max_deviation <= rep.tolerance, "{name}: deviation {} > {}", rep.max_deviation, rep.tolerance);
+    assert_eq!(rep.inverted_triangles, 0, "{name}: inverted triangles");
+    assert_eq!(rep.free_edges, 0, "{name}: cracks");
+    assert_eq!(closed_shell_defects(&r, shells), (0, 0), "{name}: (boundary, misoriented) edges on closed shells");
+    r
+}
+
+#[test]
+fn format_is_detected_and_named() {
+    assert_eq!(Format::detect(&data("step_box_inch.stp")), Some(Format::Step));
+    assert_eq!(Format::detect(b"  \r\nISO-10303-21;\nHEADER;"), Some(Format::Step));
+    for n in ["stp", ".STEP", "p21"] {
+        assert_eq!(Format::from_name(n).unwrap(), Format::Step);
+    }
+    assert!(read_model(&data("step_box_inch.stp"), Format::Step).is_ok());
+}
+
+#[test]
+fn inch_box_is_closed_and_sized_in_inches() {
+    let (model, shells) = read_step_with_shells(&data("step_box_inch.stp")).unwrap();
+    assert_eq!(model.units, "in");
+    assert_eq!(model.faces.len(), 6);
+    assert_eq!(shells.len(), 1);
+    assert!(shells[0].closed && shells[0].listed == 6);
+    assert!(model.faces.iter().all(|f| f.name.as_deref().is_some_and(|n| n.starts_with("Block"))));
+    let r = mesh_checked("box", &model, &shells, 1e-3);
+    // 2 x 1 x 0.5 inches, faces turned outward (three of its planes face inward with same_sense false).
+    assert!((volume(&r.mesh, 0..6) - 1.0).abs() < 1e-12, "volume {}", volume(&r.mesh, 0..6));
+}
+
+#[test]
+fn cylinders_with_and_without_a_seam_edge_mesh_closed() {
+    for file in ["step_cylinder.stp", "step_cylinder_noseam.stp"] {
+        let (model, shells) = read_step_with_shells(&data(file)).unwrap();
+        assert_eq!(model.faces.len(), 3, "{file}");
+        let r = mesh_checked(file, &model, &shells, 1e-3);
+        let exact = std::f64::consts::PI * 25.0 * 10.0;
+        let v = volume(&r.mesh, 0..3);
+        assert!(v > 0.0 && (v - exact).abs() < 0.01 * exact, "{file}: volume {v} vs {exact}");
+    }
+}
+
+#[test]
+fn dome_closed_at_its_pole_and_cone_at_its_apex() {
+    let (model, shells) = read_step_with_shells(&data("step_dome_cone.stp")).unwrap();
+    assert_eq!(model.faces.len(), 2);
+    let r = mesh_checked("dome and cone", &model, &shells, 1e-3);
+    // Half a sphere of radius 5 on a cone of radius 5 and height 10.
+    let exact = std::f64::consts::PI * (2.0 / 3.0 * 125.0 + 25.0 * 10.0 / 3.0);
+    let v = volume(&r.mesh, 0..2);
+    assert!((v - exact).abs() < 0.01 * exact, "volume {v} vs {exact}");
+    // Stay the dome and the cone: every vertex within the solid's box.
+    for p in &r.mesh.positions {
+        assert!(p.z >= -10.0 - 1e-9 && p.z <= 5.0 + 1e-9 && p.x.hypot(p.y) <= 5.0 + 1e-9, "{p}");
+    }
+}
+
+#[test]
+fn assembly_places_each_instance() {
+    let (model, shells) = read_step_with_shells(&data("step_assembly.stp")).unwrap();
+    assert_eq!(model.faces.len(), 12);
+    assert_eq!(shells.len(), 2);
+    assert!(model.faces.iter().all(|f| f.name.as_deref().is_some_and(|n| n.starts_with("Block"))));
+    let r = mesh_checked("assembly", &model, &shells, 1e-3);
+    let bbox = |faces: std::ops::Range<usize>| {
+        let m = sub_mesh(&r.mesh, faces);
+        let mut lo = glam::DVec3::splat(f64::INFINITY);
+        let mut hi = -lo;
+        for t in &m.indices {
+            lo = lo.min(m.positions[*t as usize]);
+            hi = hi.max(m.positions[*t as usize]);
+        }
+        (lo, hi)
+    };
+    // The block is 10 x 5 x 2; the second instance is turned 90 degrees about z and moved 20 along x.
+    let (lo, hi) = bbox(shells[0].faces.clone());
+    assert!(lo.abs_diff_eq(glam::DVec3::ZERO, 1e-9) && hi.abs_diff_eq(glam::DVec3::new(10.0, 5.0, 2.0), 1e-9));
+    let (lo, hi) = bbox(shells[1].faces.clone());
+    assert!(lo.abs_diff_eq(glam::DVec3::new(15.0, 0.0, 0.0), 1e-9), "{lo}");
+    assert!(hi.abs_diff_eq(glam::DVec3::new(20.0, 10.0, 2.0), 1e-9), "{hi}");
+}
+
+#[test]
+fn bspline_sheet_keeps_its_border() {
+    let (model, shells) = read_step_with_shells(&data("step_bspline_sheet.stp")).unwrap();
+    assert_eq!(model.faces.len(), 1);
+    assert!(!shells[0].closed);
+    let r = mesh_checked("sheet", &model, &shells, 1e-3);
+    // The open border is the square's outline: boundary edges, not cracks.
+    assert!(r.report.boundary_edges >= 4);
+    // A biquadratic whose middle control point is 4 high peaks at 4 / 4 = 1.
+    let top = r.mesh.positions.iter().map(|p| p.z).fold(f64::NEG_INFINITY, f64::max);
+    assert!((top - 1.0).abs() <= r.report.tolerance, "the bump reaches {top}");
+}
+
+#[test]
+fn a_bad_face_is_skipped_with_its_id_and_the_rest_is_read() {
+    let (model, shells) = read_step_with_shells(&data("step_bad_face.stp")).unwrap();
+    assert_eq!(model.faces.len(), 5);
+    assert_eq!(shells[0].listed, 6);
+    let w: Vec<&String> = model.warnings.iter().filter(|w| w.contains("skipped")).collect();
+    assert_eq!(w.len(), 1, "{:?}", model.warnings);
+    assert!(w[0].starts_with("#53 ADVANCED_FACE: skipped") && w[0].contains("expected an axis placement"), "{}", w[0]);
+}
+
+#[test]
+fn hostile_and_malformed_files_are_errors_naming_the_instance() {
+    let m = read_step(&data("step_hostile_knots.stp")).unwrap_err().to_string();
+    assert!(m.contains("#10") && m.contains("knot multiplicities"), "{m}");
+    let m = read_step(&data("step_unclosed_string.stp")).unwrap_err().to_string();
+    assert_eq!(m, "STEP line 10, #7: string not closed by a quote");
+    let m = read_step(&data("step_complex.stp")).unwrap_err().to_string();
+    assert!(m.contains("no faces"), "{m}");
+}
+
+/// Corpus files that mesh within tolerance, watertight, every face present.
+const MESHED: [&str; 8] = [
+    "OCC26308-Face.stp",
+    "as1-oc-214.stp",
+    "bug24983_111FACE.stp",
+    "bug29478.stp",
+    "bug29715_slow.stp",
+    "dm1-id-214.stp",
+    "io1-cm-214.stp",
+    "s1-tu-203_mainbodyfront.stp",
+];
+
+/// In a debug build, larger files are neither read nor meshed (reading
+/// projects every edge onto its surface: all 16 files take over a minute
+/// unoptimized); `cargo test --release` takes them all.
+const DEBUG_MAX_BYTES: usize = 200_000;
+
+fn corpus_files() -> Option<Vec<PathBuf>> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(corpus_dir())
+        .ok()?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().and_then(|e| e.to_str()).is_some_and(|e| e == "stp" || e == "step"))
+        .collect();
+    files.sort();
+    Some(files)
+}
+
+/// Faces the file lists (ADVANCED_FACE / FACE_SURFACE instances).
+fn faces_in_file(text: &str) -> usize {
+    text.matches("ADVANCED_FACE(").count()
+        + text.matches("ADVANCED_FACE (").count()
+        + text.matches("FACE_SURFACE(").count()
+}
+
+#[test]
+fn corpus_reads_every_face() {
+    let Some(files) = corpus_files() else {
+        eprintln!("no corpus at {}: STEP corpus test not run", corpus_dir().display());
+        return;
+    };
+    assert!(files.len() >= 16, "the corpus holds {} STEP files", files.len());
+    for path in files {
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let bytes = std::fs::read(&path).unwrap();
+        if cfg!(debug_assertions) && bytes.len() > DEBUG_MAX_BYTES {
+            eprintln!("{name}: not read in an unoptimized build (run the tests with --release)");
+            continue;
+        }
+        let (model, shells) = read_step_with_shells(&bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let skipped: Vec<&String> = model.warnings.iter().filter(|w| w.contains(": skipped:")).collect();
+        assert!(skipped.is_empty(), "{name}: {skipped:?}");
+        let listed: usize = shells.iter().map(|s| s.listed).sum();
+        assert_eq!(model.faces.len(), listed, "{name}");
+        // Every face of the file at least once (assemblies repeat faces,
+        // geometric sets add loose surfaces).
+        assert!(model.faces.len() >= faces_in_file(&String::from_utf8_lossy(&bytes)), "{name}");
+    }
+}
+
+#[test]
+fn corpus_meshes_within_tolerance_watertight() {
+    if corpus_files().is_none() {
+        eprintln!("no corpus at {}: STEP corpus test not run", corpus_dir().display());
+        return;
+    }
+    for name in MESHED {
+        let bytes = std::fs::read(corpus_dir().join(name)).unwrap();
+        if cfg!(debug_assertions) && bytes.len() > DEBUG_MAX_BYTES {
+            eprintln!("{name}: not meshed in an unoptimized build (run the tests with --release)");
+            continue;
+        }
+        let (model, shells) = read_step_with_shells(&bytes).unwrap();
+        mesh_checked(name, &model, &shells, 1e-3);
+    }
+}
