@@ -61,7 +61,7 @@ export interface MeshOutput {
 }
 
 /**
- * Reads `bytes` in `format` ("json", "iges" or "igs", or "" / "auto" to detect it) and meshes the model.
+ * Reads `bytes` in `format` ("json", "iges" or "igs", "step" or "stp", or "" / "auto" to detect it) and meshes the model.
  * Throws an `Error` whose message names the problem (the CLI's one-line error).
  */
 export function mesh(bytes: Uint8Array, format: string, options?: MeshOptions): MeshOutput;
@@ -162,7 +162,7 @@ pub fn version() -> String {
     env!("CARGO_PKG_VERSION").to_string()
 }
 
-/// Reads `bytes` in `format` (`"json"`, `"iges"`/`"igs"`, or `""`/`"auto"` to detect it) and
+/// Reads `bytes` in `format` (`"json"`, `"iges"`/`"igs"`, `"step"`/`"stp"`, or `""`/`"auto"` to detect it) and
 /// meshes the model with `options` (see the `MeshOptions` interface).
 ///
 /// # Errors
@@ -240,7 +240,7 @@ fn run(
 fn pick_format(bytes: &[u8], name: &str) -> Result<Format, Error> {
     if name.is_empty() || name.eq_ignore_ascii_case("auto") {
         Format::detect(bytes).ok_or_else(|| {
-            Error::Format("cannot detect the input format from its first bytes (expected json or iges)".into())
+            Error::Format("cannot detect the input format from its first bytes (expected json, iges or step)".into())
         })
     } else {
         Format::from_name(name)

@@ -122,7 +122,7 @@ fn mesh(m: &MeshArgs) -> Result<(), String> {
 fn input_format(path: &Path, bytes: &[u8]) -> Result<Format, String> {
     let by_name = path.extension().and_then(|e| e.to_str()).and_then(|e| Format::from_name(e).ok());
     by_name.or_else(|| Format::detect(bytes)).ok_or_else(|| {
-        Error::Format("cannot tell the input format; give --format json or --format iges".into()).to_string()
+        Error::Format("cannot tell the input format; give --format json, iges or step".into()).to_string()
     })
 }
 

@@ -696,6 +696,28 @@ fn cli_detects_the_format_without_an_extension() {
 }
 
 #[test]
+fn cli_meshes_step_by_extension_content_and_name() {
+    let dir = scratch("step");
+    let input = dir.join("cylinder.data");
+    std::fs::copy(data("step_cylinder.stp"), &input).unwrap();
+    let named = data("step_cylinder.stp");
+    for args in [
+        vec!["mesh".as_ref(), named.as_os_str()],
+        vec!["mesh".as_ref(), input.as_os_str()],
+        vec!["mesh".as_ref(), input.as_os_str(), "--format".as_ref(), "stp".as_ref()],
+    ] {
+        let out = mesh_ok(&args);
+        let r = check_report(&out.stdout);
+        assert_eq!(r["faces"], 3);
+        assert_eq!(r["boundary_edges"], 0);
+    }
+    let out = run(&["mesh".as_ref(), data("step_unclosed_string.stp").as_os_str()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("STEP line 10, #7: string not closed by a quote"), "{}", stderr(&out));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
 fn cli_writes_nothing_when_one_output_fails() {
     let dir = scratch("all-or-nothing");
     let out_path = dir.join("out.stl");

@@ -69,7 +69,8 @@ Options of `mesh`:
   --mode fast         meshing mode (`quality` is not available yet)
   --reparam MODE      rebuild poorly parameterized faces before meshing: off
                       (default), auto (faces the step-ratio test flags), force
-  --format json|iges  input format (default: from the extension, else from the content)
+  --format F          input format: json, iges (igs) or step (stp, p21); default:
+                      from the extension, else from the content
   -o, --output FILE   write the mesh; .stl, .obj, .glb, .msh (Gmsh 4.1) or
                       .unv (universal file) picks the format
   --report FILE       write the JSON report (printed to stdout when neither
