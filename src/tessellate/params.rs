@@ -156,7 +156,15 @@ fn need_all(evals: &[&dyn Fn(f64) -> (DVec3, DVec3)], a: f64, b: f64, lim: &Limi
 /// thinned to at most `max_groups` groups so surfaces with hundreds of knot
 /// spans do not force hundreds of rows where they are flat.
 pub(crate) fn initial_breaks(breaks: &[f64], lo: f64, hi: f64, max_groups: usize) -> Vec<f64> {
-    let mut inner: Vec<f64> = breaks.iter().copied().filter(|&t| t > lo && t < hi).collect();
+    // Breaks closer to an end or to each other than 1e-9 of the range would
+    // only make slivers (a knot a rounding error away from a trim edge).
+    let gap = (hi - lo) * 1e-9;
+    let mut inner: Vec<f64> = Vec::new();
+    for &t in breaks {
+        if t > lo + gap && t < hi - gap && inner.last().is_none_or(|&l| t > l + gap) {
+            inner.push(t);
+        }
+    }
     if inner.len() + 1 > max_groups {
         let step = (inner.len() + 1) as f64 / max_groups as f64;
         let mut thinned = Vec::with_capacity(max_groups);
@@ -197,4 +205,20 @@ pub(crate) fn grid_params(surface: &dyn Surface, lo: DVec2, hi: DVec2, along_u: 
     let evals: [&dyn Fn(f64) -> (DVec3, DVec3); 5] = [&c0, &c1, &c2, &c3, &c4];
     let breaks = initial_breaks(&surface.breaks(along_u), t0, t1, 16);
     subdivide(&evals, &breaks, lim)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A knot a rounding error away from the range's end (a trim edge that
+    /// stops 8e-15 past a C0 knot, as in the hammer's faces) or from another
+    /// knot starts no interval: such an interval only makes slivers.
+    #[test]
+    fn breaks_next_to_an_end_or_each_other_are_dropped() {
+        let b = initial_breaks(&[-1.02, -2.2e-15, 0.0029], -1.02, 5.8e-15, 16);
+        assert_eq!(b, [-1.02, 5.8e-15]);
+        let b = initial_breaks(&[0.0, 0.25, 0.25 + 1e-12, 0.5, 1.0], 0.0, 1.0, 16);
+        assert_eq!(b, [0.0, 0.25, 0.5, 1.0]);
+    }
 }
