@@ -257,7 +257,8 @@ pub fn repair_mesh(mesh: &Mesh, options: &RepairOptions) -> Result<RepairResult,
 /// other one reached). `clock` returns milliseconds; it times the stages.
 ///
 /// Best effort, reported in `warnings`: an open mesh keeps its open boundary
-/// (growth stops there); an inside-out closed component is turned outward;
+/// (growth stops there); vertices are not welded when welding would make the
+/// mesh non-manifold; an inside-out closed component is turned outward;
 /// contacts the exact test cannot resolve (coplanar overlaps, touching) are
 /// counted and left as they are.
 ///
@@ -290,8 +291,11 @@ pub fn repair_mesh_timed(
         });
     }
     let diag = Aabb::from_points(mesh.positions.iter().copied()).diagonal();
-    // Weld.
-    let (mut positions, mut tris) = if options.weld_tolerance > 0.0 && diag > 0.0 {
+    // Weld. Vertices an offset brought together from different sheets would
+    // join them at an edge of four triangles: then the input's own indices
+    // are kept instead, and the crossing is left to step 2.
+    let mut welded = None;
+    if options.weld_tolerance > 0.0 && diag > 0.0 {
         let (map, count) = weld_positions(&mesh.positions, options.weld_tolerance * diag);
         let mut pos = alloc::vec![DVec3::ZERO; count];
         let mut set = alloc::vec![false; count];
@@ -301,21 +305,41 @@ pub fn repair_mesh_timed(
                 pos[m as usize] = mesh.positions[i];
             }
         }
-        report.vertices_welded = mesh.positions.len() - count;
-        (pos, tris_in.iter().map(|t| t.map(|i| map[i as usize])).collect::<Vec<_>>())
-    } else {
-        (mesh.positions.clone(), tris_in)
+        let mut tris = drop_collapsed_and_duplicates(tris_in.iter().map(|t| t.map(|i| map[i as usize])).collect());
+        match topology::orient_consistently(&mut tris) {
+            Ok(flipped) => welded = Some((pos, tris, flipped, mesh.positions.len() - count)),
+            Err(e) => {
+                // Non-manifold as given too: say so in the input's own vertex numbers.
+                let mut own = drop_collapsed_and_duplicates(tris_in.clone());
+                topology::orient_consistently(&mut own)?;
+                report.warnings.push(format!(
+                    "welding within {:e} of the diagonal would make the mesh non-manifold ({e}); vertices were not welded",
+                    options.weld_tolerance
+                ));
+            }
+        }
+    }
+    let (mut positions, mut tris) = match welded {
+        Some((pos, tris, flipped, merged)) => {
+            report.vertices_welded = merged;
+            report.triangles_reoriented = flipped;
+            report.triangles_dropped = tris_in.len() - tris.len();
+            (pos, tris)
+        }
+        None => {
+            let mut tris = drop_collapsed_and_duplicates(tris_in.clone());
+            report.triangles_dropped = tris_in.len() - tris.len();
+            report.triangles_reoriented = topology::orient_consistently(&mut tris)?;
+            (mesh.positions.clone(), tris)
+        }
     };
     let before = tris.len();
-    tris = drop_collapsed_and_duplicates(tris);
-    report.triangles_dropped = before - tris.len();
     if tris.is_empty() {
         return Err(Error::Repair {
             location: "mesh".into(),
             message: "no triangle is left after welding (all collapsed)".into(),
         });
     }
-    report.triangles_reoriented = topology::orient_consistently(&mut tris)?;
     let mut nbr = topology::adjacency(&tris);
     report.free_edges_in = nbr.iter().flatten().filter(|&&u| u == topology::NONE).count();
     if report.free_edges_in > 0 {
@@ -446,6 +470,14 @@ pub fn repair_mesh_timed(
     report.volume_out = topology::signed_volume(&out_pos, out_tris.iter().copied());
     if out_tris.is_empty() {
         report.warnings.push("nothing valid was found: the result is empty".into());
+    }
+    let c = report.census_out;
+    if c.nonmanifold_edges > 0 || c.misoriented_edges > 0 {
+        // Seen only from open input, where growth can pass round the border.
+        report.warnings.push(format!(
+            "the result is not a clean 2-manifold: {} edges of more than two triangles, {} edges whose triangles disagree",
+            c.nonmanifold_edges, c.misoriented_edges
+        ));
     }
     let t4 = clock();
     if options.verify {

@@ -5,19 +5,20 @@
 use alloc::vec::Vec;
 use glam::DVec3;
 
-use super::check::triangles;
+use super::check::{census, triangles};
 use crate::{weld_positions, Error, Mesh};
 
 /// Moves every vertex by `distance` along its normal (the angle-weighted
 /// average of the facet normals around it; positive = the side the
 /// counter-clockwise triangles face). Coincident vertices (within 1e-9 of the
 /// bounding-box diagonal, as a meshed model's faces share their borders) are
-/// welded first so the offset stays closed. Triangles collapsed by welding are
-/// dropped; normals are not carried over.
+/// welded first so the offset stays closed, unless that would make an edge of
+/// more than two triangles. Triangles collapsed by welding are dropped;
+/// normals are not carried over.
 ///
 /// # Errors
-/// [`Error::Repair`] for a distance or coordinate that is not finite, or a
-/// malformed index list.
+/// [`Error::Repair`] for a distance or coordinate that is not finite, a
+/// malformed index list, or no triangles.
 pub fn offset_mesh(mesh: &Mesh, distance: f64) -> Result<Mesh, Error> {
     if !distance.is_finite() {
         return Err(Error::Repair {
@@ -26,6 +27,9 @@ pub fn offset_mesh(mesh: &Mesh, distance: f64) -> Result<Mesh, Error> {
         });
     }
     let tris = triangles(mesh)?;
+    if tris.is_empty() {
+        return Err(Error::Repair { location: "mesh".into(), message: "it has no triangles to offset".into() });
+    }
     if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(Error::Repair {
             location: alloc::format!("vertex {i}"),
@@ -34,15 +38,23 @@ pub fn offset_mesh(mesh: &Mesh, distance: f64) -> Result<Mesh, Error> {
     }
     let diag = crate::nurbs::Aabb::from_points(mesh.positions.iter().copied()).diagonal();
     let (map, count) = weld_positions(&mesh.positions, (1e-9 * diag).max(f64::MIN_POSITIVE));
-    let mut positions = alloc::vec![DVec3::ZERO; count];
-    for (i, &m) in map.iter().enumerate() {
-        positions[m as usize] = mesh.positions[i];
-    }
-    let tris: Vec<[u32; 3]> = tris
+    let welded: Vec<[u32; 3]> = tris
         .iter()
         .map(|t| t.map(|i| map[i as usize]))
         .filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
         .collect();
+    // Distinct vertices that touch (a pinch a repair left) stay apart: welding
+    // them would join two sheets at one edge.
+    let (positions, tris) = if census(&welded).nonmanifold_edges > census(&tris).nonmanifold_edges {
+        (mesh.positions.clone(), tris)
+    } else {
+        let mut positions = alloc::vec![DVec3::ZERO; count];
+        for (i, &m) in map.iter().enumerate() {
+            positions[m as usize] = mesh.positions[i];
+        }
+        (positions, welded)
+    };
+    let count = positions.len();
     let mut normals = alloc::vec![DVec3::ZERO; count];
     for t in &tris {
         let p = t.map(|i| positions[i as usize]);

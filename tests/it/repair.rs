@@ -84,6 +84,12 @@ fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
     robust::orient3d(c3(a), c3(b), c3(c), c3(d))
 }
 
+/// Exact 2-D orientation of points given as (x, y).
+fn orient2(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    let c2 = |p: [f64; 2]| robust::Coord { x: p[0], y: p[1] };
+    robust::orient2d(c2(a), c2(b), c2(c))
+}
+
 /// Whether segment `p q` crosses the interior of triangle `t` at one point
 /// strictly inside both (exact signs from the `robust` crate: an independent
 /// implementation of the predicates, not the library's).
@@ -96,39 +102,198 @@ fn segment_crosses_triangle(p: DVec3, q: DVec3, t: [DVec3; 3]) -> bool {
     s.iter().all(|&x| x > 0.0) || s.iter().all(|&x| x < 0.0)
 }
 
-/// Brute force over all pairs: triangles that share no edge must not cross.
-/// Two triangles cross along a segment exactly when an edge of one passes
-/// through the other; edges at a shared vertex can only touch there, so with
-/// one shared vertex only the two opposite edges are tried. O(n²): for small meshes.
-fn brute_force_intersections(m: &Mesh) -> usize {
-    let tris: Vec<[u32; 3]> = m.indices.chunks(3).map(|t| [t[0], t[1], t[2]]).collect();
+/// The triangle's corners with the coordinate along its normal's largest
+/// component dropped (exact: no arithmetic on the coordinates).
+fn drop_axis(t: [DVec3; 3], p: &[DVec3]) -> Vec<[f64; 2]> {
+    let n = (t[1] - t[0]).cross(t[2] - t[0]).abs();
+    let keep = if n.x >= n.y && n.x >= n.z {
+        [1, 2]
+    } else if n.y >= n.z {
+        [2, 0]
+    } else {
+        [0, 1]
+    };
+    p.iter().map(|q| [q[keep[0]], q[keep[1]]]).collect()
+}
+
+/// Whether 2-D point `p` is strictly inside triangle `t` (either orientation).
+fn strictly_inside2(p: [f64; 2], t: &[[f64; 2]]) -> bool {
+    let s = [orient2(t[0], t[1], p), orient2(t[1], t[2], p), orient2(t[2], t[0], p)];
+    s.iter().all(|&x| x > 0.0) || s.iter().all(|&x| x < 0.0)
+}
+
+/// Whether triangles `a` and `b` (vertex indices) of `m` meet anywhere but
+/// along what they share. Triangles sharing an edge are taken as neighbours.
+/// Counted: an edge of one through the interior of the other; a vertex of one
+/// on the other's plane strictly inside it (touching); coplanar triangles
+/// whose edges cross or that hold a vertex of the other strictly inside.
+/// Exact signs throughout; nothing here comes from the library.
+fn triangles_meet(m: &Mesh, a: [u32; 3], b: [u32; 3]) -> bool {
+    let shared: Vec<u32> = a.iter().copied().filter(|v| b.contains(v)).collect();
+    if shared.len() >= 2 {
+        return false;
+    }
     let pos = |i: u32| m.positions[i as usize];
-    let mut count = 0;
-    let boxes: Vec<(DVec3, DVec3)> = tris
-        .iter()
+    let (pa, pb) = (a.map(pos), b.map(pos));
+    let free_edge = |t: [u32; 3], k: usize| !shared.contains(&t[k]) && !shared.contains(&t[(k + 1) % 3]);
+    let sb = pb.map(|q| orient(pa[0], pa[1], pa[2], q));
+    let sa = pa.map(|q| orient(pb[0], pb[1], pb[2], q));
+    if sb.iter().all(|&x| x == 0.0) {
+        // Coplanar: in the plane, by dropping one coordinate.
+        if (pa[1] - pa[0]).cross(pa[2] - pa[0]) == DVec3::ZERO {
+            return false;
+        }
+        let (fa, fb) = (drop_axis(pa, &pa), drop_axis(pa, &pb));
+        for i in 0..3 {
+            for j in 0..3 {
+                if !free_edge(a, i) || !free_edge(b, j) {
+                    continue;
+                }
+                let (p, q, r, s) = (fa[i], fa[(i + 1) % 3], fb[j], fb[(j + 1) % 3]);
+                let (o1, o2) = (orient2(p, q, r), orient2(p, q, s));
+                let (o3, o4) = (orient2(r, s, p), orient2(r, s, q));
+                if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
+                    return true;
+                }
+            }
+        }
+        let inside_a = (0..3).any(|k| !shared.contains(&b[k]) && strictly_inside2(fb[k], &fa));
+        let inside_b = (0..3).any(|k| !shared.contains(&a[k]) && strictly_inside2(fa[k], &fb));
+        return inside_a || inside_b;
+    }
+    let crossing = (0..3).any(|k| free_edge(a, k) && segment_crosses_triangle(pa[k], pa[(k + 1) % 3], pb))
+        || (0..3).any(|k| free_edge(b, k) && segment_crosses_triangle(pb[k], pb[(k + 1) % 3], pa));
+    // A vertex on the other's plane strictly inside it (not a shared one).
+    let touch = |t: [u32; 3], pt: [DVec3; 3], u: [u32; 3], pu: [DVec3; 3], s: [f64; 3]| {
+        (0..3).any(|k| {
+            s[k] == 0.0
+                && !t.contains(&u[k])
+                && (pt[1] - pt[0]).cross(pt[2] - pt[0]) != DVec3::ZERO
+                && strictly_inside2(drop_axis(pt, &[pu[k]])[0], &drop_axis(pt, &pt))
+        })
+    };
+    // An edge of one lying in the other's plane and crossing one of its edges.
+    let in_plane = |t: [u32; 3], pt: [DVec3; 3], u: [u32; 3], pu: [DVec3; 3], s: [f64; 3]| {
+        if (pt[1] - pt[0]).cross(pt[2] - pt[0]) == DVec3::ZERO {
+            return false;
+        }
+        let (ft, fu) = (drop_axis(pt, &pt), drop_axis(pt, &pu));
+        (0..3).any(|j| {
+            s[j] == 0.0
+                && s[(j + 1) % 3] == 0.0
+                && free_edge(u, j)
+                && (0..3).any(|i| {
+                    let (p, q, r, w) = (ft[i], ft[(i + 1) % 3], fu[j], fu[(j + 1) % 3]);
+                    free_edge(t, i)
+                        && orient2(p, q, r) * orient2(p, q, w) < 0.0
+                        && orient2(r, w, p) * orient2(r, w, q) < 0.0
+                })
+        })
+    };
+    crossing
+        || touch(a, pa, b, pb, sb)
+        || touch(b, pb, a, pa, sa)
+        || in_plane(a, pa, b, pb, sb)
+        || in_plane(b, pb, a, pa, sa)
+}
+
+fn boxes(m: &Mesh) -> Vec<(DVec3, DVec3)> {
+    m.indices
+        .chunks(3)
         .map(|t| {
-            let p = t.map(pos);
+            let p = [0, 1, 2].map(|k| m.positions[t[k] as usize]);
             (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
         })
-        .collect();
-    for i in 0..tris.len() {
-        let a = tris[i];
-        let pa = a.map(pos);
-        for (j, b) in tris.iter().enumerate().skip(i + 1) {
-            // Boxes apart: nothing to try (a filter, not a search structure).
-            if boxes[i].0.cmpgt(boxes[j].1).any() || boxes[j].0.cmpgt(boxes[i].1).any() {
-                continue;
-            }
-            let shared: Vec<u32> = a.iter().copied().filter(|v| b.contains(v)).collect();
-            if shared.len() >= 2 {
-                continue;
-            }
-            let pb = b.map(pos);
-            let free = |t: [u32; 3], k: usize| !shared.contains(&t[k]) && !shared.contains(&t[(k + 1) % 3]);
-            let hit = (0..3).any(|k| free(a, k) && segment_crosses_triangle(pa[k], pa[(k + 1) % 3], pb))
-                || (0..3).any(|k| free(*b, k) && segment_crosses_triangle(pb[k], pb[(k + 1) % 3], pa));
-            if hit {
+        .collect()
+}
+
+fn tri(m: &Mesh, i: usize) -> [u32; 3] {
+    [m.indices[3 * i], m.indices[3 * i + 1], m.indices[3 * i + 2]]
+}
+
+fn overlap(a: &(DVec3, DVec3), b: &(DVec3, DVec3)) -> bool {
+    !(a.0.cmpgt(b.1).any() || b.0.cmpgt(a.1).any())
+}
+
+/// Brute force over all pairs (boxes apart are skipped: a filter, not a
+/// search structure). O(n²): for small meshes.
+fn brute_force_intersections(m: &Mesh) -> usize {
+    let bx = boxes(m);
+    let mut count = 0;
+    for i in 0..bx.len() {
+        for j in i + 1..bx.len() {
+            if overlap(&bx[i], &bx[j]) && triangles_meet(m, tri(m, i), tri(m, j)) {
                 count += 1;
+            }
+        }
+    }
+    count
+}
+
+/// The same count through a bounding-volume hierarchy written here (median
+/// split on the longest axis of the centroids, leaves of 8), for meshes too
+/// large for the brute force. Independent of the library's k-d tree and BVH.
+fn bvh_intersections(m: &Mesh) -> usize {
+    struct Node {
+        lo: DVec3,
+        hi: DVec3,
+        /// Children, or the range of `order` for a leaf.
+        kids: Option<(usize, usize)>,
+        range: (usize, usize),
+    }
+    fn build(bx: &[(DVec3, DVec3)], order: &mut [usize], start: usize, nodes: &mut Vec<Node>) -> usize {
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        let (mut clo, mut chi) = (lo, hi);
+        for &i in order.iter() {
+            lo = lo.min(bx[i].0);
+            hi = hi.max(bx[i].1);
+            let c = (bx[i].0 + bx[i].1) * 0.5;
+            clo = clo.min(c);
+            chi = chi.max(c);
+        }
+        let id = nodes.len();
+        nodes.push(Node { lo, hi, kids: None, range: (start, start + order.len()) });
+        if order.len() > 8 {
+            let ext = chi - clo;
+            let axis = if ext.x >= ext.y && ext.x >= ext.z {
+                0
+            } else if ext.y >= ext.z {
+                1
+            } else {
+                2
+            };
+            let key = |i: &usize| (bx[*i].0[axis] + bx[*i].1[axis]) * 0.5;
+            order.sort_by(|x, y| key(x).total_cmp(&key(y)));
+            let mid = order.len() / 2;
+            let (l, r) = order.split_at_mut(mid);
+            let left = build(bx, l, start, nodes);
+            let right = build(bx, r, start + mid, nodes);
+            nodes[id].kids = Some((left, right));
+        }
+        id
+    }
+    let bx = boxes(m);
+    let mut order: Vec<usize> = (0..bx.len()).collect();
+    let mut nodes = Vec::new();
+    build(&bx, &mut order, 0, &mut nodes);
+    let mut count = 0;
+    let mut stack = Vec::new();
+    for i in 0..bx.len() {
+        stack.push(0);
+        while let Some(n) = stack.pop() {
+            let node = &nodes[n];
+            if !overlap(&bx[i], &(node.lo, node.hi)) {
+                continue;
+            }
+            match node.kids {
+                Some((l, r)) => stack.extend([l, r]),
+                None => {
+                    for &j in &order[node.range.0..node.range.1] {
+                        if j > i && overlap(&bx[i], &bx[j]) && triangles_meet(m, tri(m, i), tri(m, j)) {
+                            count += 1;
+                        }
+                    }
+                }
             }
         }
     }
@@ -145,11 +310,13 @@ fn assert_clean(name: &str, r: &RepairResult, brute: bool) {
     assert_eq!(nonmanifold, 0, "{name}: non-manifold edges");
     assert_eq!(flipped, 0, "{name}: inconsistent orientation");
     assert!(volume(&r.mesh) > 0.0, "{name}: volume {}", volume(&r.mesh));
+    // The library's own search, then this file's independent ones.
     let exact = find_self_intersections(&r.mesh).unwrap();
     assert!(exact.is_empty(), "{name}: {} pairs still meet, first {:?}", exact.len(), &exact[..exact.len().min(5)]);
     if brute {
         assert_eq!(brute_force_intersections(&r.mesh), 0, "{name}: brute force finds intersections");
     }
+    assert_eq!(bvh_intersections(&r.mesh), 0, "{name}: the test's BVH check finds intersections");
 }
 
 // ------------------------------------------------------------ offsets
@@ -241,6 +408,99 @@ fn repair_inward_offset_of_a_corpus_cube_folds_at_its_edges() {
     assert!((v - 216.0).abs() < 0.15 * 216.0, "volume {v}");
 }
 
+#[test]
+fn the_tests_own_intersection_checks_see_crossing_touching_and_coplanar_pairs() {
+    // Two triangles and nothing else: does the pair count as meeting?
+    let pair = |a: [[f64; 3]; 3], b: [[f64; 3]; 3]| {
+        let positions = a.iter().chain(&b).map(|p| DVec3::from_array(*p)).collect();
+        let m = Mesh { positions, normals: Vec::new(), indices: vec![0, 1, 2, 3, 4, 5], face_ranges: Vec::new() };
+        let (brute, bvh) = (brute_force_intersections(&m), bvh_intersections(&m));
+        assert_eq!(brute, bvh);
+        brute
+    };
+    let base = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
+    assert_eq!(pair(base, [[1.0, 1.0, -1.0], [1.0, 1.0, 1.0], [3.0, 3.0, 1.0]]), 1, "crossing");
+    assert_eq!(pair(base, [[1.0, 1.0, 0.0], [1.0, 1.0, 1.0], [2.0, 1.0, 1.0]]), 1, "vertex touching the interior");
+    assert_eq!(pair(base, [[1.0, 1.0, 0.0], [5.0, 1.0, 0.0], [1.0, 5.0, 0.0]]), 1, "coplanar overlap");
+    assert_eq!(pair(base, [[-1.0, 1.0, 0.0], [5.0, 1.0, 0.0], [2.0, 1.0, 3.0]]), 1, "an edge in the plane");
+    assert_eq!(pair(base, [[1.0, 1.0, 0.5], [1.0, 1.0, 1.0], [3.0, 3.0, 1.0]]), 0, "above");
+    assert_eq!(pair(base, [[5.0, 0.0, 0.0], [9.0, 0.0, 0.0], [5.0, 4.0, 0.0]]), 0, "coplanar apart");
+    // On a raw offset that crosses itself, both agree with the library's search on the pairs.
+    let m = scaled(meshed("sphere.json", 2e-2), DVec3::new(2.5, 1.5, 1.0));
+    let off = offset_mesh(&m, -6.0).unwrap();
+    let (brute, bvh) = (brute_force_intersections(&off), bvh_intersections(&off));
+    let library = find_self_intersections(&off).unwrap().len();
+    eprintln!(
+        "raw offset of {} triangles: {brute} pairs by brute force, {bvh} by BVH, {library} by the library",
+        off.triangle_count()
+    );
+    assert!(brute > 10);
+    assert_eq!(brute, bvh);
+    assert_eq!(brute, library);
+}
+
+/// A corpus part meshed with edges up to `max_edge`, welded.
+fn corpus_mesh(name: &str, max_edge: f64) -> Mesh {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus").join(name);
+    let Ok(bytes) = std::fs::read(&path) else {
+        panic!("the corpus is expected beside the repository (../shared/corpus): {}", path.display());
+    };
+    let model = read_iges(&bytes).unwrap();
+    let r = mesh_model(&model, &MeshOptions::default().with_max_edge(Some(max_edge))).unwrap();
+    let diag = bbox_diagonal(&r.mesh);
+    let mut m = weld_mesh(&r.mesh, 1e-9 * diag);
+    drop_collapsed(&mut m);
+    m
+}
+
+#[test]
+fn repair_inward_offsets_of_corpus_solids_are_clean() {
+    // A CATIA cylinder (diameter 100, height 100; its faces come out facing
+    // inward) and a capsule whose mesh has slivers and a few crossings where
+    // its faces meet: each is repaired into a closed outward solid first, then
+    // offset inward by a few percent of its size, and the rims fold over.
+    for (name, max_edge, d) in [("OCC8842_cylinder_CATIA.igs", 8.0, -5.0), ("marsCapsule.igs", 1.0, -0.5)] {
+        let m = corpus_mesh(name, max_edge);
+        let outward = repair_mesh(&m, &RepairOptions::default()).unwrap().mesh;
+        assert_eq!(census(&outward), (0, 0, 0), "{name}: the meshed solid is closed");
+        assert!(volume(&outward) > 0.0);
+        let off = offset_mesh(&outward, d).unwrap();
+        assert!(!find_self_intersections(&off).unwrap().is_empty(), "{name}: the offset should self-intersect");
+        let r = repair_mesh(&off, &RepairOptions::default()).unwrap();
+        assert_clean(name, &r, false);
+        assert!(volume(&r.mesh) < volume(&outward), "{name}: inward");
+    }
+}
+
+#[test]
+fn repair_of_an_open_corpus_part_keeps_its_border_and_crosses_nothing() {
+    // The bearing is an open shell (70 free edges in loops: faces missing in
+    // the file). An inward offset by 2% of its size crosses itself; the
+    // repair is a best effort: the border stays open, the result crosses
+    // nothing, every edge has at most two triangles and they agree.
+    let m = corpus_mesh("bearing.iges", 0.004);
+    let (free, nonmanifold, _) = census(&m);
+    assert!(free > 0 && nonmanifold == 0);
+    let off = offset_mesh(&m, -0.0032).unwrap();
+    assert!(!find_self_intersections(&off).unwrap().is_empty());
+    let r = repair_mesh(&off, &RepairOptions::default()).unwrap();
+    eprintln!("bearing: {:?}", r.report);
+    assert!(r.report.warnings.iter().any(|w| w.contains("open")), "{:?}", r.report.warnings);
+    let (free_out, nonmanifold_out, flipped) = census(&r.mesh);
+    assert!(free_out > 0);
+    assert_eq!((nonmanifold_out, flipped), (0, 0));
+    assert!(find_self_intersections(&r.mesh).unwrap().is_empty());
+    assert_eq!(bvh_intersections(&r.mesh), 0);
+    // Deeper, growth leaks around the open border onto both sides of some
+    // crossings: the result then has edges of four triangles, and says so.
+    let off = offset_mesh(&m, -0.008).unwrap();
+    let r = repair_mesh(&off, &RepairOptions::default()).unwrap();
+    let nonmanifold = census(&r.mesh).1;
+    eprintln!("bearing deeper: {nonmanifold} non-manifold edges, warnings {:?}", r.report.warnings);
+    assert_eq!(nonmanifold, r.report.census_out.nonmanifold_edges);
+    assert_eq!(nonmanifold > 0, r.report.warnings.iter().any(|w| w.contains("not a clean 2-manifold")));
+}
+
 // ------------------------------------------------------------ bad input
 
 #[test]
@@ -296,6 +556,78 @@ fn repair_turns_an_inside_out_mesh_outward() {
     let r = repair_mesh(&m, &RepairOptions::default()).unwrap();
     assert!(volume(&r.mesh) > 0.0);
     assert!(r.report.warnings.iter().any(|w| w.contains("inside out")), "{:?}", r.report.warnings);
+}
+
+mod random_input {
+    //! Random input never panics: triangle soups on a coarse grid (coplanar,
+    //! collinear, coincident and repeated triangles everywhere), and closed
+    //! meshes with vertices thrown about until they cross themselves.
+
+    use super::*;
+    use proptest::prelude::*;
+    use proptest::test_runner::{Config, RngSeed};
+
+    /// Fewer cases unoptimized (CI's `cargo test` is a debug build).
+    fn config(cases: u32) -> Config {
+        let cases = if cfg!(debug_assertions) { cases / 4 } else { cases };
+        Config { cases, rng_seed: RngSeed::Fixed(0x5eed_0008), failure_persistence: None, ..Config::default() }
+    }
+
+    /// The sphere all cases throw about, meshed once.
+    fn sphere() -> &'static Mesh {
+        static SPHERE: std::sync::OnceLock<Mesh> = std::sync::OnceLock::new();
+        SPHERE.get_or_init(|| meshed("sphere.json", 5e-2))
+    }
+
+    proptest! {
+        #![proptest_config(config(96))]
+
+        #[test]
+        fn triangle_soups_get_a_result_or_an_error(
+            corners in proptest::collection::vec((0u8..3, 0u8..3, 0u8..3), 3..40),
+            picks in proptest::collection::vec(0usize..40, 3..60),
+        ) {
+            let positions: Vec<DVec3> = corners.iter().map(|&(x, y, z)| DVec3::new(x as f64, y as f64, z as f64)).collect();
+            let n = positions.len();
+            let indices: Vec<u32> = picks[..picks.len() / 3 * 3].iter().map(|&i| (i % n) as u32).collect();
+            let m = Mesh { positions, normals: Vec::new(), indices, face_ranges: Vec::new() };
+            match repair_mesh(&m, &RepairOptions::default()) {
+                Ok(r) => {
+                    prop_assert_eq!(r.report.triangles_out, r.mesh.triangle_count());
+                    prop_assert!(r.mesh.indices.iter().all(|&i| (i as usize) < r.mesh.positions.len()));
+                }
+                Err(e) => prop_assert!(!e.to_string().is_empty()),
+            }
+        }
+
+        #[test]
+        fn closed_meshes_thrown_out_of_shape_come_out_clean_or_say_why(
+            seed in any::<u64>(), share in 0.05f64..0.5, size in 0.5f64..8.0,
+        ) {
+            let mut m = sphere().clone();
+            let mut rng = seed | 1;
+            let mut next = move || {
+                rng ^= rng << 13;
+                rng ^= rng >> 7;
+                rng ^= rng << 17;
+                (rng >> 11) as f64 / (1u64 << 53) as f64
+            };
+            for p in &mut m.positions {
+                if next() < share {
+                    *p += DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * 2.0 * size;
+                }
+            }
+            let r = repair_mesh(&m, &RepairOptions::default()).unwrap();
+            let (free, nonmanifold, flipped) = census(&r.mesh);
+            if r.report.warnings.is_empty() {
+                prop_assert_eq!((free, nonmanifold, flipped), (0, 0, 0), "{:?}", r.report);
+                prop_assert_eq!(bvh_intersections(&r.mesh), 0, "{:?}", r.report);
+                prop_assert!(r.mesh.triangle_count() == 0 || volume(&r.mesh) > 0.0);
+            } else {
+                prop_assert_eq!(r.report.census_out, surfmesh::mesh_edge_census(&r.mesh).unwrap());
+            }
+        }
+    }
 }
 
 // ------------------------------------------------------------ readers
@@ -391,6 +723,24 @@ fn cli_offset_then_repair_writes_a_clean_mesh_and_a_report() {
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(err.trim(), "surfmesh: bad.obj: OBJ line 3: vertex index 9 is out of range (1 to 2 so far)");
+    assert!(!dir.join("never.stl").exists());
+    // Empty files, and a file with a vertex but no triangle.
+    std::fs::write(dir.join("empty.stl"), "").unwrap();
+    std::fs::write(dir.join("empty.obj"), "").unwrap();
+    std::fs::write(dir.join("point.obj"), "v 0 0 0\n").unwrap();
+    for (args, message) in [
+        (&["repair", "empty.stl", "-o", "never.stl"][..], "surfmesh: empty.stl: STL: the file is empty"),
+        (&["repair", "empty.obj", "-o", "never.stl"][..], "surfmesh: empty.obj: repair: mesh: it has no triangles"),
+        (&["repair", "point.obj", "-o", "never.stl"][..], "surfmesh: point.obj: repair: mesh: it has no triangles"),
+        (
+            &["offset", "empty.obj", "-d", "1", "-o", "never.stl"][..],
+            "surfmesh: empty.obj: repair: mesh: it has no triangles to offset",
+        ),
+    ] {
+        let out = run(args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        assert_eq!(String::from_utf8_lossy(&out.stderr).trim(), message);
+    }
     assert!(!dir.join("never.stl").exists());
     let out = run(&["repair", "off.stl", "--bucketing", "octree"]);
     assert_eq!(out.status.code(), Some(2));
