@@ -5,7 +5,10 @@
 use alloc::vec::Vec;
 use glam::DVec3;
 
+use core::cmp::Ordering;
+
 use super::broad::bvh_pairs;
+use super::predicates::orient3d;
 use super::topology::{edge, key};
 use super::tritri::{contact, Contact, Tri};
 use crate::nurbs::Aabb;
@@ -112,10 +115,47 @@ pub(crate) fn self_intersections(positions: &[DVec3], tris: &[[u32; 3]]) -> Vec<
     };
     let mut out = Vec::new();
     bvh_pairs(&boxes, |a, b| {
-        if contact(&tri(a), &tri(b)) != Contact::None {
-            out.push([a, b]);
+        let (ta, tb) = (tri(a), tri(b));
+        match contact(&ta, &tb) {
+            Contact::None => {}
+            // The contact test is conservative (a vertex exactly on the
+            // other's plane is flagged wherever it lies): keep such pairs only
+            // when the closed triangles really meet.
+            Contact::Degenerate if apart(&ta, &tb) => {}
+            _ => out.push([a, b]),
         }
     });
     out.sort_unstable();
     out
+}
+
+/// Whether two triangles with no vertex in common, neither lying in the
+/// other's plane, are certainly apart: no edge of either meets the other
+/// closed triangle (exact signs). False when unsure (shared vertices, coplanar edges).
+fn apart(a: &Tri, b: &Tri) -> bool {
+    if a.v.iter().any(|v| b.v.contains(v)) {
+        return false;
+    }
+    let edge_meets = |p: DVec3, q: DVec3, t: &[DVec3; 3]| -> Option<bool> {
+        let (sp, sq) = (orient3d(t[0], t[1], t[2], p), orient3d(t[0], t[1], t[2], q));
+        if sp == Ordering::Equal && sq == Ordering::Equal {
+            return None;
+        }
+        if sp != Ordering::Equal && sp == sq {
+            return Some(false);
+        }
+        // pq reaches the plane inside the closed triangle exactly when it
+        // passes no edge of it on the outside.
+        let s = [orient3d(p, q, t[0], t[1]), orient3d(p, q, t[1], t[2]), orient3d(p, q, t[2], t[0])];
+        Some(s.iter().all(|&x| x != Ordering::Less) || s.iter().all(|&x| x != Ordering::Greater))
+    };
+    for (x, y) in [(a, b), (b, a)] {
+        for k in 0..3 {
+            match edge_meets(x.p[k], x.p[(k + 1) % 3], &y.p) {
+                Some(false) => {}
+                _ => return false,
+            }
+        }
+    }
+    true
 }
