@@ -23,7 +23,10 @@ pub(crate) fn triangulate_region(
     points: &[DVec2],
     constraints: &[[usize; 2]],
 ) -> Result<Vec<[u32; 3]>, Error> {
-    let verts: Vec<Point2<f64>> = points.iter().map(|p| Point2::new(p.x, p.y)).collect();
+    // spade refuses non-zero coordinates nearer 0 than about 1.8e-43
+    // (`TooSmall`); files do hold such values (3e-49 for 0), which are 0.
+    let flush = |x: f64| if x.abs() < 1e-40 { 0.0 } else { x };
+    let verts: Vec<Point2<f64>> = points.iter().map(|p| Point2::new(flush(p.x), flush(p.y))).collect();
     let mut conflict = None;
     let cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(verts, constraints.to_vec(), |e| {
         conflict = Some(e)

@@ -286,6 +286,16 @@ fn mesh_cone_apex_meets_the_angle_limit() {
     }
 }
 
+/// Files hold coordinates like 3.8e-49 for 0; the triangulator refuses
+/// non-zero values that small, so they are taken as 0 and the face meshes.
+#[test]
+fn mesh_takes_vanishing_trim_coordinates_as_zero() {
+    let lp = uv_polygon(&[(0.2, 3.7569948658334295e-49), (0.8, 0.0), (0.8, 0.8), (0.2, 0.8)]);
+    let r = mesh(&face_with_loops(vec![lp]), 1e-2);
+    assert!(r.report.triangles > 0 && r.report.faces_skipped == 0, "{:?}", r.report.warnings);
+    assert!(r.report.max_deviation <= r.report.tolerance);
+}
+
 #[test]
 fn mesh_rejects_bad_options() {
     let model = shapes::freeform();
