@@ -42,6 +42,8 @@ pub(crate) struct SurfaceIndex<'a> {
     nearest: Vec<(f64, u32)>,
     touched: Vec<u32>,
     candidates: Vec<Candidate>,
+    /// Distances above this get a second projection from the point's own nearest sample.
+    retry_above: f64,
 }
 
 impl<'a> SurfaceIndex<'a> {
@@ -68,7 +70,16 @@ impl<'a> SurfaceIndex<'a> {
             nearest: alloc::vec![(f64::INFINITY, 0); faces.len()],
             touched: Vec::new(),
             candidates: Vec::new(),
+            retry_above: f64::INFINITY,
         }
+    }
+
+    /// Distances above `above` are checked again by a projection from the
+    /// point's own nearest sample: on a poorly parameterized face (paper 001)
+    /// Newton from the centroid's closest point can stop at a far-off point
+    /// across an abrupt change of parameter speed, and over-state the deviation.
+    pub(crate) fn retry_above(&mut self, above: f64) {
+        self.retry_above = above;
     }
 
     /// Box of all samples (the trimmed geometry, as far as sampled).
@@ -139,6 +150,18 @@ impl<'a> SurfaceIndex<'a> {
                 let hint = cand.uv + tangent_step(cand.su, cand.sv, *q - cand.point);
                 let pr = project_to_surface(s, *q, Some(hint), &self.projection);
                 *o = o.min(pr.distance).min(q.distance(cand.point));
+            }
+        }
+        for (q, o) in points.iter().zip(out.iter_mut()) {
+            if *o <= self.retry_above {
+                continue;
+            }
+            let samples = &self.samples;
+            if let Some((d, i)) = self.bvh.nearest(*q, f64::INFINITY, |i| samples[i as usize].point.distance(*q)) {
+                let s = &samples[i as usize];
+                let surface: &dyn Surface = &self.faces[s.face as usize].surface;
+                let pr = project_to_surface(surface, *q, Some(s.uv), &self.projection);
+                *o = o.min(pr.distance).min(d);
             }
         }
     }

@@ -156,6 +156,7 @@ pub fn measure_mesh(model: &Model, mesh: &Mesh, options: &MeasureOptions) -> Mes
     let mut index = SurfaceIndex::new(&model.faces, &plans, spacing(&plans, options.index_samples), options.projection);
     let diagonal = index.bbox().diagonal();
     let tolerance = options.tolerance.filter(|t| *t > 0.0 && t.is_finite()).unwrap_or(1e-3 * diagonal);
+    index.retry_above(0.5 * tolerance);
     let mut out = MeshMeasure {
         tolerance,
         diagonal,
