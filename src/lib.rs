@@ -47,7 +47,10 @@ pub use repair::{
     find_self_intersections, mesh_edge_census, mesh_volume, offset_mesh, repair_mesh, repair_mesh_timed, Bucketing,
     EdgeCensus, RepairOptions, RepairReport, RepairResult, StageTimes,
 };
-pub use reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
+pub use reparam::{
+    rebuild_face, reparameterize_model, step_ratio, Rebuilt, Reparam, ReparamFace, ReparamModel, FIT_LIMIT, FIT_SHARE,
+    RATIO_LIMIT,
+};
 /// The mesher's stages one at a time, for the criterion benches; not a stable API.
 #[cfg(feature = "std")]
 #[doc(hidden)]

@@ -91,13 +91,14 @@ impl Surface for FaceSurface {
     }
     fn breaks(&self, along_u: bool) -> Vec<f64> {
         match self {
+            // Every 8th knot: the mesher's first intervals then follow the
+            // samples (spaced by model-space length) at about a quarter of the
+            // chords the tolerance needs, so its interval splitting stays
+            // local where curvature varies, without forcing rows at coarse tolerances.
             Self::Rebuilt(s) => {
-                let [lo, hi] = s.domain();
-                if along_u {
-                    alloc::vec![lo.x, hi.x]
-                } else {
-                    alloc::vec![lo.y, hi.y]
-                }
+                let b = s.breaks(along_u);
+                let last = b.len().saturating_sub(1);
+                b.iter().enumerate().filter(|&(i, _)| i % 8 == 0 || i == last).map(|(_, &t)| t).collect()
             }
             _ => self.base_nurbs().breaks(along_u),
         }

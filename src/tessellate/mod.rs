@@ -71,9 +71,9 @@ pub fn mesh_model_with_progress(
     let mut used = 0usize;
     let mut first_failure: Option<Error> = None;
     for (index, original) in model.faces.iter().enumerate() {
-        let (mut f, mut fit_error) = match rebuilt.get(index) {
-            Some(Some(r)) => (&r.face, r.fit_error),
-            _ => (original, 0.0),
+        let (mut f, mut fit_error, cap) = match rebuilt.get(index) {
+            Some(Some(r)) => (&r.face, r.fit_error, r.max_edge),
+            _ => (original, 0.0, f64::INFINITY),
         };
         let budget = options.max_triangles.saturating_sub(used);
         if budget < 2 {
@@ -92,17 +92,23 @@ pub fn mesh_model_with_progress(
         }
         // A rebuilt face is meshed within what its fit error leaves of the tolerance.
         let share = if fit_error > 0.0 { ((tol - fit_error) / tol).clamp(0.5, 1.0) } else { 1.0 };
-        let face_lim = params::Limits { tol: lim.tol * share, ..lim };
-        let face_crit = refine::Criteria { tol: crit.tol * share, ..crit };
+        let face_lim = params::Limits { tol: lim.tol * share, max_edge: lim.max_edge.min(cap), ..lim };
+        let face_crit = refine::Criteria { tol: crit.tol * share, max_edge: crit.max_edge.min(cap), ..crit };
         let mut fr = face::mesh_face(index, f, &face_lim, &face_crit, budget);
-        if fit_error > 0.0 && !matches!(&fr, Ok(r) if !r.mesh.tris.is_empty()) {
-            // The rebuilt face failed to mesh: the original face it is, with a warning.
-            report.warnings.push(format!("face {index}: the rebuilt face did not mesh; meshed the original"));
-            if let Some(r) = report.reparameterized.iter_mut().find(|r| r.face == index) {
-                r.rebuilt = false;
+        if fit_error > 0.0 {
+            // Paper 001's rebuild is kept where it pays: under `auto` the
+            // original is meshed too and wins on more triangles or worse angles.
+            let failed = !matches!(&fr, Ok(r) if !r.mesh.tris.is_empty());
+            if failed || options.reparam == Reparam::Auto {
+                let orig = face::mesh_face(index, original, &lim, &crit, budget);
+                if let Some(why) = rebuild_loses(&fr, &orig) {
+                    report.warnings.push(format!("face {index}: {why}; meshed the original"));
+                    if let Some(r) = report.reparameterized.iter_mut().find(|r| r.face == index) {
+                        r.rebuilt = false;
+                    }
+                    (f, fit_error, fr) = (original, 0.0, orig);
+                }
             }
-            (f, fit_error) = (original, 0.0);
-            fr = face::mesh_face(index, f, &lim, &crit, budget);
         }
         let mut fr = match fr {
             Ok(fr) => fr,
@@ -257,6 +263,46 @@ fn reparameterize(model: &Model, mode: Reparam, tol: f64, report: &mut Report) -
         }
     }
     out
+}
+
+/// Why the mesh of a rebuilt face loses to the original's, if it does: it
+/// failed or is empty, is not proven where the original is, has more
+/// triangles, or a smaller 1st-percentile angle. `None` keeps the rebuild.
+fn rebuild_loses(
+    rebuilt: &Result<face::FaceResult<'_>, Error>,
+    original: &Result<face::FaceResult<'_>, Error>,
+) -> Option<alloc::string::String> {
+    let Some(new) = rebuilt.as_ref().ok().filter(|r| !r.mesh.tris.is_empty()) else {
+        return Some("the rebuilt face did not mesh".into());
+    };
+    let old = original.as_ref().ok()?;
+    let p1 = |m: &refine::WorkMesh| {
+        let corner = |a: glam::DVec3, b: glam::DVec3, c: glam::DVec3| crate::math::angle_between(b - a, c - a);
+        let mut a: Vec<f64> = m
+            .tris
+            .iter()
+            .map(|t| {
+                let [p, q, r] = t.map(|v| m.pos.get(v as usize).copied().unwrap_or_default());
+                corner(p, q, r).min(corner(q, r, p)).min(corner(r, p, q))
+            })
+            .collect();
+        a.sort_by(f64::total_cmp);
+        a.get(a.len().saturating_sub(1) / 100).map_or(0.0, |x| x.to_degrees())
+    };
+    let (nt, ot) = (new.mesh.tris.len(), old.mesh.tris.len());
+    if new.outcome.unproven > old.outcome.unproven {
+        Some(format!("the rebuilt face left {} triangles unproven", new.outcome.unproven))
+    } else if nt > ot {
+        Some(format!("the rebuilt face took more triangles ({nt} against {ot})"))
+    } else if p1(&new.mesh) < p1(&old.mesh) {
+        Some(format!(
+            "the rebuilt face's triangles were worse shaped (1st-percentile angle {:.1}° against {:.1}°)",
+            p1(&new.mesh),
+            p1(&old.mesh)
+        ))
+    } else {
+        None
+    }
 }
 
 /// What the options come to for one model.

@@ -6,8 +6,9 @@ use glam::DVec3;
 
 use crate::shapes::{unit_circle, CIRCLE_KNOTS};
 use surfmesh::{
-    measure_mesh, mesh_model, read_json, step_ratio, Face, FaceSurface, MeasureOptions, MeshOptions, MeshResult, Model,
-    NurbsCurve, NurbsSurface, Reparam, TrimLoop, RATIO_LIMIT,
+    measure_mesh, mesh_model, read_iges, read_json, reparameterize_model, step_ratio, write_iges, Face, FaceSurface,
+    MeasureOptions, MeshOptions, MeshResult, Model, NurbsCurve, NurbsSurface, Reparam, Surface, Tolerance, TrimLoop,
+    FIT_LIMIT, RATIO_LIMIT,
 };
 
 /// A wavy sheet whose u parameter crowds: the first 80% of the u range (8 of
@@ -56,10 +57,9 @@ fn area(r: &MeshResult) -> f64 {
         .sum()
 }
 
-/// Auto against off on one model: flagged and rebuilt (triangle counts and
-/// angles are printed: the mesher does not yet turn even parameters into
-/// fewer triangles every time), and within tolerance of the original
-/// surface by the independent yardstick (deviation and coverage).
+/// Auto against off on one model: flagged, rebuilt within the fit limit or
+/// guarded back to the original with a warning, and within tolerance of the
+/// original surface by the independent yardstick (deviation and coverage).
 fn auto_against_off(m: &Model, rel: f64) -> (MeshResult, MeshResult) {
     let off = mesh(m, rel, Reparam::Off);
     let auto = mesh(m, rel, Reparam::Auto);
@@ -78,8 +78,12 @@ fn auto_against_off(m: &Model, rel: f64) -> (MeshResult, MeshResult) {
         measure_mesh(m, &auto.mesh, &MeasureOptions::default().with_tolerance(rep.tolerance)).max_deviation,
         rep.tolerance
     );
-    assert!(flagged.rebuilt && flagged.ratio > RATIO_LIMIT, "{flagged:?} {:?}", rep.warnings);
-    assert!(flagged.fit_error <= rep.tolerance / 4.0, "{flagged:?}");
+    assert!(flagged.ratio > RATIO_LIMIT, "{flagged:?} {:?}", rep.warnings);
+    if flagged.rebuilt {
+        assert!(flagged.fit_error <= rep.tolerance * FIT_LIMIT, "{flagged:?}");
+    } else {
+        assert!(rep.warnings.iter().any(|w| w.contains("meshed the original")), "{:?}", rep.warnings);
+    }
     assert!(rep.warnings.iter().any(|w| w.contains("poorly parameterized")), "{:?}", rep.warnings);
     assert!(off.report.reparameterized.is_empty());
     assert!(rep.max_deviation <= rep.tolerance);
@@ -97,6 +101,12 @@ fn auto_against_off(m: &Model, rel: f64) -> (MeshResult, MeshResult) {
     (off, auto)
 }
 
+/// A model from tests/data.
+fn data(name: &str) -> Model {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    read_json(&std::fs::read(dir.join(name)).unwrap()).unwrap()
+}
+
 #[test]
 fn reparam_crowded_sheet_meshes_within_tolerance_of_the_original() {
     let m = model(Vec::new());
@@ -104,6 +114,33 @@ fn reparam_crowded_sheet_meshes_within_tolerance_of_the_original() {
     for rel in [1e-2, 1e-3] {
         auto_against_off(&m, rel);
     }
+}
+
+/// The crowded surfaces of tests/data (90% of a parameter range covering 5%
+/// of the surface): with `auto`, never more triangles nor a smaller
+/// 1st-percentile angle than with `off` (the per-face guard keeps the
+/// original otherwise), and where the rebuild is kept the angle is higher;
+/// within tolerance of the ORIGINAL surface by the yardstick.
+#[test]
+fn reparam_crowded_surfaces_win_or_keep_the_original() {
+    let mut kept = 0;
+    for name in ["crowded_u.json", "crowded_uv.json", "crowded_trimmed.json", "crowded_tube.json"] {
+        let m = data(name);
+        for rel in [1e-2, 1e-3] {
+            let (off, auto) = auto_against_off(&m, rel);
+            let (o, a) = (&off.report, &auto.report);
+            assert!(a.triangles <= o.triangles, "{name} at {rel}: {} > {} triangles", a.triangles, o.triangles);
+            assert!(a.p1_angle_deg >= o.p1_angle_deg, "{name} at {rel}: p1 {} < {}", a.p1_angle_deg, o.p1_angle_deg);
+            if a.reparameterized[0].rebuilt {
+                kept += 1;
+                assert!(a.p1_angle_deg > o.p1_angle_deg, "{name} at {rel}: rebuilt but p1 {}", a.p1_angle_deg);
+            } else {
+                assert_eq!(a.triangles, o.triangles, "{name} at {rel}: the guard keeps the original mesh");
+            }
+        }
+    }
+    // The guard is a net, not the rule: most of these meshes keep the rebuild.
+    assert!(kept >= 6, "only {kept} of 8 kept the rebuild");
 }
 
 #[test]
@@ -158,4 +195,81 @@ fn reparam_force_on_degenerate_faces_falls_back_or_holds_tolerance() {
     assert!(!r.report.reparameterized[0].rebuilt, "{:?}", r.report.warnings);
     assert!(r.report.warnings.iter().any(|w| w.contains("meshed")), "{:?}", r.report.warnings);
     assert!(r.report.max_deviation <= r.report.tolerance);
+}
+
+/// Largest distance between two faces' surfaces over a 9 × 9 grid of their (equal) domains.
+fn surface_gap(a: &Face, b: &Face) -> f64 {
+    let [lo, hi] = a.surface.domain();
+    assert_eq!([lo, hi], b.surface.domain());
+    let mut gap = 0.0f64;
+    for i in 0..=8 {
+        for j in 0..=8 {
+            let uv = lo + (hi - lo) * glam::DVec2::new(i as f64 / 8.0, j as f64 / 8.0);
+            gap = gap.max(a.surface.point(uv).distance(b.surface.point(uv)));
+        }
+    }
+    gap
+}
+
+/// Paper 001's output is the rebuilt geometry: written as IGES and read back
+/// by the project's reader it is the same surfaces and loops, and meshes within
+/// tolerance of the ORIGINAL model.
+#[test]
+fn reparam_written_iges_reads_back_as_the_rebuilt_faces() {
+    for name in ["crowded_u.json", "crowded_trimmed.json", "sphere.json", "trimmed_holes.json"] {
+        let m = data(name);
+        let out = reparameterize_model(&m, Reparam::Auto, Tolerance::Relative(1e-3)).unwrap();
+        let crowded = name.starts_with("crowded");
+        assert_eq!(out.faces.iter().filter(|f| f.rebuilt).count(), usize::from(crowded), "{name}: {:?}", out.warnings);
+        let bytes = write_iges(&out.model);
+        assert!(bytes.split(|&b| b == b'\n').all(|l| l.is_empty() || l.len() == 80), "{name}: 80-column records");
+        let back = read_iges(&bytes).unwrap();
+        assert_eq!(back.faces.len(), out.model.faces.len(), "{name}: {:?}", back.warnings);
+        assert_eq!(back.units, "mm");
+        for (a, b) in out.model.faces.iter().zip(&back.faces) {
+            assert!(surface_gap(a, b) < 1e-9, "{name}: surfaces differ by {}", surface_gap(a, b));
+            assert_eq!(a.loops.len(), b.loops.len(), "{name}");
+        }
+        let tol = out.tolerance;
+        let r = mesh_model(&back, &MeshOptions::default().with_tolerance(tol)).unwrap();
+        let yard = measure_mesh(&m, &r.mesh, &MeasureOptions::default().with_tolerance(tol));
+        assert!(yard.max_deviation <= tol, "{name}: {} > {tol} against the original", yard.max_deviation);
+        assert!(yard.coverage <= tol, "{name}: coverage {}", yard.coverage);
+    }
+}
+
+/// `surfmesh reparam IN -o OUT.igs` writes the rebuilt faces and a report; the
+/// file reads back through the IGES reader.
+#[test]
+fn reparam_command_writes_iges() {
+    let dir = std::env::temp_dir().join(format!("surfmesh-it-{}-reparam", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/crowded_uv.json");
+    let (out, report) = (dir.join("out.igs"), dir.join("report.json"));
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_surfmesh"))
+        .arg("reparam")
+        .arg(&input)
+        .arg("-o")
+        .arg(&out)
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let rep: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert_eq!(rep["rebuilt"], 1, "{rep}");
+    let back = read_iges(&std::fs::read(&out).unwrap()).unwrap();
+    assert_eq!(back.faces.len(), 1);
+    assert!(step_ratio(&back.faces[0].surface) < RATIO_LIMIT, "the written surface is evenly parameterized");
+    // A wrong output extension is a usage error, nothing written.
+    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_surfmesh"))
+        .arg("reparam")
+        .arg(&input)
+        .arg("-o")
+        .arg(dir.join("out.stl"))
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(!dir.join("out.stl").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
 }
