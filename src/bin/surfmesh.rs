@@ -7,6 +7,8 @@ mod args;
 mod fit;
 #[path = "surfmesh/repair.rs"]
 mod repair;
+#[path = "surfmesh/reparam.rs"]
+mod reparam;
 
 use std::ffi::OsString;
 use std::fs;
@@ -21,7 +23,7 @@ use surfmesh::{mesh_model, read_model, write_glb, write_msh, write_obj, write_st
 fn main() -> ExitCode {
     match args::parse(std::env::args_os().skip(1).collect()) {
         Ok(Command::Help) => {
-            print!("{}\n{}\n{}", args::USAGE, repair::USAGE, fit::USAGE);
+            print!("{}\n{}\n{}\n{}", args::USAGE, repair::USAGE, fit::USAGE, reparam::USAGE);
             ExitCode::SUCCESS
         }
         Ok(Command::Version) => {
@@ -38,6 +40,7 @@ fn main() -> ExitCode {
         Ok(Command::Offset(a)) => finish(&a.input, repair::run_offset(&a)),
         Ok(Command::Repair(a)) => finish(&a.input, repair::run_repair(&a)),
         Ok(Command::Fit(a)) => finish(&a.input, fit::run(&a)),
+        Ok(Command::Reparam(a)) => finish(&a.input, reparam::run(&a)),
         Err(message) => {
             eprintln!("surfmesh: {}", one_line(&message));
             ExitCode::from(2)

@@ -2,6 +2,7 @@
 
 mod glb;
 mod iges;
+mod iges_write;
 mod json;
 mod meshfile;
 mod msh;
@@ -14,6 +15,7 @@ use alloc::format;
 
 pub use glb::write_glb;
 pub use iges::read_iges;
+pub use iges_write::write_iges;
 pub use json::read_json;
 pub(crate) use meshfile::MAX_COORDINATE;
 pub use meshfile::{read_mesh, MeshFormat};

@@ -20,6 +20,8 @@ pub enum Command {
     Repair(crate::repair::RepairArgs),
     /// Fit a surface through a point file.
     Fit(crate::fit::FitArgs),
+    /// Rebuild poorly parameterized faces and write IGES (paper 001).
+    Reparam(crate::reparam::ReparamArgs),
 }
 
 /// Arguments of `surfmesh mesh`.
@@ -95,6 +97,7 @@ pub fn parse(args: Vec<OsString>) -> Result<Command, String> {
         Some("offset") => crate::repair::parse_offset(args).map(Command::Offset),
         Some("repair") => crate::repair::parse_repair(args).map(Command::Repair),
         Some("fit") => crate::fit::parse(args).map(Command::Fit),
+        Some("reparam") => crate::reparam::parse(args).map(Command::Reparam),
         _ => Err(format!("unknown command '{}'; try 'surfmesh --help'", first.to_string_lossy())),
     }
 }
