@@ -206,6 +206,8 @@ fn torus_points_give_a_closed_g1_surface_of_genus_one() {
 /// cannot close (the gap is widened and refilled).
 #[test]
 fn uniformly_random_points_with_clusters_and_gaps_give_closed_g1_surfaces() {
+    // The patches are what is measured; a coarse mesh of them keeps the test quick.
+    let coarse = FitOptions::default().with_relative_tolerance(1e-2);
     for seed in [1, 4] {
         let mut rng = Rng(seed * 7919);
         let pts: Vec<DVec3> = (0..500)
@@ -216,7 +218,7 @@ fn uniformly_random_points_with_clusters_and_gaps_give_closed_g1_surfaces() {
                 DVec3::new(s * t.cos(), s * t.sin(), z)
             })
             .collect();
-        let fit = fit_points(&pts, &FitOptions::default()).unwrap();
+        let fit = fit_points(&pts, &coarse).unwrap();
         let f = measure(&format!("uniform sphere seed {seed}"), &pts, &fit, 4, |p| (p.length() - 1.0).abs());
         assert!(f.max_distance < 0.05, "distance {}", f.max_distance);
         assert_eq!((fit.report.boundary_edges, fit.report.nonmanifold_edges, fit.report.holes_open), (0, 0, 0));
@@ -225,14 +227,14 @@ fn uniformly_random_points_with_clusters_and_gaps_give_closed_g1_surfaces() {
     // A torus uniform in its angles: twice as dense inside as outside.
     let (big, small) = (2.0, 0.7);
     let mut rng = Rng(31);
-    let pts: Vec<DVec3> = (0..1000)
+    let pts: Vec<DVec3> = (0..600)
         .map(|_| {
             let (u, v) = (std::f64::consts::TAU * rng.next(), std::f64::consts::TAU * rng.next());
             let w = big + small * v.cos();
             DVec3::new(w * u.cos(), w * u.sin(), small * v.sin())
         })
         .collect();
-    let fit = fit_points(&pts, &FitOptions::default()).unwrap();
+    let fit = fit_points(&pts, &coarse).unwrap();
     let f = measure("uniform-angle torus", &pts, &fit, 4, |p| {
         let q = DVec2::new(DVec2::new(p.x, p.y).length() - big, p.z);
         (q.length() - small).abs()
