@@ -6,11 +6,14 @@ use alloc::vec::Vec;
 use glam::DVec3;
 
 use super::check::{census, triangles};
+use super::topology::{adjacency, components, signed_volume, NONE};
 use crate::{weld_positions, Error, Mesh};
 
 /// Moves every vertex by `distance` along its normal (the angle-weighted
 /// average of the facet normals around it; positive = the side the
-/// counter-clockwise triangles face). Coincident vertices (within 1e-9 of the
+/// counter-clockwise triangles face, except that a closed component facing
+/// inward, enclosing a negative volume, is offset as if turned outward: a
+/// negative distance always goes inside a closed mesh). Coincident vertices (within 1e-9 of the
 /// bounding-box diagonal, as a meshed model's faces share their borders) are
 /// welded first so the offset stays closed, unless that would make an edge of
 /// more than two triangles. Triangles collapsed by welding are dropped;
@@ -55,10 +58,22 @@ pub fn offset_mesh(mesh: &Mesh, distance: f64) -> Result<Mesh, Error> {
         (positions, welded)
     };
     let count = positions.len();
+    // A closed component that encloses a negative volume faces inward: its
+    // normals are turned so that a negative distance still goes inside.
+    let nbr = adjacency(&tris);
+    let (comp, ncomp) = components(&nbr);
+    let mut volume = alloc::vec![0.0; ncomp];
+    let mut closed = alloc::vec![true; ncomp];
+    for (t, tri) in tris.iter().enumerate() {
+        let c = comp[t] as usize;
+        volume[c] += signed_volume(&positions, core::iter::once(*tri));
+        closed[c] &= nbr[t].iter().all(|&u| u != NONE);
+    }
+    let sign: Vec<f64> = volume.iter().zip(&closed).map(|(&v, &c)| if c && v < 0.0 { -1.0 } else { 1.0 }).collect();
     let mut normals = alloc::vec![DVec3::ZERO; count];
-    for t in &tris {
+    for (ti, t) in tris.iter().enumerate() {
         let p = t.map(|i| positions[i as usize]);
-        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero() * sign[comp[ti] as usize];
         for k in 0..3 {
             let angle = crate::math::angle_between(p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
             normals[t[k] as usize] += n * angle;

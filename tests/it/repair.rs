@@ -455,15 +455,20 @@ fn corpus_mesh(name: &str, max_edge: f64) -> Mesh {
 
 #[test]
 fn repair_inward_offsets_of_corpus_solids_are_clean() {
-    // A CATIA cylinder (diameter 100, height 100; its faces come out facing
-    // inward) and a capsule whose mesh has slivers and a few crossings where
-    // its faces meet: each is repaired into a closed outward solid first, then
+    // A CATIA cylinder (diameter 100, height 100) and a capsule whose mesh
+    // has slivers and a few crossings where its faces meet: each is repaired into a closed outward solid first, then
     // offset inward by a few percent of its size, and the rims fold over.
     for (name, max_edge, d) in [("OCC8842_cylinder_CATIA.igs", 8.0, -5.0), ("marsCapsule.igs", 1.0, -0.5)] {
         let m = corpus_mesh(name, max_edge);
         let outward = repair_mesh(&m, &RepairOptions::default()).unwrap().mesh;
         assert_eq!(census(&outward), (0, 0, 0), "{name}: the meshed solid is closed");
         assert!(volume(&outward) > 0.0);
+        // Turned inside out, a negative offset still goes inward.
+        let mut flipped = outward.clone();
+        flipped.indices.chunks_mut(3).for_each(|t| t.swap(1, 2));
+        let v = volume(&outward);
+        assert!(volume(&offset_mesh(&flipped, 0.2 * d).unwrap()).abs() < v, "{name}");
+        assert!(volume(&offset_mesh(&outward, 0.2 * d).unwrap()) < v, "{name}");
         let off = offset_mesh(&outward, d).unwrap();
         assert!(!find_self_intersections(&off).unwrap().is_empty(), "{name}: the offset should self-intersect");
         let r = repair_mesh(&off, &RepairOptions::default()).unwrap();
