@@ -33,8 +33,9 @@ pub use fit::{
     TriPatch, MAX_FILE_POINTS,
 };
 pub use io::{
-    read_iges, read_json, read_mesh, read_model, read_msh, read_step, read_step_with_shells, write_glb, write_iges,
-    write_msh, write_obj, write_stl, write_unv, Format, MeshFormat, StepShell, UNV_SHELL_TRIANGLE,
+    read_iges, read_json, read_mesh, read_model, read_msh, read_step, read_step_parts, read_step_with_shells,
+    write_glb, write_iges, write_msh, write_obj, write_stl, write_unv, Format, MeshFormat, StepModel, StepShell,
+    UNV_SHELL_TRIANGLE,
 };
 pub use measure::{measure_mesh, MeasureOptions, MeshMeasure};
 pub use mesh::{angle_stats, edge_counts, weld_mesh, weld_positions, AngleStats, EdgeCounts, FaceRange, Mesh, Report};

@@ -21,7 +21,7 @@ pub(crate) use meshfile::MAX_COORDINATE;
 pub use meshfile::{read_mesh, MeshFormat};
 pub use msh::{read_msh, write_msh};
 pub use obj::write_obj;
-pub use step::{read_step, read_step_with_shells, StepShell};
+pub use step::{read_step, read_step_parts, read_step_with_shells, StepModel, StepShell};
 pub use stl::write_stl;
 pub use unv::{write_unv, UNV_SHELL_TRIANGLE};
 

@@ -7,8 +7,8 @@
 use std::path::{Path, PathBuf};
 
 use surfmesh::{
-    edge_counts, mesh_model, read_model, read_step, read_step_with_shells, Format, Mesh, MeshOptions, MeshResult,
-    Model, StepShell,
+    edge_counts, mesh_model, read_model, read_step, read_step_parts, read_step_with_shells, Format, Mesh, MeshOptions,
+    MeshResult, Model, StepShell,
 };
 
 fn data(name: &str) -> Vec<u8> {
@@ -141,6 +141,27 @@ fn assembly_places_each_instance() {
     let (lo, hi) = bbox(shells[1].faces.clone());
     assert!(lo.abs_diff_eq(glam::DVec3::new(15.0, 0.0, 0.0), 1e-9), "{lo}");
     assert!(hi.abs_diff_eq(glam::DVec3::new(20.0, 10.0, 2.0), 1e-9), "{hi}");
+}
+
+/// Each placement of the block is a part of its own, named by its product;
+/// the solid's style colours its faces, one face's own style wins over it,
+/// and a curve style colours no face.
+#[test]
+fn assembly_parts_and_colours() {
+    let s = read_step_parts(&data("step_assembly.stp")).unwrap();
+    assert_eq!(s.parts, ["Block", "Block"]);
+    assert_eq!(s.face_parts, [0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1]);
+    let solid = Some([0.8f32, 0.25, 0.1]);
+    let blue = Some([0.0f32, 0.0, 1.0]);
+    let per_block = [solid, blue, solid, solid, solid, solid];
+    assert_eq!(s.face_colours, [per_block, per_block].concat());
+    // One solid styled as a whole; a file without styles has no colours.
+    let s = read_step_parts(&data("step_box_inch.stp")).unwrap();
+    assert_eq!(s.parts.len(), 1);
+    assert!(s.face_parts.iter().all(|&p| p == 0));
+    assert!(s.face_colours.iter().all(|c| *c == Some([0.8, 0.2, 0.1])), "{:?}", s.face_colours);
+    let s = read_step_parts(&data("step_cylinder.stp")).unwrap();
+    assert!(s.face_colours.len() == 3 && s.face_colours.iter().all(Option::is_none));
 }
 
 #[test]

@@ -35,6 +35,9 @@ pub(super) struct Placed {
     pub uncertainty: f64,
     /// Product name of the part.
     pub name: Option<String>,
+    /// Which part instance the item belongs to: items placed together by
+    /// one assembly path share it.
+    pub instance: usize,
 }
 
 /// What to read.
@@ -274,6 +277,7 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
                     angle: u.rad,
                     uncertainty: u.uncertainty / u.mm,
                     name: name.clone(),
+                    instance: visits,
                 });
             }
         }
@@ -302,7 +306,15 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
         let top = ["MANIFOLD_SOLID_BREP", "BREP_WITH_VOIDS", "FACETED_BREP", "SHELL_BASED_SURFACE_MODEL"];
         if top.iter().any(|n| e.has(n)) && !emitted.contains(&e.id()) && !nested.contains(&e.id()) {
             warnings.push(format!("#{} {}: not in any representation; read in place", e.id(), e.type_name()));
-            plan.placed.push(Placed { item: e.id(), m: DAffine3::IDENTITY, angle: 1.0, uncertainty: 0.0, name: None });
+            visits += 1;
+            plan.placed.push(Placed {
+                item: e.id(),
+                m: DAffine3::IDENTITY,
+                angle: 1.0,
+                uncertainty: 0.0,
+                name: None,
+                instance: visits,
+            });
         }
     }
     // Faces that a representation lists on their own but that a shell also

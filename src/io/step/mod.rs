@@ -20,6 +20,7 @@ mod edges;
 mod graph;
 mod parser;
 mod shapes;
+mod styles;
 mod surfaces;
 
 use alloc::string::String;
@@ -58,6 +59,26 @@ pub struct StepShell {
     pub listed: usize,
 }
 
+/// A STEP file as read: the model, and what the file says about its faces
+/// beyond their geometry.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct StepModel {
+    /// The faces to mesh, their units and the reader's warnings.
+    pub model: Model,
+    /// Which faces came from which shell (closed shells must mesh without border).
+    pub shells: Vec<StepShell>,
+    /// One name per part instance, in the order of first use: the product's
+    /// name (empty when the file gives none). Two placements of one product
+    /// are two parts with the same name.
+    pub parts: Vec<String>,
+    /// For each face of [`Model::faces`], the index of its part in [`StepModel::parts`].
+    pub face_parts: Vec<u32>,
+    /// For each face, its colour (red, green, blue in 0..=1) from the file's
+    /// `STYLED_ITEM`s: the face's own, else its shell's, else its solid's.
+    pub face_colours: Vec<Option<[f32; 3]>>,
+}
+
 /// Reads a STEP file (ISO 10303-21).
 ///
 /// Solids (`MANIFOLD_SOLID_BREP`, `BREP_WITH_VOIDS`), shells of surface
@@ -83,6 +104,14 @@ pub fn read_step(bytes: &[u8]) -> Result<Model, Error> {
 /// # Errors
 /// As [`read_step`].
 pub fn read_step_with_shells(bytes: &[u8]) -> Result<(Model, Vec<StepShell>), Error> {
+    read_step_parts(bytes).map(|s| (s.model, s.shells))
+}
+
+/// As [`read_step`], with shells, part instances and colours ([`StepModel`]).
+///
+/// # Errors
+/// As [`read_step`].
+pub fn read_step_parts(bytes: &[u8]) -> Result<StepModel, Error> {
     let g = parser::parse(bytes)?;
     let mut warnings = Vec::new();
     let plan = assembly::plan(&g, &mut warnings)?;
@@ -101,6 +130,19 @@ pub fn read_step_with_shells(bytes: &[u8]) -> Result<(Model, Vec<StepShell>), Er
             (None, own) => own,
         };
     }
+    // Part instances in the order of first use.
+    let mut parts: Vec<String> = Vec::new();
+    let mut index: hashbrown::HashMap<usize, u32> = hashbrown::HashMap::new();
+    let mut face_parts = Vec::with_capacity(faces.len());
+    for &p in &shapes.placement {
+        let placed = plan.placed.get(p);
+        let instance = placed.map_or(usize::MAX, |p| p.instance);
+        let k = *index.entry(instance).or_insert_with(|| {
+            parts.push(placed.and_then(|p| p.name.clone()).unwrap_or_default());
+            (parts.len() - 1) as u32
+        });
+        face_parts.push(k);
+    }
     let model = Model { units: plan.units.clone(), faces, warnings, tolerance: plan.tolerance };
-    Ok((model, shapes.shells))
+    Ok(StepModel { model, shells: shapes.shells, parts, face_parts, face_colours: shapes.colours })
 }

@@ -21,6 +21,7 @@ use super::assembly::{Placed, Plan};
 use super::curves::{bounded_pieces, rev_all, Geo};
 use super::edges::Edges;
 use super::graph::{Ent, Graph};
+use super::styles::{colours, Rgb};
 use super::surfaces::{is_bspline_surface, StepSurface};
 use super::{step_error, StepShell, MAX_FACES};
 use crate::io::iges::loops::{build_face_oriented, FaceSrc, LoopSrc};
@@ -35,6 +36,8 @@ use crate::Error;
 #[derive(Debug, Clone, Default)]
 struct ItemFaces {
     faces: Vec<Face>,
+    /// The `#id` each face was read from (a face, or a loose surface).
+    ids: Vec<u64>,
     /// `(#id, closed, faces, faces listed)` per shell.
     shells: Vec<(u64, bool, core::ops::Range<usize>, usize)>,
 }
@@ -57,6 +60,8 @@ pub(super) struct Shapes {
     pub faces: Vec<Face>,
     /// Index of the placement each face comes from.
     pub placement: Vec<usize>,
+    /// Each face's colour: its own style's, else its shell's, else its solid's or set's.
+    pub colours: Vec<Option<Rgb>>,
     pub shells: Vec<StepShell>,
     pub first_error: Option<Error>,
 }
@@ -75,7 +80,9 @@ pub(super) fn read_shapes(g: &Graph, plan: &Plan, warnings: &mut Vec<String>) ->
         edge_uses: Vec::new(),
     };
     let mut cache: HashMap<(u64, u64, u64), ItemFaces> = HashMap::new();
-    let mut out = Shapes { faces: Vec::new(), placement: Vec::new(), shells: Vec::new(), first_error: None };
+    let styles = colours(g);
+    let mut out =
+        Shapes { faces: Vec::new(), placement: Vec::new(), colours: Vec::new(), shells: Vec::new(), first_error: None };
     for (pi, p) in plan.placed.iter().enumerate() {
         let key = (p.item, p.angle.to_bits(), p.uncertainty.to_bits());
         if !cache.contains_key(&key) {
@@ -91,11 +98,15 @@ pub(super) fn read_shapes(g: &Graph, plan: &Plan, warnings: &mut Vec<String>) ->
             ));
         }
         let base = out.faces.len();
-        for f in &item.faces {
+        for (k, (f, id)) in item.faces.iter().zip(&item.ids).enumerate() {
             match place_face(f, &p.m) {
                 Ok(f) => {
                     out.faces.push(f);
                     out.placement.push(pi);
+                    let shell = item.shells.iter().find(|s| s.2.contains(&k)).map(|s| s.0);
+                    let colour =
+                        [Some(*id), shell, Some(p.item)].into_iter().flatten().find_map(|i| styles.get(&i).copied());
+                    out.colours.push(colour);
                 }
                 Err(m) => r.warnings.push(format!("#{}: a face could not be placed: {m}", p.item)),
             }
@@ -206,7 +217,10 @@ impl Reader<'_, '_> {
     fn face_or_surface(&mut self, geo: &Geo<'_>, s: Ent<'_>, out: &mut ItemFaces) {
         let r = if is_face(s) { self.face(geo, s, false) } else { self.loose_surface(geo, s) };
         match r {
-            Ok(f) => out.faces.push(f),
+            Ok(f) => {
+                out.faces.push(f);
+                out.ids.push(s.id());
+            }
             Err(err) => self.skip(s, err),
         }
     }
@@ -233,7 +247,10 @@ impl Reader<'_, '_> {
         for f in &list {
             let fe = self.g.get(*f, s.id())?;
             match self.face(geo, fe, flip) {
-                Ok(face) => out.faces.push(face),
+                Ok(face) => {
+                    out.faces.push(face);
+                    out.ids.push(fe.id());
+                }
                 Err(err) => self.skip(fe, err),
             }
         }
