@@ -17,7 +17,7 @@ use wasm_bindgen::prelude::*;
 
 use crate::{fit_points, read_points, FitOptions, FitResult, PointFormat};
 use crate::{offset_mesh, read_mesh, repair_mesh_timed, Bucketing, MeshFormat, RepairOptions};
-use crate::{read_model, Error, Format, MeshOptions, MeshResult};
+use crate::{read_model, read_step_parts, Error, Format, MeshOptions, MeshResult};
 // `tests/wasm_node.rs` compiles this file into a crate where `crate::` is the
 // test itself, which does not import this name; take it from the library there.
 #[cfg(not(test))]
@@ -56,6 +56,12 @@ export interface MeshOutput {
   indices: Uint32Array;
   /** Pairs (first triangle, triangle count), one pair per model face. */
   faceRanges: Uint32Array;
+  /** The part of each face (the pair of the same index in `faceRanges`): an index into `parts`. */
+  faceParts: Uint32Array;
+  /** Red, green, blue (0 to 1) per face as the file colours it (STEP styles); NaN where it does not. */
+  faceColors: Float32Array;
+  /** Part names: one per part instance of a STEP assembly ("" when unnamed); one "" for other formats. */
+  parts: string[];
   /** The measured report (tolerance, triangles, max_deviation, warnings, ...). */
   report: Record<string, any>;
 }
@@ -225,7 +231,14 @@ fn run(
     options.validate()?;
     let format = pick_format(bytes, format)?;
     let t0 = now_ms();
-    let model = read_model(bytes, format)?;
+    let (model, parts) = if format == Format::Step {
+        let s = read_step_parts(bytes)?;
+        (s.model, Parts { names: s.parts, faces: s.face_parts, colours: s.face_colours })
+    } else {
+        let model = read_model(bytes, format)?;
+        let n = model.faces.len();
+        (model, Parts { names: alloc::vec![String::new()], faces: alloc::vec![0; n], colours: alloc::vec![None; n] })
+    };
     let t1 = now_ms();
     let mut result = mesh_model_with_progress(&model, options, progress)?;
     let t2 = now_ms();
@@ -233,7 +246,14 @@ fn run(
         result.report.parse_ms = t1 - t0;
         result.report.time_ms = t2 - t1;
     }
-    to_js(&result)
+    to_js(&result, &parts)
+}
+
+/// Part names, each face's part and each face's colour, for the JS result.
+struct Parts {
+    names: Vec<String>,
+    faces: Vec<u32>,
+    colours: Vec<Option<[f32; 3]>>,
 }
 
 /// `""` and `"auto"` detect the format from the bytes; anything else is a name.
@@ -337,8 +357,8 @@ fn type_name(value: &JsValue) -> String {
     }
 }
 
-/// Builds `{ positions, normals, indices, faceRanges, report }`.
-fn to_js(result: &MeshResult) -> Result<JsValue, Error> {
+/// Builds `{ positions, normals, indices, faceRanges, faceParts, faceColors, parts, report }`.
+fn to_js(result: &MeshResult, parts: &Parts) -> Result<JsValue, Error> {
     let mesh = &result.mesh;
     let flat =
         |v: &[glam::DVec3]| -> Vec<f32> { v.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect() };
@@ -347,12 +367,20 @@ fn to_js(result: &MeshResult) -> Result<JsValue, Error> {
         serde_json::to_string(&result.report).map_err(|e| Error::Internal(format!("report to JSON: {e}")))?;
     let report = JSON::parse(&report_json).map_err(|_| Error::Internal("report JSON rejected by JSON.parse".into()))?;
 
+    let colours: Vec<f32> = parts.colours.iter().flat_map(|c| c.unwrap_or([f32::NAN; 3])).collect();
+    let names = Array::new();
+    for n in &parts.names {
+        names.push(&JsValue::from_str(n));
+    }
     let out = Object::new();
-    let fields: [(&str, JsValue); 5] = [
+    let fields: [(&str, JsValue); 8] = [
         ("positions", Float32Array::from(flat(&mesh.positions).as_slice()).into()),
         ("normals", Float32Array::from(flat(&mesh.normals).as_slice()).into()),
         ("indices", Uint32Array::from(mesh.indices.as_slice()).into()),
         ("faceRanges", Uint32Array::from(ranges.as_slice()).into()),
+        ("faceParts", Uint32Array::from(parts.faces.as_slice()).into()),
+        ("faceColors", Float32Array::from(colours.as_slice()).into()),
+        ("parts", names.into()),
         ("report", report),
     ];
     for (name, value) in fields {

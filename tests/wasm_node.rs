@@ -12,8 +12,8 @@ extern crate alloc;
 // Names `src/wasm.rs` reaches through `crate::`.
 #[allow(unused_imports)]
 use surfmesh::{
-    fit_points, mesh_model, offset_mesh, read_mesh, read_model, read_points, repair_mesh_timed, Bucketing, Error,
-    FitOptions, FitResult, Format, MeshFormat, MeshOptions, MeshResult, PointFormat, RepairOptions,
+    fit_points, mesh_model, offset_mesh, read_mesh, read_model, read_points, read_step_parts, repair_mesh_timed,
+    Bucketing, Error, FitOptions, FitResult, Format, MeshFormat, MeshOptions, MeshResult, PointFormat, RepairOptions,
 };
 
 #[path = "../src/wasm.rs"]
@@ -576,4 +576,32 @@ fn fit_errors_are_js_errors_with_the_cli_message() {
     assert!(m.starts_with("option smooth: unknown option"), "{m}");
     let m = message(binding::fit(b"1 2 3", "las", JsValue::UNDEFINED));
     assert!(m.starts_with("format: unknown point format"), "{m}");
+}
+
+/// A STEP assembly of two placed blocks: the result names one part per
+/// placement, says each face's part, and carries the styles' colours (the
+/// solid's, one face's own); a JSON model is one unnamed part without colours.
+#[wasm_bindgen_test]
+fn step_assembly_parts_and_colours_reach_js() {
+    let bytes = include_bytes!("data/step_assembly.stp");
+    let v = binding::mesh(bytes, "step", options(&[("toleranceRel", num(1e-3))]))
+        .unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+    let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
+    let parts: Vec<String> =
+        get("parts").dyn_into::<Array>().expect("parts").iter().map(|p| p.as_string().expect("name")).collect();
+    assert_eq!(parts, ["Block", "Block"]);
+    let face_parts = get("faceParts").dyn_into::<Uint32Array>().expect("faceParts").to_vec();
+    assert_eq!(face_parts, [0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1]);
+    assert_eq!(get("faceRanges").dyn_into::<Uint32Array>().expect("faceRanges").length(), 24);
+    let colours = get("faceColors").dyn_into::<Float32Array>().expect("faceColors").to_vec();
+    assert_eq!(colours.len(), 36);
+    assert_eq!(&colours[0..3], &[0.8, 0.25, 0.1]);
+    assert_eq!(&colours[3..6], &[0.0, 0.0, 1.0]);
+    assert_eq!(&colours[21..24], &[0.0, 0.0, 1.0]);
+
+    let v = binding::mesh(FREEFORM, "json", JsValue::UNDEFINED).unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+    let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
+    assert_eq!(get("parts").dyn_into::<Array>().expect("parts").length(), 1);
+    let colours = get("faceColors").dyn_into::<Float32Array>().expect("faceColors").to_vec();
+    assert!(!colours.is_empty() && colours.iter().all(|c| c.is_nan()));
 }
