@@ -168,6 +168,15 @@ pub fn version() -> String {
     env!("CARGO_PKG_VERSION").to_string()
 }
 
+/// Bytes of linear memory the module holds. Wasm memory only grows, so
+/// read after one `mesh` call in a fresh instance it is that call's peak
+/// (benchmarks compare it with the size of the mesh returned).
+#[cfg_attr(not(test), wasm_bindgen(js_name = memoryBytes))]
+#[cfg_attr(test, allow(dead_code))]
+pub fn memory_bytes() -> f64 {
+    (core::arch::wasm32::memory_size(0) * 65536) as f64
+}
+
 /// Reads `bytes` in `format` (`"json"`, `"iges"`/`"igs"`, `"step"`/`"stp"`, or `""`/`"auto"` to detect it) and
 /// meshes the model with `options` (see the `MeshOptions` interface).
 ///

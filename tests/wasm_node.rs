@@ -604,4 +604,7 @@ fn step_assembly_parts_and_colours_reach_js() {
     assert_eq!(get("parts").dyn_into::<Array>().expect("parts").length(), 1);
     let colours = get("faceColors").dyn_into::<Float32Array>().expect("faceColors").to_vec();
     assert!(!colours.is_empty() && colours.iter().all(|c| c.is_nan()));
+    // The module's memory in whole 64 KiB pages, at least what the meshes above needed.
+    let bytes = binding::memory_bytes();
+    assert!(bytes >= 65536.0 && bytes % 65536.0 == 0.0, "{bytes}");
 }
