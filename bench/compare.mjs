@@ -333,9 +333,18 @@ const fms = (x) => (x == null ? '–' : x < 10 ? x.toFixed(2) : x < 100 ? x.toFi
 const fmb = (kb) => (kb == null ? '–' : (kb / 1024).toFixed(1));
 
 function meshRow(label, setting, m, run, js) {
-  if (run?.skipped || run?.error) return `| ${label} | ${setting} | ${run.skipped ?? run.error} |||||||||||||`;
+  if (run?.skipped || run?.error) return `| ${label} | ${setting} | ${run.skipped ?? run.error} ||||||||||||||`;
   const p = median(run?.parse_ms ?? []);
-  return `| ${label} | ${setting} | ${m?.triangles ?? run?.triangles ?? '–'} | ${f3(m?.max_deviation)} | ${f3(m?.mean_deviation)} | ${f3(m?.coverage)} | ${m?.boundary_edges ?? '–'} | ${m?.face_ranges ? m.free_edges : 'n/a'} | ${m?.nonmanifold_edges ?? '–'} | ${m ? `${m.min_angle_deg.toFixed(1)} / ${m.p1_angle_deg.toFixed(1)}` : '–'} | ${fms(p)} | ${fms(median(run?.mesh_ms ?? []))} | ${fms(totalMs(run))} | ${fms(run?.cold_ms)} | ${fmb(memKb(run, js))} |`;
+  return `| ${label} | ${setting} | ${m?.triangles ?? run?.triangles ?? '–'} | ${f3(m?.max_deviation)} | ${f3(m?.mean_deviation)} | ${f3(m?.coverage)} | ${m?.boundary_edges ?? '–'} | ${m?.face_ranges ? m.free_edges : 'n/a'} | ${m?.nonmanifold_edges ?? '–'} | ${m ? `${m.min_angle_deg.toFixed(1)} / ${m.p1_angle_deg.toFixed(1)}` : '–'} | ${fms(p)} | ${fms(median(run?.mesh_ms ?? []))} | ${fms(totalMs(run))} | ${fms(run?.cold_ms)} | ${fmb(memKb(run, js))} | ${wasmMemory(run)} |`;
+}
+
+/** Wasm linear memory, MB: surfmesh's after its first call (its peak) with the ratio to the mesh it returned; OCCT's heap. */
+function wasmMemory(run) {
+  if (run?.wasm_peak_bytes) {
+    const ratio = run.output_bytes > 0 ? ` (${(run.wasm_peak_bytes / run.output_bytes).toFixed(1)}× output)` : '';
+    return `${fmb(run.wasm_peak_bytes / 1024)}${ratio}`;
+  }
+  return run?.heap_bytes ? fmb(run.heap_bytes / 1024) : '–';
 }
 
 function markdown(rows, meta) {
@@ -386,20 +395,20 @@ function markdown(rows, meta) {
   out.push('');
   out.push('## Every mesh, measured by the same yardstick');
   out.push('');
-  out.push('Deviation: largest / mean distance from 15 points per triangle to the exact surfaces. Coverage: largest distance from exact-surface samples to the mesh (holes, dropped faces). Cracks need face ranges (n/a without). Angles: smallest / 1st percentile, degrees. Times: median of the timed runs after warm-up; first run: the first call in a fresh process (wasm compilation and JIT included; in-process runners only). Memory: peak RSS, MB (Node: above a bare Node process).');
+  out.push('Deviation: largest / mean distance from 15 points per triangle to the exact surfaces. Coverage: largest distance from exact-surface samples to the mesh (holes, dropped faces). Cracks need face ranges (n/a without). Angles: smallest / 1st percentile, degrees. Times: median of the timed runs after warm-up; first run: the first call in a fresh process (wasm compilation and JIT included; in-process runners only). Memory: peak RSS, MB (Node: above a bare Node process). Wasm memory: the module\'s linear memory after its first call, i.e. its peak, with the ratio to the typed arrays of the mesh it returned (surfmesh); OCCT\'s wasm heap.');
   for (const r of rows) {
     out.push('');
     out.push(`### ${r.file} at ${r.rel} (tolerance ${f3(r.tolerance)} ${r.units}, ${r.faces} faces)`);
     out.push('');
-    out.push('| mesher | setting | triangles | max dev | mean dev | coverage | boundary | cracks | non-manifold | angles | parse ms | mesh ms | total ms | first run ms | memory MB |');
-    out.push('|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|');
+    out.push('| mesher | setting | triangles | max dev | mean dev | coverage | boundary | cracks | non-manifold | angles | parse ms | mesh ms | total ms | first run ms | memory MB | wasm memory MB |');
+    out.push('|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|');
     out.push(meshRow('surfmesh wasm', `rel ${r.rel}`, r.surfmesh_wasm?.measure, r.surfmesh_wasm?.run, true));
     if (r.surfmesh_native) out.push(meshRow('surfmesh native', `rel ${r.rel}`, r.surfmesh_native.measure, r.surfmesh_native.run, false));
-    if (r.surfmesh_native?.note) out.push(`| | ${r.surfmesh_native.note} ||||||||||||||`);
+    if (r.surfmesh_native?.note) out.push(`| | ${r.surfmesh_native.note} |||||||||||||||`);
     if (r.occt) {
       out.push(meshRow('OCCT', `deflection ${f3(r.occt.deflection)}, angle ${ANGLE}`, r.occt.measure, r.occt.run, true));
       if (r.occt.equal) out.push(meshRow('OCCT, equal deviation', `deflection ${f3(r.occt.equal.deflection)}`, r.occt.equal.measure, { triangles: r.occt.equal.measure.triangles }, true));
-      else if (!r.occt.run?.error) out.push(`| OCCT, equal deviation | not reached in ${r.occt.tried?.length ?? 0} tries ||||||||||||||`);
+      else if (!r.occt.run?.error) out.push(`| OCCT, equal deviation | not reached in ${r.occt.tried?.length ?? 0} tries |||||||||||||||`);
     }
     for (const k of ['verb', 'curvo']) {
       if (!r[k]) continue;

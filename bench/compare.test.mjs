@@ -33,6 +33,9 @@ test('the benchmark meshes, measures and compares one small surface', { timeout:
     assert.equal(row.surfmesh_native.run.triangles, sw.triangles);
     assert.equal(sw.free_edges + sw.nonmanifold_edges, 0);
     assert.equal(row.surfmesh_wasm.run.total_ms.length, 1);
+    // The wasm module's peak memory, against the mesh it returned.
+    const { wasm_peak_bytes: peak, wasm_base_bytes: base, output_bytes: output } = row.surfmesh_wasm.run;
+    assert.ok(output > 0 && peak >= base && peak % 65536 === 0, JSON.stringify({ peak, base, output }));
     // Each peer reached surfmesh's measured deviation and was measured by the same yardstick.
     for (const peer of ['verb', 'curvo']) {
       const m = row[peer].measure;
@@ -48,6 +51,7 @@ test('the benchmark meshes, measures and compares one small surface', { timeout:
     const md = readFileSync(join(out, 'latest.md'), 'utf8');
     assert.match(md, /\| verb-nurbs \(JS\) \| 0\.01 \| 1 \|/);
     assert.match(md, /### cylinder\.json at 0\.01/);
+    assert.match(md, /\| surfmesh wasm \| rel 0\.01 \|.*× output\) \|/);
   } finally {
     rmSync(out, { recursive: true, force: true });
   }

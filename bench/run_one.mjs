@@ -10,7 +10,8 @@
 // Times are the median-ready lists of every run after one warm-up run; parse
 // and mesh apart where the mesher allows (occt-import-js reads and meshes in
 // one call). Memory: the process's peak resident set, and the same at start
-// (bare Node), in KB. The last mesh is written as JSON
+// (bare Node), in KB; for surfmesh also its wasm memory after the first call
+// (its peak) against the bytes of the mesh it returns. The last mesh is written as JSON
 // {positions, indices, faceRanges} for the yardstick (examples/measure.rs).
 
 import { spawnSync } from 'node:child_process';
@@ -79,15 +80,21 @@ function runSurfmesh() {
   const bytes = readFileSync(file);
   const rel = Number(arg('--rel'));
   const format = extname(file).slice(1).toLowerCase(); // as the CLI: the format from the extension
+  // Wasm memory only grows: its size after the first call is that call's peak.
+  const wasmBase = surfmesh.memoryBytes?.() ?? null;
+  let wasmPeak = null;
   const t = timed(() => {
     const m = surfmesh.mesh(bytes, format, { toleranceRel: rel });
+    wasmPeak ??= surfmesh.memoryBytes?.() ?? null;
     return { parse: m.report.parse_ms, mesh: m.report.time_ms, result: m };
   });
   const m = t.result;
   writeMesh(out, m.positions, m.indices, Array.from(m.faceRanges));
   delete t.result;
   const { warnings, ...report } = m.report;
-  finish({ ...t, triangles: m.indices.length / 3, report, warnings: warnings.slice(0, 5), version: surfmesh.version() });
+  // The mesh as the JS caller holds it: every typed array of the result.
+  const outputBytes = [m.positions, m.normals, m.indices, m.faceRanges, m.faceParts, m.faceColors].reduce((n, a) => n + (a?.byteLength ?? 0), 0);
+  finish({ ...t, triangles: m.indices.length / 3, report, warnings: warnings.slice(0, 5), version: surfmesh.version(), wasm_base_bytes: wasmBase, wasm_peak_bytes: wasmPeak, output_bytes: outputBytes });
 }
 
 // ---- occt-import-js (OCCT's BRepMesh in wasm) -----------------------------------------
