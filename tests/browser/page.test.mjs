@@ -185,6 +185,23 @@ test('IGES and STEP files go to the module, which meshes them or says why not', 
   await shot(page, '05-step-message');
 });
 
+test('a STEP assembly meshes, and a picked face names its part', async () => {
+  const bytes = readFileSync(join(root, 'tests', 'data', 'step_assembly.stp'));
+  const state = await settle(() => page.setInputFiles('#file-input', { name: 'assembly.stp', mimeType: 'application/octet-stream', buffer: bytes }));
+  assert.equal(state, 'ready', await page.textContent('#error-message'));
+  assert.equal(await stat('stat-faces'), 12);
+  assert.equal(await stat('stat-open-edges'), 0, 'two closed blocks');
+  const box = await page.locator('#canvas').boundingBox();
+  let text = '';
+  for (const [fx, fy] of [[0.5, 0.5], [0.35, 0.5], [0.65, 0.5], [0.5, 0.4], [0.5, 0.6], [0.3, 0.4], [0.7, 0.6]]) {
+    await page.mouse.click(box.x + box.width * fx, box.y + box.height * fy);
+    text = await page.textContent('#status');
+    if (text.startsWith('Face ')) break;
+  }
+  assert.match(text, /^Face \d+ of 12 \(Block\): \d+ triangles$/);
+  await shot(page, '05b-step-assembly');
+});
+
 test('STL, OBJ and GLB exports hold the triangles the page shows', async () => {
   await settle(() => page.selectOption('#sample', 'can.json'));
   assert.equal(await page.getAttribute('body', 'data-state'), 'ready');

@@ -338,7 +338,9 @@ viewer.canvas.addEventListener('pointerup', (e) => {
   if (!down || Math.hypot(e.clientX - down.x, e.clientY - down.y) > 4 || !state.shown) return;
   const face = viewer.pick(e.clientX, e.clientY);
   const ranges = state.shown.result.faceRanges;
-  if (face >= 0) status(`Face ${face} of ${ranges.length / 2}: ${count(ranges[2 * face + 1])} triangles`);
+  // A STEP assembly names the part the face belongs to.
+  const part = state.shown.result.parts?.[state.shown.result.faceParts?.[face]];
+  if (face >= 0) status(`Face ${face} of ${ranges.length / 2}${part ? ` (${part})` : ''}: ${count(ranges[2 * face + 1])} triangles`);
 });
 
 $('tol-value').addEventListener('change', () => {
