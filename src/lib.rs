@@ -21,6 +21,7 @@ mod measure;
 mod mesh;
 mod model;
 mod nurbs;
+mod quality;
 mod repair;
 mod reparam;
 mod tessellate;
@@ -44,6 +45,7 @@ pub use nurbs::{
     project_to_surface, Aabb, BasisDers, CurveDerivs, KnotVector, NurbsCurve, NurbsError, NurbsSurface, Projection,
     ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
 };
+pub use quality::{ElementSize, QualityMethod, QualityOptions, QualityReport, EDGE_BAND, GOOD_ANGLE_DEG};
 pub use repair::{
     find_self_intersections, mesh_edge_census, mesh_volume, offset_mesh, repair_mesh, repair_mesh_timed, Bucketing,
     EdgeCensus, RepairOptions, RepairReport, RepairResult, StageTimes,
@@ -56,7 +58,9 @@ pub use reparam::{
 #[cfg(feature = "std")]
 #[doc(hidden)]
 pub use tessellate::stages;
-pub use tessellate::{mesh_model, mesh_model_with_progress, MeshOptions, MeshResult, OptionsError, Tolerance};
+pub use tessellate::{
+    mesh_model, mesh_model_with_progress, MeshMode, MeshOptions, MeshResult, OptionsError, Tolerance,
+};
 
 /// Reads `bytes` in `format` and meshes the model: the one call both doors use.
 ///

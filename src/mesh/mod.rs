@@ -88,4 +88,7 @@ pub struct Report {
     pub warnings: Vec<String>,
     /// Faces the parameterization test flagged (paper 001), rebuilt or not.
     pub reparameterized: Vec<crate::reparam::ReparamFace>,
+    /// Quality mode only: element size and how near the mesh comes to it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quality: Option<crate::quality::QualityReport>,
 }

@@ -22,7 +22,7 @@ use crate::nurbs::{Aabb, Surface};
 use crate::reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
 use crate::{Error, Mesh, Model, Report};
 
-pub use options::{MeshOptions, OptionsError, Tolerance};
+pub use options::{MeshMode, MeshOptions, OptionsError, Tolerance};
 
 /// A mesh and what was measured on it.
 #[derive(Debug, Clone, Default)]
@@ -38,6 +38,8 @@ pub struct MeshResult {
 /// Each face gets an iso-parametric grid sized by paper 000's chord test, a
 /// constrained Delaunay band along its trim loops, and refinement until every
 /// triangle's measured deviation, normal turn and edge length pass.
+/// With [`MeshMode::Quality`] the faces get near-equilateral triangles of
+/// the size in [`MeshOptions::quality`] instead (paper 003).
 ///
 /// # Errors
 /// Invalid options, an empty model, a face whose loops cross or leave the
@@ -58,6 +60,9 @@ pub fn mesh_model_with_progress(
     options: &MeshOptions,
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<MeshResult, Error> {
+    if options.mode == MeshMode::Quality {
+        return crate::quality::mesh_quality(model, options, progress);
+    }
     let Setup { tol, diag, lim, crit } = setup(model, options)?;
     let aim = crit.tol;
     let mut report = Report { tolerance: tol, angle: options.angle, faces: model.faces.len(), ..Report::default() };

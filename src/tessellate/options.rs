@@ -2,7 +2,20 @@
 
 use core::fmt;
 
+use crate::quality::QualityOptions;
 use crate::reparam::Reparam;
+
+/// What the mesher aims at.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum MeshMode {
+    /// Fewest triangles within the chordal tolerance (paper 000).
+    #[default]
+    Fast,
+    /// Near-equilateral triangles of a chosen size for analysis (paper 003),
+    /// set by [`MeshOptions::quality`].
+    Quality,
+}
 
 /// How the chordal tolerance is given.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,6 +58,10 @@ pub struct MeshOptions {
     /// (paper 001). Default [`Reparam::Off`]; [`Reparam::Auto`] rebuilds the
     /// faces the ratio test flags.
     pub reparam: Reparam,
+    /// Fewest triangles ([`MeshMode::Fast`], default) or analysis quality.
+    pub mode: MeshMode,
+    /// Settings of [`MeshMode::Quality`]: element size, method, weights.
+    pub quality: QualityOptions,
 }
 
 impl Default for MeshOptions {
@@ -59,6 +76,8 @@ impl Default for MeshOptions {
             measure_steps: 4,
             safety: 0.8,
             reparam: Reparam::Off,
+            mode: MeshMode::Fast,
+            quality: QualityOptions::default(),
         }
     }
 }
@@ -129,6 +148,18 @@ impl MeshOptions {
         self
     }
 
+    /// Sets the meshing mode.
+    pub fn with_mode(mut self, mode: MeshMode) -> Self {
+        self.mode = mode;
+        self
+    }
+
+    /// Sets the quality mode's settings.
+    pub fn with_quality(mut self, quality: QualityOptions) -> Self {
+        self.quality = quality;
+        self
+    }
+
     /// Checks every field.
     ///
     /// # Errors
@@ -175,6 +206,6 @@ impl MeshOptions {
         if !(self.safety.is_finite() && self.safety > 0.1 && self.safety <= 1.0) {
             return Err(OptionsError { option: "safety", message: "must be in (0.1, 1]" });
         }
-        Ok(())
+        self.quality.validate()
     }
 }

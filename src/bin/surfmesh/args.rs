@@ -4,7 +4,7 @@
 use std::ffi::OsString;
 use std::path::PathBuf;
 
-use surfmesh::{Format, MeshOptions, Reparam};
+use surfmesh::{Format, MeshMode, MeshOptions, QualityMethod, Reparam};
 
 /// What the user asked for.
 pub enum Command {
@@ -68,7 +68,17 @@ Options of `mesh`:
   --max-edge L        longest triangle edge allowed, model units
   --min-edge L        edges this short are never split, model units
   --max-triangles N   triangle budget (default 4000000)
-  --mode fast         meshing mode (`quality` is not available yet)
+  --mode MODE         fast (default): fewest triangles within the tolerance;
+                      quality: near-equilateral triangles of size H for
+                      analysis (paper 003)
+  --size H            quality mode: element size, model units
+  --size-rel R        quality mode: element size as a fraction of the model's
+                      diagonal (default 0.02)
+  --method M          quality mode: looping (default, paper 003), delaunay
+                      (spade's refinement) or best (both, the better kept per face)
+  --weights C1,C2,C3,C4  quality mode: the splitting function's weights
+                      (default 1,0.3,0.6,1)
+  --passes N          quality mode: improvement rounds (default 6)
   --reparam MODE      rebuild poorly parameterized faces before meshing: off
                       (default), auto (faces the step-ratio test flags), force
   --format F          input format: json, iges (igs) or step (stp, p21); default:
@@ -107,6 +117,8 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
     let mut format = None;
     let mut options = MeshOptions::default();
     let (mut tol, mut tol_rel) = (None, None);
+    let (mut size, mut size_rel) = (None, None);
+    let mut quality = options.quality.clone();
     let mut output = None;
     let mut report: Option<PathBuf> = None;
     while let Some(arg) = args.next() {
@@ -137,10 +149,43 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
                 options = options.with_max_triangles(n);
             }
             "--mode" => match value()?.to_str() {
-                Some("fast") => {}
-                Some("quality") => return Err("--mode quality is not available yet; use --mode fast".into()),
-                _ => return Err("--mode must be fast (quality is not available yet)".into()),
+                Some("fast") => options = options.with_mode(MeshMode::Fast),
+                Some("quality") => options = options.with_mode(MeshMode::Quality),
+                _ => return Err("--mode must be fast or quality".into()),
             },
+            "--size" => size = Some(number(&name, value()?)?),
+            "--size-rel" => size_rel = Some(number(&name, value()?)?),
+            "--method" => {
+                let method = match value()?.to_str() {
+                    Some("looping") => QualityMethod::Looping,
+                    Some("delaunay") => QualityMethod::Delaunay,
+                    Some("best") => QualityMethod::Best,
+                    _ => return Err("--method must be looping, delaunay or best".into()),
+                };
+                quality = quality.with_method(method);
+            }
+            "--weights" => {
+                let v = value()?;
+                let c: Vec<f64> = v
+                    .to_str()
+                    .unwrap_or("")
+                    .split(',')
+                    .map(|x| x.trim().parse::<f64>())
+                    .collect::<Result<_, _>>()
+                    .map_err(|_| {
+                        format!("{name}: '{}' is not four numbers separated by commas", v.to_string_lossy())
+                    })?;
+                let c: [f64; 4] = c.try_into().map_err(|_| {
+                    format!("{name}: '{}' is not four numbers separated by commas", v.to_string_lossy())
+                })?;
+                quality = quality.with_weights(c);
+            }
+            "--passes" => {
+                let v = value()?;
+                let n = v.to_str().and_then(|s| s.parse().ok());
+                quality =
+                    quality.with_passes(n.ok_or_else(|| format!("{name}: '{}' is not a count", v.to_string_lossy()))?);
+            }
             "--reparam" => {
                 let mode = match value()?.to_str() {
                     Some("auto") => Reparam::Auto,
@@ -170,6 +215,16 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
         (None, Some(r)) => options.with_relative_tolerance(r),
         (None, None) => options,
     };
+    quality = match (size, size_rel) {
+        (Some(_), Some(_)) => return Err("give --size or --size-rel, not both".into()),
+        (Some(h), None) => quality.with_size(h),
+        (None, Some(r)) => quality.with_relative_size(r),
+        (None, None) => quality,
+    };
+    if options.mode != MeshMode::Quality && quality != options.quality {
+        return Err("--size, --size-rel, --method, --weights and --passes need --mode quality".into());
+    }
+    options = options.with_quality(quality);
     options.validate().map_err(|e| e.to_string())?;
     if let (Some((out, _)), Some(rep)) = (&output, &report) {
         if out == rep {
