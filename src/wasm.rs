@@ -17,7 +17,7 @@ use wasm_bindgen::prelude::*;
 
 use crate::{fit_points, read_points, FitOptions, FitResult, PointFormat};
 use crate::{offset_mesh, read_mesh, repair_mesh_timed, Bucketing, MeshFormat, RepairOptions};
-use crate::{read_model, read_step_parts, Error, Format, MeshOptions, MeshResult};
+use crate::{read_model, read_step_parts, Error, Format, MeshMode, MeshOptions, MeshResult, QualityMethod};
 // `tests/wasm_node.rs` compiles this file into a crate where `crate::` is the
 // test itself, which does not import this name; take it from the library there.
 #[cfg(not(test))]
@@ -44,6 +44,14 @@ export interface MeshOptions {
   maxTriangles?: number;
   /** Rebuild poorly parameterized faces first: "off" (default), "auto" (flagged faces), "force". */
   reparam?: "auto" | "off" | "force";
+  /** "fast" (default): fewest triangles within the tolerance; "quality": near-equilateral triangles of size H (paper 003). */
+  mode?: "fast" | "quality";
+  /** Quality mode: element size H in model units (exclusive with sizeRel). */
+  size?: number;
+  /** Quality mode: element size as a fraction of the model's bounding-box diagonal (default 0.02). */
+  sizeRel?: number;
+  /** Quality mode: "looping" (default, paper 003), "delaunay" (spade's refinement) or "best" (both, better per face). */
+  method?: "looping" | "delaunay" | "best";
 }
 
 /** What `mesh` returns. */
@@ -160,7 +168,19 @@ export function meshWithProgress(
 "#;
 
 /// Option names `mesh` accepts, in the order they are read.
-const OPTION_NAMES: [&str; 7] = ["tolerance", "toleranceRel", "angle", "maxEdge", "minEdge", "maxTriangles", "reparam"];
+const OPTION_NAMES: [&str; 11] = [
+    "tolerance",
+    "toleranceRel",
+    "angle",
+    "maxEdge",
+    "minEdge",
+    "maxTriangles",
+    "reparam",
+    "mode",
+    "size",
+    "sizeRel",
+    "method",
+];
 
 /// The crate version, so a page can show which mesher produced a mesh.
 #[cfg_attr(not(test), wasm_bindgen)]
@@ -339,7 +359,35 @@ fn read_options(value: &JsValue) -> Result<MeshOptions, String> {
         };
         options = options.with_reparam(mode);
     }
+    let mut quality = options.quality.clone();
+    match (number(object, "size")?, number(object, "sizeRel")?) {
+        (Some(_), Some(_)) => return Err("option size: give size or sizeRel, not both".into()),
+        (Some(h), None) => quality = quality.with_size(h),
+        (None, Some(r)) => quality = quality.with_relative_size(r),
+        (None, None) => {}
+    }
+    if let Some(m) = word(object, "method", &["looping", "delaunay", "best"])? {
+        let method = [QualityMethod::Looping, QualityMethod::Delaunay, QualityMethod::Best][m];
+        quality = quality.with_method(method);
+    }
+    options = options.with_quality(quality);
+    if let Some(m) = word(object, "mode", &["fast", "quality"])? {
+        options = options.with_mode([MeshMode::Fast, MeshMode::Quality][m]);
+    }
     Ok(options)
+}
+
+/// A string-valued option: the index of its value in `allowed`, `None` when absent.
+fn word(object: &Object, name: &str, allowed: &[&str]) -> Result<Option<usize>, String> {
+    let value = Reflect::get(object, &JsValue::from_str(name)).map_err(|_| format!("option {name}: cannot be read"))?;
+    if value.is_undefined() || value.is_null() {
+        return Ok(None);
+    }
+    let text = value.as_string().unwrap_or_default();
+    match allowed.iter().position(|a| *a == text) {
+        Some(i) => Ok(Some(i)),
+        None => Err(format!("option {name}: expected one of \"{}\"", allowed.join("\", \""))),
+    }
 }
 
 /// A number-valued option: `None` when absent (undefined or null).

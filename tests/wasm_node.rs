@@ -13,7 +13,8 @@ extern crate alloc;
 #[allow(unused_imports)]
 use surfmesh::{
     fit_points, mesh_model, offset_mesh, read_mesh, read_model, read_points, read_step_parts, repair_mesh_timed,
-    Bucketing, Error, FitOptions, FitResult, Format, MeshFormat, MeshOptions, MeshResult, PointFormat, RepairOptions,
+    Bucketing, Error, FitOptions, FitResult, Format, MeshFormat, MeshMode, MeshOptions, MeshResult, PointFormat,
+    QualityMethod, RepairOptions,
 };
 
 #[path = "../src/wasm.rs"]
@@ -230,6 +231,37 @@ fn bad_options_are_named() {
     ];
     for (opts, expected) in cases {
         let m = err(&dome(), opts);
+        assert!(m.contains(expected), "expected {expected:?} in {m:?}");
+    }
+}
+
+#[wasm_bindgen_test]
+fn quality_mode_gives_near_equilateral_triangles_of_the_size_asked() {
+    let plane = include_bytes!("data/plane.json");
+    let out = ok(plane, options(&[("mode", "quality".into()), ("size", num(2.0)), ("method", "best".into())]));
+    let quality = Reflect::get(&out.report, &"quality".into()).expect("quality report");
+    let field = |name: &str| Reflect::get(&quality, &name.into()).ok().and_then(|v| v.as_f64()).expect(name);
+    assert_eq!(field("size"), 2.0);
+    assert!(field("good_angle_fraction") >= 0.99);
+    // The 10 mm square: each side in ceil(10 / 2) = 5 parts, no edge beyond 1.4 H.
+    assert_eq!(out.number("boundary_edges"), 20.0);
+    assert!(out.longest_edge() <= 2.8 + 1e-6, "{}", out.longest_edge());
+    // Relative size: 0.1 of the diagonal 14.14 mm.
+    let rel = ok(plane, options(&[("mode", "quality".into()), ("sizeRel", num(0.1))]));
+    let q = Reflect::get(&rel.report, &"quality".into()).expect("quality report");
+    let size = Reflect::get(&q, &"size".into()).ok().and_then(|v| v.as_f64()).expect("size");
+    assert!((size - 0.1 * 200f64.sqrt()).abs() < 1e-9, "{size}");
+    // Fast mode reports no quality section.
+    let fast = ok(plane, JsValue::UNDEFINED);
+    assert!(Reflect::get(&fast.report, &"quality".into()).expect("get").is_undefined());
+    for (opts, expected) in [
+        (options(&[("mode", "slow".into())]), "option mode: expected one of \"fast\", \"quality\""),
+        (options(&[("mode", "quality".into()), ("size", num(1.0)), ("sizeRel", num(0.1))]), "not both"),
+        (options(&[("mode", "quality".into()), ("method", "fancy".into())]), "option method"),
+        (options(&[("mode", "quality".into()), ("size", num(-1.0))]), "option --size"),
+        (options(&[("mode", "quality".into()), ("size", num(1e-5))]), "choose a larger size"),
+    ] {
+        let m = err(plane, opts);
         assert!(m.contains(expected), "expected {expected:?} in {m:?}");
     }
 }

@@ -27,18 +27,23 @@ pub(crate) struct FaceMesh {
     pub tris: Vec<[u32; 3]>,
 }
 
-/// Smallest angle of a triangle in model space, radians (0 when degenerate).
+/// Smallest angle of a triangle in model space, radians (0 when
+/// degenerate): the angle opposite the shortest side, by the law of cosines.
 pub(crate) fn min_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let ang = |p: DVec3, q: DVec3, r: DVec3| {
-        let (u, v) = (q - p, r - p);
-        libm::atan2(u.cross(v).length(), u.dot(v))
-    };
-    let m = ang(a, b, c).min(ang(b, c, a)).min(ang(c, a, b));
-    if m.is_finite() {
-        m
+    let (x, y, z) = (b.distance_squared(c), c.distance_squared(a), a.distance_squared(b));
+    // Opposite side s, adjacent sides p and q.
+    let (s, p, q) = if x <= y && x <= z {
+        (x, y, z)
+    } else if y <= z {
+        (y, z, x)
     } else {
-        0.0
+        (z, x, y)
+    };
+    let den = 2.0 * libm::sqrt(p * q);
+    if !(den > 0.0 && den.is_finite()) {
+        return 0.0;
     }
+    libm::acos(((p + q - s) / den).clamp(-1.0, 1.0))
 }
 
 fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
@@ -48,6 +53,8 @@ fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
 struct Work<'a> {
     s: &'a dyn Surface,
     m: FaceMesh,
+    /// Unit surface normal at each node.
+    nrm: Vec<DVec3>,
     alive: Vec<bool>,
     /// Triangles around each node.
     vt: Vec<Vec<u32>>,
@@ -86,7 +93,8 @@ pub(crate) fn improve(
     let span = (hi - lo).max_element().max(1e-300);
     let hmax = mesh.h.iter().copied().fold(0.0, f64::max);
     let alive = alloc::vec![true; mesh.tris.len()];
-    let mut w = Work { s: surface, m: mesh, alive, vt, hmax, tiny: 1e-16 * span * span, max_nodes };
+    let nrm = mesh.uv.iter().map(|&q| surface.normal(q)).collect();
+    let mut w = Work { s: surface, m: mesh, nrm, alive, vt, hmax, tiny: 1e-16 * span * span, max_nodes };
     for _ in 0..passes {
         if resize {
             w.split_long();
@@ -134,8 +142,7 @@ impl Work<'_> {
             return false;
         }
         let facet = (m.x[b] - m.x[a]).cross(m.x[c] - m.x[a]);
-        let n = self.s.normal((m.uv[a] + m.uv[b] + m.uv[c]) / 3.0);
-        facet.dot(n) > 0.0
+        facet.dot(self.nrm[a] + self.nrm[b] + self.nrm[c]) > 0.0
     }
 
     fn angle_of(&self, t: [u32; 3]) -> f64 {
@@ -248,12 +255,14 @@ impl Work<'_> {
             self.m.h.push(0.5 * (self.m.h[a as usize] + self.m.h[b as usize]));
             self.m.fixed.push(false);
             self.vt.push(Vec::new());
+            self.nrm.push(self.s.normal(uv));
             if !new.iter().all(|&t| self.tri_ok(t)) {
                 self.m.uv.pop();
                 self.m.x.pop();
                 self.m.h.pop();
                 self.m.fixed.pop();
                 self.vt.pop();
+                self.nrm.pop();
                 continue;
             }
             self.set_tri(t1, new[0]);
@@ -310,7 +319,7 @@ impl Work<'_> {
                 let uv = (self.m.uv[a as usize] + self.m.uv[b as usize]) * 0.5;
                 (b, a, uv, self.s.point(uv))
             };
-            let old_uv = (self.m.uv[keep as usize], self.m.x[keep as usize]);
+            let old_uv = (self.m.uv[keep as usize], self.m.x[keep as usize], self.nrm[keep as usize]);
             let mut before = f64::INFINITY;
             let touched: Vec<u32> = self.vt[a as usize]
                 .iter()
@@ -324,6 +333,7 @@ impl Work<'_> {
             before = before.min(self.angle_of(self.m.tris[t1 as usize])).min(self.angle_of(self.m.tris[t2 as usize]));
             self.m.uv[keep as usize] = uv;
             self.m.x[keep as usize] = x;
+            self.nrm[keep as usize] = if fa || fb { old_uv.2 } else { self.s.normal(uv) };
             let mut ok = true;
             let mut after = f64::INFINITY;
             for &t in &touched {
@@ -345,6 +355,7 @@ impl Work<'_> {
             if !ok || after < before.min(20f64.to_radians()) {
                 self.m.uv[keep as usize] = old_uv.0;
                 self.m.x[keep as usize] = old_uv.1;
+                self.nrm[keep as usize] = old_uv.2;
                 continue;
             }
             let _ = (c, d);
@@ -429,13 +440,16 @@ impl Work<'_> {
             if !uv.is_finite() {
                 continue;
             }
+            let old_n = self.nrm[v];
             self.m.uv[v] = uv;
             self.m.x[v] = self.s.point(uv);
+            self.nrm[v] = self.s.normal(uv);
             let ok = tris.iter().all(|&t| self.tri_ok(t));
             let after = tris.iter().map(|&t| self.angle_of(t)).fold(f64::INFINITY, f64::min);
             if !ok || after < before.min(30f64.to_radians()) {
                 self.m.uv[v] = old_uv;
                 self.m.x[v] = old_x;
+                self.nrm[v] = old_n;
             }
         }
     }

@@ -3,7 +3,7 @@
 #[cfg(feature = "std")]
 mod cdt;
 mod face;
-mod measure;
+pub(crate) mod measure;
 mod options;
 mod params;
 mod refine;
