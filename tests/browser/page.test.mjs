@@ -1,6 +1,6 @@
 // The page in headless Chromium, driven as a user would and judged by what it
 // shows: the default sample's mesh and its numbers, a finer tolerance, a
-// broken file, a good file, the exports, cancel, the display toggles, and the
+// broken file, a good file, the exports, cancel, the display toggles, quality mode, and the
 // time from navigation to the first mesh on screen. Screenshots go to
 // tests/browser/screenshots/.
 //
@@ -320,5 +320,35 @@ test('cancel stops a long run at once; the page keeps the last mesh and keeps wo
   });
   assert.equal(again, 'ready');
   assert.ok((await stat('stat-triangles')) > before);
+  assert.deepEqual(page.errors, []);
+});
+
+test('quality mode meshes near-equilateral triangles of the chosen size; the can stays closed', async () => {
+  await settle(() => page.selectOption('#sample', 'can.json'));
+  const fast = await stat('stat-triangles');
+  assert.equal(await page.textContent('#stat-good-angles'), '—');
+  assert.ok(!(await page.isVisible('#size-field')), 'no size field in fast mode');
+  const state = await settle(() => page.click('.segmented label:has-text("Quality")'));
+  assert.equal(state, 'ready');
+  assert.ok(await page.isVisible('#size-field'));
+  const percent = async (id) => parseFloat(await page.textContent(`#${id}`));
+  assert.ok((await percent('stat-good-angles')) >= 99, `${await page.textContent('#stat-good-angles')} reach 25°`);
+  assert.ok((await percent('stat-edge-band')) >= 90, `${await page.textContent('#stat-edge-band')} of edges in the band`);
+  assert.equal(await stat('stat-open-edges'), 0, 'the can stays closed');
+  assert.equal(await stat('stat-free-edges'), 0);
+  assert.match(await page.textContent('#status'), /triangles of size [\d.e+-]+ · [\d.]+ % with angles ≥ 25°/);
+  const coarse = await stat('stat-triangles');
+  assert.notEqual(coarse, fast);
+  await shot(page, '11-quality-mode');
+  // Half the size, about four times the triangles.
+  await settle(async () => {
+    await page.fill('#size-value', '0.01');
+    await page.press('#size-value', 'Enter');
+  });
+  const fine = await stat('stat-triangles');
+  assert.ok(fine > 3 * coarse && fine < 5 * coarse, `${fine} triangles at H = 0.01, ${coarse} at 0.02`);
+  await settle(() => page.click('.segmented label:has-text("Fast")'));
+  assert.equal(await stat('stat-triangles'), fast, 'fast mode gives its mesh back');
+  assert.equal(await page.textContent('#stat-good-angles'), '—');
   assert.deepEqual(page.errors, []);
 });

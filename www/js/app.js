@@ -98,7 +98,17 @@ function showStats(report, quality) {
   setStat('stat-vertices', count(report.vertices));
   setStat('stat-tolerance', fmt(report.tolerance));
   const within = report.max_deviation <= report.tolerance;
-  setStat('stat-max-deviation', `${fmt(report.max_deviation)} ${within ? '✓' : '✗'}`, within ? 'ok' : 'bad');
+  if (report.quality) {
+    // Quality mode aims at a size, not a tolerance: the deviation is reported, not judged.
+    setStat('stat-max-deviation', fmt(report.max_deviation));
+    const q = report.quality;
+    setStat('stat-good-angles', percent(q.good_angle_fraction), q.good_angle_fraction >= 0.99 ? 'ok' : 'bad');
+    setStat('stat-edge-band', percent(q.edge_band_fraction), q.edge_band_fraction >= 0.9 ? 'ok' : 'bad');
+  } else {
+    setStat('stat-max-deviation', `${fmt(report.max_deviation)} ${within ? '✓' : '✗'}`, within ? 'ok' : 'bad');
+    setStat('stat-good-angles', '—');
+    setStat('stat-edge-band', '—');
+  }
   setStat('stat-mean-deviation', fmt(report.mean_deviation));
   setStat('stat-min-angle', `${report.min_angle_deg.toFixed(1)}° (1%: ${report.p1_angle_deg.toFixed(1)}°)`);
   setStat('stat-free-edges', count(report.free_edges), report.free_edges === 0 ? 'ok' : 'bad');
@@ -141,10 +151,22 @@ function tolKind() {
   return document.querySelector('input[name="tol-kind"]:checked').value;
 }
 
+function meshMode() {
+  return document.querySelector('input[name="mode"]:checked').value;
+}
+
+function percent(fraction) {
+  return `${(100 * fraction).toFixed(1)} %`;
+}
+
 /** The mesher options the controls ask for; the module validates them. */
 function readOptions() {
   const value = Number($('tol-value').value);
   const options = tolKind() === 'rel' ? { toleranceRel: value } : { tolerance: value };
+  if (meshMode() === 'quality') {
+    options.mode = 'quality';
+    options.sizeRel = Number($('size-value').value);
+  }
   const angle = $('angle').value.trim();
   if (angle !== '' && angle !== DEFAULT_ANGLE_DEG) options.angle = (Number(angle) * Math.PI) / 180;
   const maxEdge = $('max-edge').value.trim();
@@ -217,7 +239,8 @@ function remesh({ fresh = false } = {}) {
   const fine = adopt(options) ?? pool.mesh(bytes, format, options, onProgress);
   fine.onProgress = onProgress;
   const coarseRel = options.toleranceRel === undefined || options.toleranceRel < COARSE_REL;
-  if (fresh && coarseRel) {
+  // The coarse preview is a fast-mode mesh: not shown while quality mode is asked for.
+  if (fresh && coarseRel && options.mode !== 'quality') {
     const coarse = adopt({ toleranceRel: COARSE_REL }) ?? pool.mesh(bytes, format, { toleranceRel: COARSE_REL });
     coarse.promise.then(
       ({ result, lines }) => {
@@ -242,8 +265,11 @@ function remesh({ fresh = false } = {}) {
       setState('ready');
       const r = result.report;
       status(
-        `${count(r.triangles)} triangles · max deviation ${fmt(r.max_deviation)} ≤ ${fmt(r.tolerance)} · ` +
-          `${r.time_ms.toFixed(0)} ms`,
+        r.quality
+          ? `${count(r.triangles)} triangles of size ${fmt(r.quality.size)} · ` +
+              `${percent(r.quality.good_angle_fraction)} with angles ≥ 25° · ${r.time_ms.toFixed(0)} ms`
+          : `${count(r.triangles)} triangles · max deviation ${fmt(r.max_deviation)} ≤ ${fmt(r.tolerance)} · ` +
+              `${r.time_ms.toFixed(0)} ms`,
       );
     },
     (error) => {
@@ -351,7 +377,17 @@ $('tol-slider').addEventListener('input', () => {
   sliderToValue();
   remeshSoon();
 });
-for (const id of ['angle', 'max-edge']) $(id).addEventListener('change', () => remesh());
+for (const id of ['angle', 'max-edge', 'size-value']) $(id).addEventListener('change', () => remesh());
+for (const radio of document.querySelectorAll('input[name="mode"]')) {
+  radio.addEventListener('change', () => {
+    const quality = meshMode() === 'quality';
+    $('size-field').hidden = !quality;
+    $('mode-hint').textContent = quality
+      ? 'Near-equilateral triangles of size H for analysis (paper 003); faces meet node to node.'
+      : 'Fewest triangles within the tolerance.';
+    remesh();
+  });
+}
 for (const radio of document.querySelectorAll('input[name="tol-kind"]')) {
   radio.addEventListener('change', () => {
     const abs = tolKind() === 'abs';
