@@ -150,6 +150,45 @@ impl NurbsSurface {
         }
     }
 
+    /// `S(u, v)` at every `(us[i], vs[j])`, `u` outer: the basis functions of
+    /// each row and column are computed once instead of once per point.
+    pub fn points_on_grid(&self, us: &[f64], vs: &[f64]) -> Vec<DVec3> {
+        match self.ku.degree().max(self.kv.degree()) {
+            0..=3 => self.points_on_grid_n::<4>(us, vs),
+            4..=7 => self.points_on_grid_n::<8>(us, vs),
+            _ => self.points_on_grid_n::<{ super::MAX_DEGREE + 1 }>(us, vs),
+        }
+    }
+
+    fn points_on_grid_n<const N: usize>(&self, us: &[f64], vs: &[f64]) -> Vec<DVec3> {
+        let (p, q) = (self.ku.degree(), self.kv.degree());
+        let nv = self.kv.control_count();
+        let columns: Vec<(usize, [f64; N])> = vs
+            .iter()
+            .map(|&v| {
+                let mut b = [[0.0; N]; 3];
+                let span = self.kv.basis_into(v, 0, &mut b);
+                (span, b[0])
+            })
+            .collect();
+        let mut out = Vec::with_capacity(us.len() * vs.len());
+        for &u in us {
+            let mut bu = [[0.0; N]; 3];
+            let su = self.ku.basis_into(u, 0, &mut bu);
+            for (sv, bv) in &columns {
+                let mut a = DVec4::ZERO;
+                for (r, wu) in bu[0].iter().enumerate().take(p + 1) {
+                    let row = (su - p + r) * nv + sv - q;
+                    for (s, wv) in bv.iter().enumerate().take(q + 1) {
+                        a += self.points[row + s] * (wu * wv);
+                    }
+                }
+                out.push(a.truncate() / a.w);
+            }
+        }
+        out
+    }
+
     fn homogeneous_derivs_n<const N: usize>(&self, uv: DVec2, order: usize) -> [[DVec4; 3]; 3] {
         let mut bu = [[0.0; N]; 3];
         let mut bv = [[0.0; N]; 3];

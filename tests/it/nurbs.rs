@@ -519,6 +519,26 @@ proptest! {
         prop_assert!(s.derivs(uv).point.distance(got) <= 1e-12 * 20.0);
     }
 
+    /// A grid evaluated by rows and columns holds the rational definition at every node,
+    /// including parameters outside the domain (clamped, as `point` does).
+    #[test]
+    fn surface_grid_points_match_definition(g in surf_gen(9, 0.3..3.0), us in vec(-0.1f64..=1.1, 1..6), vs in vec(-0.1f64..=1.1, 1..6)) {
+        let s = g.build();
+        let [lo, hi] = s.domain();
+        let us: Vec<f64> = us.iter().map(|&f| lerp(lo.x, hi.x, f)).collect();
+        let vs: Vec<f64> = vs.iter().map(|&f| lerp(lo.y, hi.y, f)).collect();
+        let grid = s.points_on_grid(&us, &vs);
+        prop_assert_eq!(grid.len(), us.len() * vs.len());
+        for (i, &u) in us.iter().enumerate() {
+            for (j, &v) in vs.iter().enumerate() {
+                let uv = DVec2::new(u.clamp(lo.x, hi.x), v.clamp(lo.y, hi.y));
+                let want = ref_surface_point(&g, uv);
+                let got = grid[i * vs.len() + j];
+                prop_assert!(got.distance(want) <= 1e-12 * 20.0, "({}, {}): {} vs {}", u, v, got, want);
+            }
+        }
+    }
+
     /// Curve C', C'' equal central differences of C and C' inside a knot span.
     #[test]
     fn curve_derivatives_match_finite_differences(c in curve_gen(5), pick in 0usize..16, f in 0.05f64..0.95) {
