@@ -83,8 +83,13 @@ fn run(file: &str, rel: f64, abs: Option<f64>, all: bool) -> Result<(), String> 
         if !all && ratio <= RATIO_LIMIT {
             continue;
         }
-        let one =
-            Model { units: model.units.clone(), faces: vec![face.clone()], warnings: Vec::new(), tolerance: None };
+        let one = Model {
+            units: model.units.clone(),
+            faces: vec![face.clone()],
+            warnings: Vec::new(),
+            tolerance: None,
+            bodies: Vec::new(),
+        };
         let mut row = serde_json::json!({
             "file": name, "face": index, "ratio": ratio, "tolerance": tol, "detect_us": detect_us,
             "trimmed": !face.loops.is_empty(),

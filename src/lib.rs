@@ -39,7 +39,10 @@ pub use io::{
     UNV_SHELL_TRIANGLE,
 };
 pub use measure::{measure_mesh, MeasureOptions, MeshMeasure};
-pub use mesh::{angle_stats, edge_counts, weld_mesh, weld_positions, AngleStats, EdgeCounts, FaceRange, Mesh, Report};
+pub use mesh::{
+    angle_stats, edge_counts, edge_counts_in_bodies, weld_mesh, weld_positions, AngleStats, EdgeCounts, FaceRange,
+    Mesh, Report,
+};
 pub use model::{Face, FaceSurface, Model, TrimLoop};
 pub use nurbs::{
     project_to_surface, Aabb, BasisDers, CurveDerivs, KnotVector, NurbsCurve, NurbsError, NurbsSurface, Projection,

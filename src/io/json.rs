@@ -91,7 +91,7 @@ pub fn read_json(bytes: &[u8]) -> Result<Model, Error> {
     for (index, face) in raw.faces.into_iter().enumerate() {
         faces.push(build_face(index, face, &mut total)?);
     }
-    Ok(Model { units: raw.units.unwrap_or_else(|| "mm".into()), faces, warnings: Vec::new(), tolerance: None })
+    Ok(Model { units: raw.units.unwrap_or_else(|| "mm".into()), faces, ..Model::default() })
 }
 
 /// Turns serde's error into [`Error::Json`], dropping serde's own

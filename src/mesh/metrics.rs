@@ -24,7 +24,34 @@ pub struct EdgeCounts {
 /// Counts boundary, crack and non-manifold edges after welding vertices closer
 /// than `weld_tol`; `sew_tol` is how close unconnected borders must be to count as a crack.
 pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
-    let (map, nverts) = weld_positions(&mesh.positions, weld_tol);
+    edge_counts_in_bodies(mesh, &[], weld_tol, sew_tol)
+}
+
+/// As [`edge_counts`], with faces in bodies (`bodies[face]`, empty: one
+/// body): vertices of different bodies are never welded, and a border is a
+/// crack only next to another border of its own body, so parts of an
+/// assembly that touch are counted each on its own.
+pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol: f64) -> EdgeCounts {
+    let (mut map, mut nverts) = weld_positions(&mesh.positions, weld_tol);
+    let face_of = face_lookup(mesh);
+    let body_of_face = |f: u32| bodies.get(f as usize).copied().unwrap_or(0);
+    if !bodies.is_empty() {
+        // Each vertex's body, from the triangles that use it (faces own their vertices).
+        let mut body_of_vertex = alloc::vec![0u32; mesh.positions.len()];
+        for (ti, t) in mesh.indices.chunks_exact(3).enumerate() {
+            for &v in t {
+                if let Some(b) = body_of_vertex.get_mut(v as usize) {
+                    *b = body_of_face(face_of(ti));
+                }
+            }
+        }
+        let mut ids: hashbrown::HashMap<(u32, u32), u32> = hashbrown::HashMap::new();
+        for (v, m) in map.iter_mut().enumerate() {
+            let next = ids.len() as u32;
+            *m = *ids.entry((*m, body_of_vertex[v])).or_insert(next);
+        }
+        nverts = ids.len();
+    }
     // Representative position of each welded vertex.
     let mut pos = alloc::vec![DVec3::ZERO; nverts];
     for (i, &m) in map.iter().enumerate() {
@@ -33,7 +60,6 @@ pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
     // Directed edge counts keyed by the undirected pair.
     let mut edges: hashbrown::HashMap<(u32, u32), (u32, u32)> = hashbrown::HashMap::new();
     let mut owner: hashbrown::HashMap<(u32, u32), u32> = hashbrown::HashMap::new();
-    let face_of = face_lookup(mesh);
     for (ti, t) in mesh.indices.chunks_exact(3).enumerate() {
         let v = [map[t[0] as usize], map[t[1] as usize], map[t[2] as usize]];
         if v[0] == v[1] || v[1] == v[2] || v[2] == v[0] {
@@ -64,7 +90,7 @@ pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
         }
     }
     out.boundary_edges = free.len();
-    out.free_edges = count_cracks(&free, &pos, sew_tol);
+    out.free_edges = count_cracks(&free, &pos, sew_tol, &body_of_face);
     out
 }
 
@@ -77,9 +103,9 @@ fn face_lookup(mesh: &Mesh) -> impl Fn(usize) -> u32 + '_ {
 }
 
 /// A free edge is a crack when a vertex or midpoint of a free edge of another
-/// face lies within `sew` (and within a fifth of the edge's length) of its
-/// quarter, half or three-quarter point.
-fn count_cracks(free: &[(u32, u32, u32)], pos: &[DVec3], sew: f64) -> usize {
+/// face of its body lies within `sew` (and within a fifth of the edge's
+/// length) of its quarter, half or three-quarter point.
+fn count_cracks(free: &[(u32, u32, u32)], pos: &[DVec3], sew: f64, body: &dyn Fn(u32) -> u32) -> usize {
     if free.is_empty() || !(sew > 0.0 && sew.is_finite()) {
         return 0;
     }
@@ -122,6 +148,7 @@ fn count_cracks(free: &[(u32, u32, u32)], pos: &[DVec3], sew: f64) -> usize {
                         let Some(list) = grid.get(&(kx + dx, ky + dy, kz + dz)) else { continue };
                         for &(p, tag, f) in list {
                             let other = f != face
+                                && body(f) == body(face)
                                 && match tag {
                                     Tag::Vertex(v) => v != a && v != b,
                                     Tag::Mid => true,

@@ -8,7 +8,7 @@ use alloc::vec::Vec;
 use glam::DVec3;
 use serde::Serialize;
 
-pub use metrics::{angle_stats, edge_counts, AngleStats, EdgeCounts};
+pub use metrics::{angle_stats, edge_counts, edge_counts_in_bodies, AngleStats, EdgeCounts};
 pub use weld::{weld_mesh, weld_positions};
 
 /// An indexed triangle mesh. Every face owns its vertices (so normals can break

@@ -20,6 +20,17 @@ pub struct Model {
     /// minimum resolution), when it states one: the gaps its author accepted
     /// between faces, so sewing reaches at least that far.
     pub tolerance: Option<f64>,
+    /// Per face, the body (shell, solid, part instance) it belongs to, when
+    /// the file says: faces of different bodies are never sewn together,
+    /// and each body's edges are counted on their own. Empty: one body.
+    pub bodies: Vec<u32>,
+}
+
+impl Model {
+    /// The body face `face` belongs to (0 when the model has no bodies).
+    pub fn body(&self, face: usize) -> u32 {
+        self.bodies.get(face).copied().unwrap_or(0)
+    }
 }
 
 /// A surface restricted to the region its loops enclose.
@@ -68,6 +79,19 @@ impl FaceSurface {
             match s {
                 Self::Nurbs(n) | Self::Rebuilt(n) => return n,
                 Self::Offset { base, .. } => s = base,
+            }
+        }
+    }
+}
+
+impl FaceSurface {
+    /// `S(u, v)` at every `(us[i], vs[j])`, `u` outer; NURBS faces evaluate
+    /// the grid by rows and columns ([`NurbsSurface::points_on_grid`]).
+    pub fn points_on_grid(&self, us: &[f64], vs: &[f64]) -> Vec<DVec3> {
+        match self {
+            Self::Nurbs(s) | Self::Rebuilt(s) => s.points_on_grid(us, vs),
+            Self::Offset { .. } => {
+                us.iter().flat_map(|&u| vs.iter().map(move |&v| self.point(DVec2::new(u, v)))).collect()
             }
         }
     }

@@ -5,42 +5,59 @@ use alloc::format;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
-use super::params::{grid_params, Limits};
+use super::params::{grid_params, Limits, Region};
 use super::refine::{Criteria, Outcome, WorkMesh};
 use crate::model::Face;
 use crate::nurbs::Surface;
 use crate::Error;
 
 /// A meshed face: its work mesh and what refinement measured.
-pub(crate) struct FaceResult<'a> {
+pub(crate) struct FaceResult {
     pub mesh: WorkMesh,
     pub outcome: Outcome,
-    /// The face's trim curves, as its trim edges index them.
-    pub curves: Vec<&'a crate::NurbsCurve>,
 }
 
 /// Grid parameters in both directions over `[lo, hi]`, sharing the tolerance
 /// between the two directions: half each, then the whole remainder to one
 /// direction when the other turned out (nearly) straight, as on a cylinder.
-pub(super) fn grid(surface: &dyn Surface, lo: DVec2, hi: DVec2, lim: &Limits) -> (Vec<f64>, Vec<f64>) {
+/// On a trimmed face, `loops` limits every test to the kept region.
+pub(super) fn grid(
+    surface: &dyn Surface,
+    lo: DVec2,
+    hi: DVec2,
+    lim: &Limits,
+    loops: Option<&TrimRegion<'_>>,
+) -> (Vec<f64>, Vec<f64>) {
+    #[cfg(feature = "std")]
+    let pieces = |along_u: bool, s: f64| loops.map_or_else(Vec::new, |l| l.line_pieces(along_u, s));
+    #[cfg(feature = "std")]
+    let region: Option<Region<'_>> = if loops.is_some() { Some(&pieces) } else { None };
+    #[cfg(not(feature = "std"))]
+    let region: Option<Region<'_>> = None;
     let half = Limits { tol: lim.tol * 0.5, ..*lim };
-    let (mut pu, mut su) = grid_params(surface, lo, hi, true, &half);
-    let (mut pv, mut sv) = grid_params(surface, lo, hi, false, &half);
+    let (mut pu, mut su) = grid_params(surface, lo, hi, true, &half, region);
+    let (mut pv, mut sv) = grid_params(surface, lo, hi, false, &half, region);
     if sv < 0.5 * half.tol && su > sv {
         let rest = Limits { tol: (lim.tol - sv).max(half.tol), ..*lim };
-        (pu, su) = grid_params(surface, lo, hi, true, &rest);
+        (pu, su) = grid_params(surface, lo, hi, true, &rest, region);
     } else if su < 0.5 * half.tol && sv > su {
         let rest = Limits { tol: (lim.tol - su).max(half.tol), ..*lim };
-        (pv, sv) = grid_params(surface, lo, hi, false, &rest);
+        (pv, sv) = grid_params(surface, lo, hi, false, &rest, region);
     }
     // Where the iso-curves left most of the tolerance unused, a twist may use it.
     let room = lim.tol - su - sv;
     if room >= 0.5 * lim.tol {
         // 0.85: the twist estimate is exact only for bilinear cells.
-        refine_twisted_cells(surface, &mut pu, &mut pv, 0.85 * room);
+        refine_twisted_cells(surface, &mut pu, &mut pv, 0.85 * room, loops);
     }
     (pu, pv)
 }
+
+/// The trim loops of a face, when it has any (without `std` no trimmed face is meshed).
+#[cfg(feature = "std")]
+pub(super) type TrimRegion<'a> = super::trim::Loops<'a>;
+#[cfg(not(feature = "std"))]
+pub(super) type TrimRegion<'a> = core::marker::PhantomData<&'a ()>;
 
 /// Beyond paper 000: its tests run along iso-curves only, and a twisted
 /// surface (a bilinear saddle, whose iso-curves are all straight) passes them
@@ -49,13 +66,30 @@ pub(super) fn grid(surface: &dyn Surface, lo: DVec2, hi: DVec2, lim: &Limits) ->
 /// surface at the centre beyond the iso-curve sags; where it exceeds `room`
 /// (what the sags left of the tolerance), the cell's row and column are split
 /// into equal parts by the square root of the excess (twist falls with the
-/// product of both steps).
-fn refine_twisted_cells(surface: &dyn Surface, pu: &mut Vec<f64>, pv: &mut Vec<f64>, room: f64) {
+/// product of both steps). On a trimmed face only cells with a corner inside count.
+fn refine_twisted_cells(
+    surface: &dyn Surface,
+    pu: &mut Vec<f64>,
+    pv: &mut Vec<f64>,
+    room: f64,
+    loops: Option<&TrimRegion<'_>>,
+) {
     for _ in 0..4 {
         let (nu, nv) = (pu.len(), pv.len());
         if nu < 2 || nv < 2 || nu * nv > 4_000_000 {
             return;
         }
+        #[cfg(feature = "std")]
+        let inside = loops.map(|l| l.contains_grid(pu, pv));
+        #[cfg(not(feature = "std"))]
+        let inside: Option<Vec<bool>> = loops.map(|_| Vec::new());
+        let kept = |i: usize, j: usize| {
+            inside.as_ref().is_none_or(|m| {
+                [(0, 0), (1, 0), (0, 1), (1, 1)]
+                    .iter()
+                    .any(|&(a, b)| m.get((i + a) * nv + j + b).copied().unwrap_or(true))
+            })
+        };
         let pts: Vec<DVec3> = (0..nu)
             .flat_map(|i| pv.iter().map(move |&v| (i, v)))
             .map(|(i, v)| surface.point(DVec2::new(pu[i], v)))
@@ -67,7 +101,7 @@ fn refine_twisted_cells(surface: &dyn Surface, pu: &mut Vec<f64>, pv: &mut Vec<f
             for j in 0..nv - 1 {
                 let p = |a: usize, b: usize| pts[(i + a) * nv + j + b];
                 let twist = (p(0, 0) + p(1, 1) - p(1, 0) - p(0, 1)) * 0.25;
-                if twist.length() <= room {
+                if twist.length() <= room || !kept(i, j) {
                     continue;
                 }
                 let n = surface.normal(DVec2::new(0.5 * (pu[i] + pu[i + 1]), 0.5 * (pv[j] + pv[j + 1])));
@@ -101,41 +135,97 @@ fn split_by(p: &[f64], need: &[usize]) -> Vec<f64> {
     out
 }
 
-/// Meshes face `index` within `crit`, using at most `budget` triangles.
-pub(crate) fn mesh_face<'a>(
+/// Meshes face `index` on its own within `crit`, using at most `budget`
+/// triangles, as `mesh_model` meshes it in a model (its seams within
+/// `tight`), so the two can be compared.
+pub(crate) fn mesh_face(
     index: usize,
-    face: &'a Face,
+    face: &Face,
     lim: &Limits,
     crit: &Criteria,
     budget: usize,
-) -> Result<FaceResult<'a>, Error> {
+    tight: f64,
+) -> Result<FaceResult, Error> {
+    #[cfg(feature = "std")]
+    {
+        let domain: Vec<crate::TrimLoop> =
+            if face.loops.is_empty() { domain_loop(&face.surface).into_iter().collect() } else { Vec::new() };
+        let loops = if face.loops.is_empty() { &domain } else { &face.loops };
+        let mut o = outline(index, &face.surface, loops, face.loops.is_empty(), lim)?;
+        super::sew::unify(&mut [Some((&face.surface as &dyn Surface, &mut o))], &[], tight, tight, tight + lim.tol);
+        let mut wm = initial_from_outline(index, &face.surface, &o, lim, budget)?;
+        let outcome = wm.refine(&face.surface, &o.loops.curves, crit, budget);
+        Ok(FaceResult { mesh: wm, outcome })
+    }
+    #[cfg(not(feature = "std"))]
+    {
+        let _ = tight;
+        let (mut wm, curves) = initial_face(index, face, lim, budget)?;
+        let outcome = wm.refine(&face.surface, &curves, crit, budget);
+        Ok(FaceResult { mesh: wm, outcome })
+    }
+}
+
+/// The mesh of face `index` before refinement without the CDT (no `std`):
+/// the grid of an untrimmed face; a trimmed face is an error.
+#[cfg(not(feature = "std"))]
+pub(crate) fn initial_face<'a>(
+    index: usize,
+    face: &'a Face,
+    lim: &Limits,
+    budget: usize,
+) -> Result<(WorkMesh, Vec<&'a crate::NurbsCurve>), Error> {
     let surface: &dyn Surface = &face.surface;
     let mut wm = WorkMesh::default();
     let curves;
     if face.loops.is_empty() {
         curves = Vec::new();
         let [lo, hi] = surface.domain();
-        let (pu, pv) = grid(surface, lo, hi, lim);
+        let (pu, pv) = grid(surface, lo, hi, lim, None);
         check_grid(index, &pu, &pv, budget)?;
         build_full_grid(surface, &pu, &pv, &mut wm);
     } else {
         curves = trimmed(index, surface, face, lim, budget, &mut wm)?;
     }
-    let outcome = wm.refine(surface, &curves, crit, budget);
-    Ok(FaceResult { mesh: wm, outcome, curves })
+    Ok((wm, curves))
 }
 
-/// Trimmed face: loops, grid over their box, CDT band; returns the trim curves.
+/// A face's border, ready to be sewn to its neighbours and triangulated:
+/// its loops discretized, the parameter box its grid covers, and per loop
+/// node its node id across the model (`u32::MAX` until sewing names it).
 #[cfg(feature = "std")]
-fn trimmed<'a>(
+pub(crate) struct Outline<'a> {
+    pub loops: super::trim::Loops<'a>,
+    /// The grid's parameter lines.
+    pub pu: Vec<f64>,
+    pub pv: Vec<f64>,
+    pub gids: Vec<Vec<u32>>,
+}
+
+/// The outline of face `index`: `loops` (the face's own, or [`domain_loop`]'s
+/// for an untrimmed face, `whole`) discretized by the chord test, and the
+/// grid inside it. Loop pieces along an iso-line that the grid's lines cross
+/// get a node at each crossing when they are the domain's border or collapse
+/// to a point (a pole): the band then joins the grid's columns to the
+/// border one by one, as the untrimmed grid would, instead of fanning a few
+/// far nodes over many columns.
+///
+/// # Errors
+/// As `mesh_model` for bad loops, or loops outside the surface's domain.
+#[cfg(feature = "std")]
+pub(crate) fn outline<'a>(
     index: usize,
     surface: &dyn Surface,
-    face: &'a Face,
+    loops: &'a [crate::TrimLoop],
+    whole: bool,
     lim: &Limits,
-    budget: usize,
-    wm: &mut WorkMesh,
-) -> Result<Vec<&'a crate::NurbsCurve>, Error> {
-    let loops = super::trim::prepare_loops(index, surface, &face.loops, lim)?;
+) -> Result<Outline<'a>, Error> {
+    if whole {
+        if let Some(o) = domain_outline(surface, loops, lim) {
+            return Ok(o);
+        }
+    }
+    let mut loops = super::trim::prepare_loops(index, surface, loops, lim)?;
     let [dlo, dhi] = surface.domain();
     let (llo, lhi) = loops.bounds();
     let lo = llo.max(dlo);
@@ -146,10 +236,170 @@ fn trimmed<'a>(
             message: "trim loops lie outside the surface's parameter domain".into(),
         });
     }
-    let (pu, pv) = grid(surface, lo, hi, lim);
-    check_grid(index, &pu, &pv, budget)?;
-    build_trimmed(index, surface, &loops, &pu, &pv, wm)?;
-    Ok(loops.curves)
+    let (pu, pv) = grid(surface, lo, hi, lim, Some(&loops));
+    align_to_grid(surface, &mut loops, &pu, &pv, whole);
+    let gids = loops.polys.iter().map(|p| alloc::vec![u32::MAX; p.uv.len()]).collect();
+    Ok(Outline { loops, pu, pv, gids })
+}
+
+/// The outline of an untrimmed face along [`domain_loop`]'s `loops`: the
+/// grid over the whole domain, and a loop node at each of its border nodes
+/// (the grid tests its border iso-curves, so they need no chord test of
+/// their own). `None` when `loops` is not such a loop.
+#[cfg(feature = "std")]
+fn domain_outline<'a>(surface: &dyn Surface, loops: &'a [crate::TrimLoop], lim: &Limits) -> Option<Outline<'a>> {
+    use super::trim::{CurveRef, Loops, Polyline};
+    let [lp] = loops else { return None };
+    let [lo, hi] = surface.domain();
+    let (pu, pv) = grid(surface, lo, hi, lim, None);
+    // Border nodes counter-clockwise from (lo.x, lo.y), as the loop runs.
+    let mut uv: Vec<DVec2> = Vec::new();
+    uv.extend(pu.iter().map(|&u| DVec2::new(u, lo.y)));
+    uv.extend(pv[1..].iter().map(|&v| DVec2::new(hi.x, v)));
+    uv.extend(pu.iter().rev().skip(1).map(|&u| DVec2::new(u, hi.y)));
+    uv.extend(pv.iter().rev().skip(1).map(|&v| DVec2::new(lo.x, v)));
+    uv.pop();
+    // Each node on the loop's straight pieces: curve and parameter.
+    let ends: Vec<(DVec2, DVec2)> =
+        lp.curves.iter().map(|c| (c.point(0.0).truncate(), c.point(1.0).truncate())).collect();
+    let mut at = Vec::with_capacity(uv.len());
+    let mut k = 0usize;
+    for &q in &uv {
+        while k < ends.len() {
+            let (a, b) = ends[k];
+            let t =
+                if (b - a).x.abs() >= (b - a).y.abs() { (q.x - a.x) / (b.x - a.x) } else { (q.y - a.y) / (b.y - a.y) };
+            if (0.0..1.0).contains(&t) && q.distance(a.lerp(b, t)) <= 1e-12 * (1.0 + q.length()) {
+                at.push(CurveRef { curve: k as u32, t });
+                break;
+            }
+            k += 1;
+        }
+    }
+    if at.len() != uv.len() || uv.len() < 3 {
+        return None;
+    }
+    let n = at.len();
+    let seg = (0..n)
+        .map(|i| {
+            let (a, b) = (at[i], at[(i + 1) % n]);
+            (a.curve, a.t, if b.curve == a.curve && b.t > a.t { b.t } else { 1.0 })
+        })
+        .collect();
+    let loops = Loops { polys: alloc::vec![Polyline { uv, at, seg }], curves: lp.curves.iter().collect() };
+    let gids = alloc::vec![alloc::vec![u32::MAX; n]];
+    Some(Outline { loops, pu, pv, gids })
+}
+
+/// See [`outline`]: nodes where grid lines cross loop pieces that run along
+/// an iso-line (all of them when `whole`, else those that collapse to a point).
+#[cfg(feature = "std")]
+fn align_to_grid(surface: &dyn Surface, loops: &mut super::trim::Loops<'_>, pu: &[f64], pv: &[f64], whole: bool) {
+    use super::trim::CurveRef;
+    let span = (pu.last().copied().unwrap_or(0.0) - pu.first().copied().unwrap_or(0.0)).abs()
+        + (pv.last().copied().unwrap_or(0.0) - pv.first().copied().unwrap_or(0.0)).abs();
+    let eps = 1e-9 * span.max(1e-300);
+    for poly in &mut loops.polys {
+        let n = poly.uv.len();
+        let (mut uv, mut at, mut seg) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+        for i in 0..n {
+            let (a, b) = (poly.uv[i], poly.uv[(i + 1) % n]);
+            let (curve, ta, tb) = poly.seg[i];
+            uv.push(a);
+            at.push(poly.at[i]);
+            let c = loops.curves.get(curve as usize);
+            let (pa, pb) = (surface.point(a), surface.point(b));
+            let collapsed = pa.distance(pb) <= 1e-12 * (1.0 + pa.length());
+            let mut from = ta;
+            if let Some(c) = c.filter(|_| whole || collapsed) {
+                // Along u (v fixed) or along v (u fixed).
+                let (lines, x0, x1) = if (a.y - b.y).abs() <= eps {
+                    (pu, a.x, b.x)
+                } else if (a.x - b.x).abs() <= eps {
+                    (pv, a.y, b.y)
+                } else {
+                    (&[][..], 0.0, 0.0)
+                };
+                let (lo, hi) = (x0.min(x1), x0.max(x1));
+                let mut cross: Vec<f64> = lines.iter().copied().filter(|&x| x > lo + eps && x < hi - eps).collect();
+                if x1 < x0 {
+                    cross.reverse();
+                }
+                for x in cross {
+                    let t = ta + (tb - ta) * (x - x0) / (x1 - x0);
+                    let q = c.point(t).truncate();
+                    // Only where the curve runs straight in (u,v).
+                    if q.distance(a.lerp(b, (x - x0) / (x1 - x0))) > 1e3 * eps {
+                        continue;
+                    }
+                    seg.push((curve, from, t));
+                    uv.push(q);
+                    at.push(CurveRef { curve, t });
+                    from = t;
+                }
+            }
+            seg.push((curve, from, tb));
+        }
+        poly.uv = uv;
+        poly.at = at;
+        poly.seg = seg;
+    }
+}
+
+/// The loop around a surface's whole parameter domain, a straight (u,v)
+/// piece between each two knot lines (so the border has nodes where the
+/// surface may kink): an untrimmed face meshed as trimmed by it can take
+/// into its border the nodes of the faces it meets. `None` for an empty domain.
+pub(crate) fn domain_loop(surface: &dyn Surface) -> Option<crate::TrimLoop> {
+    let [lo, hi] = surface.domain();
+    if !(hi.x > lo.x && hi.y > lo.y) {
+        return None;
+    }
+    let bu = super::params::initial_breaks(&surface.breaks(true), lo.x, hi.x, 16);
+    let bv = super::params::initial_breaks(&surface.breaks(false), lo.y, hi.y, 16);
+    let mut corners: Vec<DVec2> = Vec::new();
+    corners.extend(bu.iter().map(|&u| DVec2::new(u, lo.y)));
+    corners.extend(bv[1..].iter().map(|&v| DVec2::new(hi.x, v)));
+    corners.extend(bu.iter().rev().skip(1).map(|&u| DVec2::new(u, hi.y)));
+    corners.extend(bv.iter().rev().skip(1).map(|&v| DVec2::new(lo.x, v)));
+    corners.pop(); // back at the start
+    let n = corners.len();
+    let mut curves = Vec::with_capacity(n);
+    for i in 0..n {
+        let (a, b) = (corners[i], corners[(i + 1) % n]);
+        let c = crate::NurbsCurve::try_new(
+            1,
+            alloc::vec![0.0, 0.0, 1.0, 1.0],
+            alloc::vec![a.extend(0.0), b.extend(0.0)],
+            None,
+        )
+        .ok()?;
+        curves.push(c);
+    }
+    Some(crate::TrimLoop { curves })
+}
+
+/// The mesh of a face before refinement from its (sewn) outline: the grid
+/// inside it and the CDT band along it, loop nodes of one model node welded
+/// into one vertex (a seam, a pole) that carries the node's id.
+///
+/// # Errors
+/// A grid over `budget`, or loops the triangulation finds crossing.
+#[cfg(feature = "std")]
+pub(crate) fn initial_from_outline(
+    index: usize,
+    surface: &dyn Surface,
+    o: &Outline<'_>,
+    lim: &Limits,
+    budget: usize,
+) -> Result<WorkMesh, Error> {
+    let _ = lim;
+    check_grid(index, &o.pu, &o.pv, budget)?;
+    let band = Band::new(surface, &o.loops, &o.pu, &o.pv);
+    let tris = band.triangulate(index)?;
+    let mut wm = WorkMesh::default();
+    band.build(surface, &tris, &mut wm, Some(&o.gids));
+    Ok(wm)
 }
 
 /// Without the CDT (no `std`), trimmed faces cannot be meshed.
@@ -244,23 +494,6 @@ fn fix_pole_corners(uv: &mut [DVec2; 3], mult: [u32; 3]) {
 }
 
 #[cfg(feature = "std")]
-/// Trimmed face: kept grid nodes plus loop nodes, constrained Delaunay in a
-/// plane scaled by the surface's mean first derivatives, region by parity.
-fn build_trimmed(
-    index: usize,
-    surface: &dyn Surface,
-    loops: &super::trim::Loops<'_>,
-    pu: &[f64],
-    pv: &[f64],
-    wm: &mut WorkMesh,
-) -> Result<(), Error> {
-    let band = Band::new(surface, loops, pu, pv);
-    let tris = band.triangulate(index)?;
-    band.build(surface, &tris, wm);
-    Ok(())
-}
-
-#[cfg(feature = "std")]
 /// What the CDT of a trimmed face works on: loop nodes first (with their
 /// segments as constraints), then the grid nodes inside the region and not too
 /// close to a loop, and the scale of the plane the triangulation runs in.
@@ -312,18 +545,43 @@ impl Band {
         super::cdt::triangulate_region(index, &scaled, &self.constraints)
     }
 
-    /// Puts the nodes on the surface and the triangles `tris` into `wm`, loop segments marked as trim edges.
-    pub fn build(&self, surface: &dyn Surface, tris: &[[u32; 3]], wm: &mut WorkMesh) {
+    /// Puts the nodes on the surface and the triangles `tris` into `wm`, loop
+    /// segments marked as trim edges. With `gids` (per loop, per node), loop
+    /// nodes of one id become one vertex carrying it, and triangles that
+    /// collapse by that (at a pole) are left out; a segment that then has a
+    /// triangle on both sides (a seam) is an inner edge, not a trim edge.
+    pub fn build(&self, surface: &dyn Surface, tris: &[[u32; 3]], wm: &mut WorkMesh, gids: Option<&[Vec<u32>]>) {
+        let flat: Vec<u32> = gids.map(|g| g.iter().flatten().copied().collect()).unwrap_or_default();
+        let mut by_gid: hashbrown::HashMap<u32, u32> = hashbrown::HashMap::new();
         let mut vid = Vec::with_capacity(self.nodes.len());
-        for &q in &self.nodes {
-            vid.push(wm.add_vertex(surface.point(q), surface.normal(q)));
+        for (k, &q) in self.nodes.iter().enumerate() {
+            let g = flat.get(k).copied().unwrap_or(u32::MAX);
+            if g != u32::MAX {
+                if let Some(&v) = by_gid.get(&g) {
+                    vid.push(v);
+                    continue;
+                }
+            }
+            let v = wm.add_vertex(surface.point(q), surface.normal(q));
+            if g != u32::MAX {
+                by_gid.insert(g, v);
+                wm.gid[v as usize] = g;
+            }
+            vid.push(v);
         }
         for t in tris {
+            let v = [vid[t[0] as usize], vid[t[1] as usize], vid[t[2] as usize]];
+            if v[0] == v[1] || v[1] == v[2] || v[2] == v[0] {
+                continue;
+            }
             let uv = [self.nodes[t[0] as usize], self.nodes[t[1] as usize], self.nodes[t[2] as usize]];
-            wm.add_triangle([vid[t[0] as usize], vid[t[1] as usize], vid[t[2] as usize]], uv);
+            wm.add_triangle(v, uv);
         }
         for &(a, b, curve, ta, tb) in &self.segs {
-            wm.mark_trim(vid[a], vid[b], curve, ta, tb);
+            let (va, vb) = (vid[a], vid[b]);
+            if va != vb && wm.edge_triangles(va, vb) == 1 {
+                wm.mark_trim(va, vb, curve, ta, tb);
+            }
         }
     }
 }

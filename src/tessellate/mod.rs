@@ -17,7 +17,7 @@ use alloc::format;
 use alloc::vec::Vec;
 use glam::DVec2;
 
-use crate::mesh::{angle_stats, edge_counts, FaceRange};
+use crate::mesh::{angle_stats, edge_counts_in_bodies, FaceRange};
 use crate::nurbs::{Aabb, Surface};
 use crate::reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
 use crate::{Error, Mesh, Model, Report};
@@ -69,121 +69,158 @@ pub fn mesh_model_with_progress(
     report.warnings.extend(model.warnings.iter().cloned());
     // Paper 001: faces whose parameters crowd are rebuilt on even ones first.
     let rebuilt = reparameterize(model, options.reparam, tol, &mut report);
-    // Mesh every face on its own.
-    let mut works: Vec<sew::FaceWork<'_>> = Vec::with_capacity(model.faces.len());
-    let mut outcomes: Vec<refine::Outcome> = Vec::with_capacity(model.faces.len());
-    let mut fit_errors: Vec<f64> = Vec::with_capacity(model.faces.len());
-    let mut used = 0usize;
+    // Untrimmed faces are meshed as trimmed by their domain's border, so
+    // that their borders can be sewn like trim loops.
+    let domain_of = |f: &crate::Face| -> Vec<crate::TrimLoop> {
+        if cfg!(feature = "std") && f.loops.is_empty() {
+            face::domain_loop(&f.surface).into_iter().collect()
+        } else {
+            Vec::new()
+        }
+    };
+    let domain_loops: Vec<Vec<crate::TrimLoop>> = model.faces.iter().map(domain_of).collect();
+    let rebuilt_domain_loops: Vec<Vec<crate::TrimLoop>> =
+        rebuilt.iter().map(|r| r.as_ref().map_or_else(Vec::new, |r| domain_of(&r.face))).collect();
+    // Within one face (a seam) borders meet within a rounding, or the file's
+    // own modelling tolerance.
+    let auto_tight = {
+        let auto = (0.5 * tol).min(1e-4 * diag.max(tol));
+        model.tolerance.filter(|t| t.is_finite() && *t > 0.0).map_or(auto, |t| auto.max(t.min(0.5 * tol)))
+    };
+    // Each face's variant and outline (its loops discretized), on its own.
+    let mut chosen: Vec<Option<Chosen<'_>>> = Vec::with_capacity(model.faces.len());
     let mut first_failure: Option<Error> = None;
     for (index, original) in model.faces.iter().enumerate() {
         let (mut f, mut fit_error, cap) = match rebuilt.get(index) {
             Some(Some(r)) => (&r.face, r.fit_error, r.max_edge),
             _ => (original, 0.0, f64::INFINITY),
         };
-        let budget = options.max_triangles.saturating_sub(used);
-        if budget < 2 {
-            report.faces_skipped += 1;
-            report
-                .warnings
-                .push(format!("face {index}: skipped, the triangle budget {} is spent", options.max_triangles));
-            push_empty(&mut works, &mut outcomes, &mut fit_errors, f);
-            continue;
-        }
         if !face_is_supported(f) {
             report.faces_skipped += 1;
             report.warnings.push(format!("face {index}: trimmed faces need the default `std` feature (CDT); skipped"));
-            push_empty(&mut works, &mut outcomes, &mut fit_errors, f);
+            chosen.push(None);
             continue;
         }
         // A rebuilt face is meshed within what its fit error leaves of the tolerance.
         let share = if fit_error > 0.0 { ((tol - fit_error) / tol).clamp(0.5, 1.0) } else { 1.0 };
-        let face_lim = params::Limits { tol: lim.tol * share, max_edge: lim.max_edge.min(cap), ..lim };
-        let face_crit = refine::Criteria { tol: crit.tol * share, max_edge: crit.max_edge.min(cap), ..crit };
-        let mut fr = face::mesh_face(index, f, &face_lim, &face_crit, budget);
+        let mut face_lim = params::Limits { tol: lim.tol * share, max_edge: lim.max_edge.min(cap), ..lim };
+        let mut face_crit = refine::Criteria { tol: crit.tol * share, max_edge: crit.max_edge.min(cap), ..crit };
         if fit_error > 0.0 {
             // Paper 001's rebuild is kept where it pays: under `auto` the
             // original is meshed too and wins on more triangles or worse angles.
+            let budget = options.max_triangles;
+            let fr = face::mesh_face(index, f, &face_lim, &face_crit, budget, auto_tight);
             let failed = !matches!(&fr, Ok(r) if !r.mesh.tris.is_empty());
             if failed || options.reparam == Reparam::Auto {
-                let orig = face::mesh_face(index, original, &lim, &crit, budget);
+                let orig = face::mesh_face(index, original, &lim, &crit, budget, auto_tight);
                 if let Some(why) = rebuild_loses(&fr, &orig) {
                     report.warnings.push(format!("face {index}: {why}; meshed the original"));
                     if let Some(r) = report.reparameterized.iter_mut().find(|r| r.face == index) {
                         r.rebuilt = false;
                     }
-                    (f, fit_error, fr) = (original, 0.0, orig);
+                    (f, fit_error, face_lim, face_crit) = (original, 0.0, lim, crit);
                 }
             }
         }
-        let mut fr = match fr {
-            Ok(fr) => fr,
+        let loops: &[crate::TrimLoop] = match (f.loops.is_empty(), core::ptr::eq(f, original)) {
+            (false, _) => &f.loops,
+            (true, true) => &domain_loops[index],
+            (true, false) => &rebuilt_domain_loops[index],
+        };
+        match Chosen::new(index, f, loops, face_lim, face_crit, fit_error) {
+            Ok(c) => chosen.push(Some(c)),
             // One face that cannot be meshed does not sink the others; a
             // model where none can is the first face's error.
             Err(Error::Mesh { face, message }) if model.faces.len() > 1 => {
                 report.faces_skipped += 1;
                 report.warnings.push(format!("face {index}: skipped: {message}"));
                 first_failure.get_or_insert(Error::Mesh { face, message });
-                push_empty(&mut works, &mut outcomes, &mut fit_errors, f);
-                if !progress(index + 1, model.faces.len()) {
-                    return Err(Error::Cancelled);
-                }
-                continue;
+                chosen.push(None);
             }
             Err(e) => return Err(e),
+        }
+    }
+    // Shared borders get the same nodes before anything is triangulated.
+    // Borders of different faces are sewn as far apart as the model's gaps
+    // need, up to 0.4 of the tolerance: each side then moves by half the
+    // gap, within what the 0.8 safety leaves of the tolerance. A sewing
+    // distance the caller sets holds for seams too.
+    let (sew_tol, tight) = match options.sew {
+        Some(s) => (s, auto_tight.min(s)),
+        None => (0.4 * tol, auto_tight),
+    };
+    let ids = unify_outlines(&mut chosen, &model.bodies, sew_tol, tight, aim + sew_tol);
+    // Every face's first mesh (grid and trim band) on those nodes.
+    let mut works: Vec<sew::FaceWork<'_>> = Vec::with_capacity(model.faces.len());
+    let mut fit_errors: Vec<f64> = Vec::with_capacity(model.faces.len());
+    let mut used = 0usize;
+    for (index, c) in chosen.iter().enumerate() {
+        let f = &model.faces[index];
+        let Some(c) = c else {
+            works.push(empty_work(f, crit));
+            fit_errors.push(0.0);
+            continue;
         };
-        if fit_error > 0.0 {
-            // Reported against the original face: the mesh's distance to the new one plus the fit error.
-            for m in &mut fr.outcome.measures {
-                m.max += fit_error;
+        let budget = options.max_triangles.saturating_sub(used);
+        match c.initial(index, budget) {
+            Ok((mesh, curves)) => {
+                used += mesh.tris.len();
+                works.push(sew::FaceWork { surface: &c.face.surface, curves, mesh, crit: c.crit });
+                fit_errors.push(c.fit_error);
             }
-        }
-        used += fr.mesh.tris.len();
-        if fr.mesh.tris.is_empty() {
-            report.faces_skipped += 1;
-            report.warnings.push(format!("face {index}: produced no triangles"));
-        }
-        if fr.outcome.unproven > 0 {
-            report.warnings.push(format!(
-                "face {index}: {} triangles still exceed the limits ({})",
-                fr.outcome.unproven,
-                if fr.outcome.budget_hit { "triangle budget reached" } else { "edges at the minimum length" }
-            ));
-        }
-        works.push(sew::FaceWork { surface: &f.surface, curves: fr.curves, mesh: fr.mesh });
-        fit_errors.push(fit_error);
-        outcomes.push(fr.outcome);
-        if !progress(index + 1, model.faces.len()) {
-            return Err(Error::Cancelled);
+            Err(Error::Mesh { face, message }) if model.faces.len() > 1 => {
+                report.faces_skipped += 1;
+                report.warnings.push(format!("face {index}: skipped: {message}"));
+                first_failure.get_or_insert(Error::Mesh { face, message });
+                works.push(empty_work(f, crit));
+                fit_errors.push(0.0);
+            }
+            Err(Error::Limit(m)) if model.faces.len() > 1 && budget < options.max_triangles => {
+                report.faces_skipped += 1;
+                report.warnings.push(format!("face {index}: skipped, the triangle budget is spent ({m})"));
+                works.push(empty_work(f, crit));
+                fit_errors.push(0.0);
+            }
+            Err(e) => return Err(e),
         }
     }
     if let Some(e) = first_failure.filter(|_| works.iter().all(|w| w.mesh.tris.is_empty())) {
         return Err(e);
     }
-    // Make shared borders conform, then measure again what sewing touched.
-    let sew_tol = options.sew.unwrap_or_else(|| {
-        let auto = (0.5 * tol).min(1e-4 * diag.max(tol));
-        model.tolerance.filter(|t| t.is_finite() && *t > 0.0).map_or(auto, |t| auto.max(t.min(0.5 * tol)))
-    });
-    let mut changed = sew::conform(&mut works, sew_tol, aim + sew_tol);
-    // Sewing may fold a thin triangle next to a moved or inserted border
-    // vertex: unfold by interior edge flips or by moving an inner vertex,
-    // which leaves the sewn borders as they are (a rebuilt face within what
-    // its fit error leaves of the tolerance).
-    for ((w, ch), fit_error) in works.iter_mut().zip(changed.iter_mut()).zip(&fit_errors) {
-        let share = if *fit_error > 0.0 { ((tol - fit_error) / tol).clamp(0.5, 1.0) } else { 1.0 };
-        ch.extend(w.mesh.repair_inverted(w.surface, &refine::Criteria { tol: crit.tol * share, ..crit }));
-        ch.sort_unstable();
-        ch.dedup();
+    // Refinement keeps shared borders shared: a split of a shared edge is
+    // made on every side; then every node takes one position.
+    let budget_hit = sew::refine_all(&mut works, ids, options.max_triangles, progress)?;
+    let settled = sew::settle_nodes(&mut works, 1e-6 * tol);
+    for (w, moved) in works.iter_mut().zip(&settled) {
+        w.mesh.forget(moved);
     }
-    for (((w, out), ch), fit_error) in works.iter().zip(outcomes.iter_mut()).zip(&changed).zip(&fit_errors) {
-        out.measures.resize(w.mesh.tris.len(), Default::default());
-        out.turns.resize(w.mesh.tris.len(), 0.0);
-        for &t in ch {
-            let (mut m, turn) = w.mesh.measure_one(w.surface, t as usize, &crit);
-            m.max += fit_error;
-            out.measures[t as usize] = m;
-            out.turns[t as usize] = turn;
+    // Refinement may leave a thin triangle folded next to a border node it
+    // cannot move: unfold by interior edge flips or by moving an inner
+    // vertex, which leaves the shared borders as they are.
+    let mut outcomes: Vec<refine::Outcome> = Vec::with_capacity(works.len());
+    for (index, (w, fit_error)) in works.iter_mut().zip(&fit_errors).enumerate() {
+        let changed = w.mesh.repair_inverted(w.surface, &w.crit);
+        w.mesh.forget(&changed);
+        let mut out = w.mesh.outcome(w.surface, &w.crit);
+        if *fit_error > 0.0 {
+            // Reported against the original face: the mesh's distance to the new one plus the fit error.
+            for m in &mut out.measures {
+                m.max += fit_error;
+            }
         }
+        if w.mesh.tris.is_empty() {
+            if !report.warnings.iter().any(|x| x.starts_with(&format!("face {index}: "))) {
+                report.faces_skipped += 1;
+                report.warnings.push(format!("face {index}: produced no triangles"));
+            }
+        } else if out.unproven > 0 {
+            report.warnings.push(format!(
+                "face {index}: {} triangles still exceed the limits ({})",
+                out.unproven,
+                if budget_hit { "triangle budget reached" } else { "edges at the minimum length" }
+            ));
+        }
+        outcomes.push(out);
     }
     let mut mesh = Mesh::default();
     let (mut dev_sum, mut dev_count) = (0.0, 0u64);
@@ -212,7 +249,7 @@ pub fn mesh_model_with_progress(
     report.mean_deviation = if dev_count > 0 { dev_sum / dev_count as f64 } else { 0.0 };
     report.triangles = mesh.triangle_count();
     report.vertices = mesh.positions.len();
-    let edges = edge_counts(&mesh, (tol * 1e-3).min(sew_tol * 0.5), tol);
+    let edges = edge_counts_in_bodies(&mesh, &model.bodies, (tol * 1e-3).min(tight * 0.5), tol);
     report.free_edges = edges.free_edges;
     report.boundary_edges = edges.boundary_edges;
     report.nonmanifold_edges = edges.nonmanifold_edges;
@@ -274,8 +311,8 @@ fn reparameterize(model: &Model, mode: Reparam, tol: f64, report: &mut Report) -
 /// failed or is empty, is not proven where the original is, has more
 /// triangles, or a smaller 1st-percentile angle. `None` keeps the rebuild.
 fn rebuild_loses(
-    rebuilt: &Result<face::FaceResult<'_>, Error>,
-    original: &Result<face::FaceResult<'_>, Error>,
+    rebuilt: &Result<face::FaceResult, Error>,
+    original: &Result<face::FaceResult, Error>,
 ) -> Option<alloc::string::String> {
     let Some(new) = rebuilt.as_ref().ok().filter(|r| !r.mesh.tris.is_empty()) else {
         return Some("the rebuilt face did not mesh".into());
@@ -344,16 +381,71 @@ fn setup(model: &Model, options: &MeshOptions) -> Result<Setup, Error> {
     Ok(Setup { tol, diag, lim, crit })
 }
 
-/// Records a face that produced nothing, so face ranges still match faces.
-fn push_empty<'a>(
-    works: &mut Vec<sew::FaceWork<'a>>,
-    outcomes: &mut Vec<refine::Outcome>,
-    fit_errors: &mut Vec<f64>,
-    f: &'a crate::Face,
-) {
-    works.push(sew::FaceWork { surface: &f.surface, curves: Vec::new(), mesh: Default::default() });
-    outcomes.push(Default::default());
-    fit_errors.push(0.0);
+/// A face as it will be meshed: the variant chosen (the original or paper
+/// 001's rebuild), its limits and, with `std`, its outline to sew.
+struct Chosen<'a> {
+    face: &'a crate::Face,
+    #[cfg(feature = "std")]
+    outline: face::Outline<'a>,
+    fit_error: f64,
+    lim: params::Limits,
+    crit: refine::Criteria,
+}
+
+impl<'a> Chosen<'a> {
+    /// `loops`: the face's own, or its domain's border when it has none.
+    fn new(
+        index: usize,
+        face: &'a crate::Face,
+        loops: &'a [crate::TrimLoop],
+        lim: params::Limits,
+        crit: refine::Criteria,
+        fit_error: f64,
+    ) -> Result<Self, Error> {
+        #[cfg(feature = "std")]
+        let outline = face::outline(index, &face.surface, loops, face.loops.is_empty(), &lim)?;
+        #[cfg(not(feature = "std"))]
+        let _ = (index, loops);
+        Ok(Self {
+            face,
+            #[cfg(feature = "std")]
+            outline,
+            fit_error,
+            lim,
+            crit,
+        })
+    }
+
+    /// The face's mesh before refinement, and the curves its trim edges follow.
+    fn initial(&self, index: usize, budget: usize) -> Result<(refine::WorkMesh, Vec<&'a crate::NurbsCurve>), Error> {
+        #[cfg(feature = "std")]
+        {
+            let wm = face::initial_from_outline(index, &self.face.surface, &self.outline, &self.lim, budget)?;
+            Ok((wm, self.outline.loops.curves.clone()))
+        }
+        #[cfg(not(feature = "std"))]
+        face::initial_face(index, self.face, &self.lim, budget)
+    }
+}
+
+/// Sews the outlines of the faces to be meshed (see [`sew::unify`]); returns the node ids given.
+fn unify_outlines(chosen: &mut [Option<Chosen<'_>>], bodies: &[u32], sew_tol: f64, tight: f64, reach: f64) -> u32 {
+    #[cfg(feature = "std")]
+    {
+        let mut faces: Vec<Option<(&dyn Surface, &mut face::Outline<'_>)>> =
+            chosen.iter_mut().map(|c| c.as_mut().map(|c| (&c.face.surface as &dyn Surface, &mut c.outline))).collect();
+        sew::unify(&mut faces, bodies, sew_tol, tight, reach)
+    }
+    #[cfg(not(feature = "std"))]
+    {
+        let _ = (chosen, bodies, sew_tol, tight, reach);
+        0
+    }
+}
+
+/// A face that produced nothing, so face ranges still match faces.
+fn empty_work(f: &crate::Face, crit: refine::Criteria) -> sew::FaceWork<'_> {
+    sew::FaceWork { surface: &f.surface, curves: Vec::new(), mesh: Default::default(), crit }
 }
 
 fn face_is_supported(f: &crate::Face) -> bool {
@@ -403,12 +495,13 @@ pub(crate) fn trimmed_bbox(model: &Model) -> Aabb {
             }
             c
         };
-        for i in 0..=16 {
-            for j in 0..=16 {
-                let q = lo + (hi - lo) * DVec2::new(i as f64 / 16.0, j as f64 / 16.0);
-                if inside(q) {
-                    b.add_point(s.point(q));
-                }
+        let steps: Vec<f64> = (0..=16).map(|i| i as f64 / 16.0).collect();
+        let us: Vec<f64> = steps.iter().map(|t| lo.x + (hi.x - lo.x) * t).collect();
+        let vs: Vec<f64> = steps.iter().map(|t| lo.y + (hi.y - lo.y) * t).collect();
+        let points = f.surface.points_on_grid(&us, &vs);
+        for (k, p) in points.into_iter().enumerate() {
+            if inside(DVec2::new(us[k / vs.len()], vs[k % vs.len()])) {
+                b.add_point(p);
             }
         }
     }

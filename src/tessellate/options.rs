@@ -42,8 +42,10 @@ pub struct MeshOptions {
     /// 1e-3 × the absolute tolerance (guards singular points against endless refinement).
     pub min_edge: Option<f64>,
     /// Borders of different faces closer than this are sewn into one edge,
-    /// model units. Default: the smaller of half the tolerance and 1e-4 × the
-    /// model diagonal (CAD files keep their gaps far below either).
+    /// model units. Default: 0.4 × the tolerance (each side then moves by
+    /// at most half the gap, within what the mesher's safety margin leaves),
+    /// and within one face (a seam) the smaller of half the tolerance and
+    /// 1e-4 × the model diagonal.
     pub sew: Option<f64>,
     /// Refinement stops (with a warning) once the whole mesh holds this many triangles.
     /// Default 4,000,000: bounds memory in a browser tab.

@@ -77,32 +77,39 @@ pub(crate) fn dist_to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
     p.distance(a + ab * t)
 }
 
+/// One curve an interval is tested on: its evaluator (point and unit normal
+/// or tangent) and, when only part of it matters, the parameter intervals
+/// that do (an iso-line's pieces inside a face's trim loops).
+pub(crate) struct Probe<'e> {
+    pub eval: &'e dyn Fn(f64) -> (DVec3, DVec3),
+    pub inside: Option<Vec<(f64, f64)>>,
+}
+
 /// Subdivides `[t0, t1]` (already split at `breaks`) until every interval passes
 /// for all curves in `evals`. Returns ascending parameters including both ends,
 /// and the largest sag left in an accepted interval.
+#[cfg(feature = "std")]
 pub(crate) fn subdivide(evals: &[&dyn Fn(f64) -> (DVec3, DVec3)], breaks: &[f64], lim: &Limits) -> (Vec<f64>, f64) {
+    let probes: Vec<Probe<'_>> = evals.iter().map(|&eval| Probe { eval, inside: None }).collect();
+    subdivide_probes(&probes, breaks, lim)
+}
+
+/// As [`subdivide`], each curve tested only on the parts of an interval where it matters.
+pub(crate) fn subdivide_probes(probes: &[Probe<'_>], breaks: &[f64], lim: &Limits) -> (Vec<f64>, f64) {
     let mut out: Vec<f64> = Vec::new();
     let mut worst: f64 = 0.0;
     let Some(&first) = breaks.first() else { return (out, 0.0) };
     out.push(first);
     for w in breaks.windows(2) {
         if w[1] > w[0] {
-            split_rec(evals, w[0], w[1], lim, 0, &mut out, &mut worst);
+            split_rec(probes, w[0], w[1], lim, 0, &mut out, &mut worst);
         }
     }
     (out, worst)
 }
 
-fn split_rec(
-    evals: &[&dyn Fn(f64) -> (DVec3, DVec3)],
-    a: f64,
-    b: f64,
-    lim: &Limits,
-    depth: usize,
-    out: &mut Vec<f64>,
-    worst: &mut f64,
-) {
-    let (need, sag) = need_all(evals, a, b, lim);
+fn split_rec(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits, depth: usize, out: &mut Vec<f64>, worst: &mut f64) {
+    let (need, sag) = need_all(probes, a, b, lim);
     if need <= 1.0 || depth >= MAX_DEPTH || out.len() >= MAX_PARAMS || b - a <= (a.abs() + b.abs()) * 1e-12 {
         *worst = worst.max(sag);
         out.push(b);
@@ -117,7 +124,7 @@ fn split_rec(
         let mut part_sag: f64 = 0.0;
         for k in 0..n {
             let (t0, t1) = (a + (b - a) * k as f64 / n as f64, a + (b - a) * (k + 1) as f64 / n as f64);
-            let (nk, sk) = need_all(evals, t0, t1, lim);
+            let (nk, sk) = need_all(probes, t0, t1, lim);
             part_need = part_need.max(nk);
             part_sag = part_sag.max(sk);
         }
@@ -136,18 +143,33 @@ fn split_rec(
     let mut prev = a;
     for k in 1..=n {
         let t = if k == n { b } else { a + (b - a) * k as f64 / n as f64 };
-        split_rec(evals, prev, t, lim, depth + 1, out, worst);
+        split_rec(probes, prev, t, lim, depth + 1, out, worst);
         prev = t;
     }
 }
 
-fn need_all(evals: &[&dyn Fn(f64) -> (DVec3, DVec3)], a: f64, b: f64, lim: &Limits) -> (f64, f64) {
+fn need_all(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits) -> (f64, f64) {
     let mut need: f64 = 1.0;
     let mut sag: f64 = 0.0;
-    for e in evals {
-        let (n, s) = interval_need(*e, a, b, lim);
+    let mut take = |(n, s): (f64, f64)| {
         need = need.max(n);
         sag = sag.max(s);
+    };
+    for p in probes {
+        match &p.inside {
+            None => take(interval_need(p.eval, a, b, lim)),
+            Some(pieces) => {
+                // Only the part of [a, b] inside the region is tested; a piece
+                // a rounding error long says nothing.
+                let eps = (b - a) * 1e-9;
+                for &(lo, hi) in pieces {
+                    let (x, y) = (a.max(lo), b.min(hi));
+                    if y - x > eps {
+                        take(interval_need(p.eval, x, y, lim));
+                    }
+                }
+            }
+        }
     }
     (need, sag)
 }
@@ -186,25 +208,38 @@ pub(crate) fn initial_breaks(breaks: &[f64], lo: f64, hi: f64, max_groups: usize
     out
 }
 
+/// The parameter intervals of an iso-line inside a face's trimmed region:
+/// `region(along_u, s)` gives, for the line at `s` (v = s when `along_u`, else
+/// u = s), the pieces of its running parameter that lie inside.
+pub(crate) type Region<'r> = &'r dyn Fn(bool, f64) -> Vec<(f64, f64)>;
+
 /// Parameters along u (`along_u`) or v over the rectangle `[lo, hi]`, tested on
-/// the two boundary iso-curves and the interior ones at 1/4, 1/2 and 3/4.
-pub(crate) fn grid_params(surface: &dyn Surface, lo: DVec2, hi: DVec2, along_u: bool, lim: &Limits) -> (Vec<f64>, f64) {
+/// the two boundary iso-curves and the interior ones at 1/4, 1/2 and 3/4
+/// (paper 000 §3.1.3). On a trimmed face (`region` given) each line is tested
+/// only where it runs inside the loops, and at every eighth of the rectangle:
+/// what lies outside the trim (a fold, a pole, a wild corner of the base
+/// surface) must not set the grid of the part that is kept.
+pub(crate) fn grid_params(
+    surface: &dyn Surface,
+    lo: DVec2,
+    hi: DVec2,
+    along_u: bool,
+    lim: &Limits,
+    region: Option<Region<'_>>,
+) -> (Vec<f64>, f64) {
     let (t0, t1, s0, s1) = if along_u { (lo.x, hi.x, lo.y, hi.y) } else { (lo.y, hi.y, lo.x, hi.x) };
-    let fixed: [f64; 5] = [s0, s0 + 0.25 * (s1 - s0), s0 + 0.5 * (s1 - s0), s0 + 0.75 * (s1 - s0), s1];
+    let lines = if region.is_some() { 8 } else { 4 };
     let make = |s: f64| {
         move |t: f64| {
             let uv = if along_u { DVec2::new(t, s) } else { DVec2::new(s, t) };
             (surface.point(uv), surface.normal(uv))
         }
     };
-    let c0 = make(fixed[0]);
-    let c1 = make(fixed[1]);
-    let c2 = make(fixed[2]);
-    let c3 = make(fixed[3]);
-    let c4 = make(fixed[4]);
-    let evals: [&dyn Fn(f64) -> (DVec3, DVec3); 5] = [&c0, &c1, &c2, &c3, &c4];
+    let curves: Vec<_> = (0..=lines).map(|k| s0 + (s1 - s0) * k as f64 / lines as f64).map(|s| (s, make(s))).collect();
+    let probes: Vec<Probe<'_>> =
+        curves.iter().map(|(s, c)| Probe { eval: c, inside: region.map(|r| r(along_u, *s)) }).collect();
     let breaks = initial_breaks(&surface.breaks(along_u), t0, t1, 16);
-    subdivide(&evals, &breaks, lim)
+    subdivide_probes(&probes, &breaks, lim)
 }
 
 #[cfg(test)]

@@ -32,6 +32,17 @@ pub(crate) struct WorkMesh {
     pub uvs: Vec<[DVec2; 3]>,
     edges: HashMap<(u32, u32), [u32; 2]>,
     trim: HashMap<(u32, u32), TrimEdge>,
+    /// Per vertex: its node id across the model (`NONE` for inner vertices),
+    /// so that borders of different faces can name the same node.
+    pub gid: Vec<u32>,
+    /// Border edges another face (or another stretch of this face's border,
+    /// across a seam) shares: a split of one must be made in the other.
+    pub shared: hashbrown::HashSet<(u32, u32)>,
+    /// Shared edges refinement split, as `(a, b, new vertex)`, for the caller
+    /// to make the same split where the edge is shared.
+    pub events: Vec<(u32, u32, u32)>,
+    /// Cached measure of each triangle (`None`: changed since measured).
+    measures: Vec<Option<(TriMeasure, f64)>>,
 }
 
 fn key(a: u32, b: u32) -> (u32, u32) {
@@ -55,7 +66,6 @@ pub(crate) struct Outcome {
     pub turns: Vec<f64>,
     /// Triangles left failing because the budget ran out or their edges hit `min_edge`.
     pub unproven: usize,
-    pub budget_hit: bool,
 }
 
 impl WorkMesh {
@@ -63,6 +73,7 @@ impl WorkMesh {
     pub fn add_vertex(&mut self, p: DVec3, n: DVec3) -> u32 {
         self.pos.push(p);
         self.normal.push(n);
+        self.gid.push(NONE);
         (self.pos.len() - 1) as u32
     }
 
@@ -80,6 +91,12 @@ impl WorkMesh {
     pub fn mark_trim(&mut self, a: u32, b: u32, curve: u32, ta: f64, tb: f64) {
         let (t_lo, t_hi) = if a < b { (ta, tb) } else { (tb, ta) };
         self.trim.insert(key(a, b), TrimEdge { curve, t_lo, t_hi });
+    }
+
+    /// How many triangles use edge `a-b`.
+    #[cfg(feature = "std")]
+    pub fn edge_triangles(&self, a: u32, b: u32) -> usize {
+        self.edges.get(&key(a, b)).map_or(0, |e| e.iter().filter(|&&t| t != NONE).count())
     }
 
     fn attach(&mut self, a: u32, b: u32, t: u32) {
@@ -153,7 +170,12 @@ impl WorkMesh {
     /// Splits edge `a-b` at its middle and the (one or two) triangles on it;
     /// pushes the triangles that changed or were added to `out`.
     fn split_edge(&mut self, surface: &dyn Surface, curves: &[&NurbsCurve], a: u32, b: u32, out: &mut Vec<u32>) {
-        self.split_edge_at(surface, curves, a, b, 0.5, None, out);
+        let shared = self.shared.contains(&key(a, b));
+        if let Some(m) = self.split_edge_at(surface, curves, a, b, 0.5, None, out) {
+            if shared {
+                self.events.push((a, b, m));
+            }
+        }
     }
 
     /// Splits the longest edge of `t` by Rivara's longest-edge propagation:
@@ -251,12 +273,38 @@ impl WorkMesh {
         if let Some(te) = trim {
             if let Some(c) = curves.get(te.curve as usize) {
                 let (ta, tb) = if a < b { (te.t_lo, te.t_hi) } else { (te.t_hi, te.t_lo) };
-                let tm = ta + (tb - ta) * frac;
+                let mut tm = ta + (tb - ta) * frac;
+                if target.is_none() && frac == 0.5 {
+                    // Refinement halves the edge in model space: a trim curve
+                    // whose parameter crowds (most of its range on a short
+                    // stretch) would otherwise be split next to one end,
+                    // again and again.
+                    let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+                    let side = |t: f64| {
+                        let p = surface.point(c.point(t).truncate());
+                        p.distance(pa) - p.distance(pb)
+                    };
+                    let (mut lo, mut hi) = (ta, tb);
+                    if side(lo) < 0.0 && side(hi) > 0.0 {
+                        for _ in 0..48 {
+                            let mid = 0.5 * (lo + hi);
+                            if side(mid) < 0.0 {
+                                lo = mid;
+                            } else {
+                                hi = mid;
+                            }
+                        }
+                        tm = 0.5 * (lo + hi);
+                    }
+                }
                 trim_at = Some((c.point(tm).truncate(), ta, tm, tb));
             }
         }
-        let m = self.pos.len() as u32;
-        let mut m_pos = None;
+        // First where the new vertex goes in each triangle on the edge, then
+        // (when it is a real split) the change.
+        let mut plan: Vec<(u32, [u32; 3], [DVec2; 3], DVec2)> = Vec::with_capacity(2);
+        let mut m_pos: Option<DVec3> = None;
+        let mut m_normal = DVec3::ZERO;
         for &t in adj.iter().filter(|&&t| t != NONE) {
             let tv = self.tris[t as usize];
             let tuv = self.uvs[t as usize];
@@ -278,11 +326,37 @@ impl WorkMesh {
                 }
             };
             if m_pos.is_none() {
-                let p = target.unwrap_or_else(|| surface.point(uv_m));
-                m_pos = Some(p);
-                self.pos.push(p);
-                self.normal.push(surface.normal(uv_m));
+                m_pos = Some(target.unwrap_or_else(|| surface.point(uv_m)));
+                m_normal = surface.normal(uv_m);
             }
+            plan.push((t, [x0, x1, x2], [u0, u1, u2], uv_m));
+        }
+        let p = m_pos?;
+        if target.is_none() {
+            // A point that is not strictly inside the edge, or lands on a
+            // triangle's third corner, or children that fold in (u,v) (a
+            // curve whose parameters no longer match the ends, corners of one
+            // (u,v) at a collapsed border) would split nothing and be split
+            // again forever: the edge stays as it is.
+            let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+            let near = 1e-6 * pa.distance(pb);
+            let area = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+            let bad = !(p.distance(pa) > near && p.distance(pb) > near)
+                || plan.iter().any(|&(_, x, u, uv_m)| {
+                    let whole = area(u[0], u[1], u[2]);
+                    p.distance(self.pos[x[2] as usize]) <= near
+                        || (whole != 0.0
+                            && (area(u[0], uv_m, u[2]) * whole <= 0.0 || area(uv_m, u[1], u[2]) * whole <= 0.0))
+                });
+            if bad {
+                return None;
+            }
+        }
+        let m = self.pos.len() as u32;
+        self.pos.push(p);
+        self.normal.push(m_normal);
+        self.gid.push(NONE);
+        for (t, [x0, x1, x2], [u0, u1, u2], uv_m) in plan {
             // Replace t by [x0, m, x2] and add [m, x1, x2].
             self.detach(x0, x1, t);
             self.detach(x1, x2, t);
@@ -299,7 +373,10 @@ impl WorkMesh {
             out.push(t);
             out.push(t2);
         }
-        m_pos?;
+        if self.shared.remove(&key(a, b)) {
+            self.shared.insert(key(a, m));
+            self.shared.insert(key(m, b));
+        }
         if let (Some(te), Some((_, ta, tm, tb))) = (trim, trim_at) {
             self.trim.remove(&key(a, b));
             self.mark_trim(a, m, te.curve, ta, tm);
@@ -308,44 +385,89 @@ impl WorkMesh {
         Some(m)
     }
 
-    /// Re-measures triangle `t` (after sewing changed it).
-    pub fn measure_one(&self, surface: &dyn Surface, t: usize, c: &Criteria) -> (TriMeasure, f64) {
-        self.measure(surface, t, c)
-    }
-
     /// Measures every triangle and splits the failing ones until all pass or
     /// the budget is spent. `budget` is the triangle count this face may reach.
     pub fn refine(&mut self, surface: &dyn Surface, curves: &[&NurbsCurve], c: &Criteria, budget: usize) -> Outcome {
-        let mut out = Outcome::default();
-        let mut stack: Vec<u32> = (0..self.tris.len() as u32).rev().collect();
+        let all = (0..self.tris.len() as u32).collect();
+        self.refine_from(surface, curves, c, budget, all);
+        self.outcome(surface, c)
+    }
+
+    /// Splits failing triangles, starting from `todo` (and what their splits
+    /// change), until all pass, edges reach `min_edge` or the face has
+    /// `budget` triangles; measures are cached, so a later call that starts
+    /// from a few changed triangles costs only those. Returns whether the
+    /// budget stopped it.
+    pub fn refine_from(
+        &mut self,
+        surface: &dyn Surface,
+        curves: &[&NurbsCurve],
+        c: &Criteria,
+        budget: usize,
+        mut todo: Vec<u32>,
+    ) -> bool {
+        let mut budget_hit = false;
+        todo.reverse();
+        let mut stack = todo;
         let mut changed = Vec::new();
-        let mut measures: Vec<Option<(TriMeasure, f64)>> = alloc::vec![None; self.tris.len()];
+        self.measures.resize(self.tris.len(), None);
+        let mut fold_splits = 0usize;
+        let fold_limit = 2 * stack.iter().filter(|&&t| self.inverted(surface, t as usize)).count() + 16;
         while let Some(t) = stack.pop() {
             let t = t as usize;
             let (m, turn) = self.measure(surface, t, c);
-            measures[t] = Some((m, turn));
+            self.measures[t] = Some((m, turn));
             let (a, b, len) = self.longest_edge(t);
-            let fails = m.max > c.tol || turn > c.angle || len > c.max_edge || self.inverted(surface, t);
-            if !fails {
+            let limits = m.max > c.tol || turn > c.angle || len > c.max_edge;
+            // A folded sliver along a border is mended by splitting it, but
+            // a fold splitting cannot mend (its corners off the surface
+            // after sewing) would only breed more: such splits are rationed.
+            let folded = !limits && fold_splits < fold_limit && self.inverted(surface, t);
+            if !(limits || folded) {
                 continue;
+            }
+            if folded {
+                fold_splits += 1;
             }
             if len <= c.min_edge {
                 continue;
             }
             if self.tris.len() >= budget {
-                out.budget_hit = true;
+                budget_hit = true;
                 continue;
             }
             changed.clear();
             self.split_lepp(surface, curves, t as u32, (a, b), &mut changed);
-            measures.resize(self.tris.len(), None);
-            for &x in &changed {
-                measures[x as usize] = None;
-                stack.push(x);
+            self.forget(&changed);
+            stack.extend_from_slice(&changed);
+        }
+        budget_hit
+    }
+
+    /// Drops the cached measures of triangles `ts` (they changed).
+    pub fn forget(&mut self, ts: &[u32]) {
+        self.measures.resize(self.tris.len(), None);
+        for &x in ts {
+            if let Some(m) = self.measures.get_mut(x as usize) {
+                *m = None;
             }
         }
-        for (t, m) in measures.iter().enumerate() {
-            let (m, turn) = m.unwrap_or_else(|| self.measure(surface, t, c));
+    }
+
+    /// Every triangle's measure (from the cache where it is still valid) and
+    /// how many fail the limits.
+    pub fn outcome(&mut self, surface: &dyn Surface, c: &Criteria) -> Outcome {
+        let mut out = Outcome::default();
+        self.measures.resize(self.tris.len(), None);
+        for t in 0..self.tris.len() {
+            let (m, turn) = match self.measures[t] {
+                Some(x) => x,
+                None => {
+                    let x = self.measure(surface, t, c);
+                    self.measures[t] = Some(x);
+                    x
+                }
+            };
             let (_, _, len) = self.longest_edge(t);
             if m.max > c.tol || turn > c.angle || len > c.max_edge {
                 out.unproven += 1;
@@ -374,11 +496,9 @@ impl WorkMesh {
                 let v = self.tris[t as usize];
                 let mut fixed = false;
                 for k in 0..3 {
-                    if self.try_flip(surface, c, t, v[k], v[(k + 1) % 3]) {
+                    if let Some(u) = self.try_flip(surface, c, t, v[k], v[(k + 1) % 3]) {
                         changed.push(t);
-                        if let Some(adj) = self.edges.get(&key(v[(k + 2) % 3], v[k])) {
-                            changed.extend(adj.iter().copied().filter(|&x| x != NONE));
-                        }
+                        changed.push(u);
                         fixed = true;
                         break;
                     }
@@ -407,37 +527,37 @@ impl WorkMesh {
     }
 
     /// Flips edge `a-b` of triangle `t` (where `t` runs a→b) if the result is better; see [`Self::repair_inverted`].
-    fn try_flip(&mut self, surface: &dyn Surface, c: &Criteria, t: u32, a: u32, b: u32) -> bool {
+    fn try_flip(&mut self, surface: &dyn Surface, c: &Criteria, t: u32, a: u32, b: u32) -> Option<u32> {
         if self.trim.contains_key(&key(a, b)) {
-            return false;
+            return None;
         }
-        let Some(&adj) = self.edges.get(&key(a, b)) else { return false };
+        let &adj = self.edges.get(&key(a, b))?;
         let u = if adj[0] == t { adj[1] } else { adj[0] };
         if u == NONE || adj[0] != t && adj[1] != t {
-            return false;
+            return None;
         }
         let (tv, tuv) = (self.tris[t as usize], self.uvs[t as usize]);
         let (uv_, uuv) = (self.tris[u as usize], self.uvs[u as usize]);
-        let Some(i) = (0..3).find(|&k| tv[k] == a && tv[(k + 1) % 3] == b) else { return false };
-        let Some(j) = (0..3).find(|&k| uv_[k] == b && uv_[(k + 1) % 3] == a) else { return false };
+        let i = (0..3).find(|&k| tv[k] == a && tv[(k + 1) % 3] == b)?;
+        let j = (0..3).find(|&k| uv_[k] == b && uv_[(k + 1) % 3] == a)?;
         let cv = tv[(i + 2) % 3];
         let d = uv_[(j + 2) % 3];
         if cv == d || self.edges.contains_key(&key(cv, d)) {
-            return false;
+            return None;
         }
         let (qa, qb, qc) = (tuv[i], tuv[(i + 1) % 3], tuv[(i + 2) % 3]);
         let (qb2, qa2, qd) = (uuv[j], uuv[(j + 1) % 3], uuv[(j + 2) % 3]);
         // One chart on both sides (not across a seam).
         let span = (qa - qb).length().max(1e-300);
         if (qa - qa2).length() > 1e-9 * span || (qb - qb2).length() > 1e-9 * span {
-            return false;
+            return None;
         }
         let area = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
         let sense = area(qb2, qa2, qd);
         let (t1, t2) = ([a, d, cv], [d, b, cv]);
         let (w1, w2) = ([qa, qd, qc], [qd, qb, qc]);
         if !(area(w1[0], w1[1], w1[2]) * sense > 0.0 && area(w2[0], w2[1], w2[2]) * sense > 0.0) {
-            return false;
+            return None;
         }
         // Apply, then test; undo when worse.
         let old = (tv, tuv, uv_, uuv);
@@ -449,7 +569,7 @@ impl WorkMesh {
         if !good {
             self.retriangulate(t, u, [t1, t2], [old.0, old.2], [old.1, old.3]);
         }
-        good
+        good.then_some(u)
     }
 
     /// Moves inner vertex `x` to the (u,v) centroid of its neighbours when

@@ -1,154 +1,48 @@
 //! Sewing faces into one watertight mesh (paper 000 §3.3, paper 003's
 //! shared-boundary topology).
 //!
-//! Paper 000 splits a shared edge identically on both patches. Faces here are
-//! meshed one by one, so their borders are made to agree afterwards: every
-//! border vertex of one face that lies on another face's exact border (within
-//! the sewing distance) is inserted into that border, splitting the triangle
-//! behind it, and border vertices that coincide are snapped to one position.
-//! Both sides then hold the same nodes, so welding leaves no crack and no
-//! T-junction, whichever face refined its border more.
+//! Paper 000 splits a shared edge identically on both patches. Here every
+//! face's border (its trim loops discretized, or its domain's border) takes
+//! in, before anything is triangulated, the nodes of the other borders that
+//! run along it, each at its own curve's nearest point; loop nodes that then
+//! coincide are one node of the model, with one id. Each face is
+//! triangulated on those nodes, so both sides of a shared border start with
+//! the same ones. Refinement may split a shared edge; the split is made at
+//! once in every face that shares it, which refines what it changed there.
+//! At the end every node takes one position. Welding then leaves no crack
+//! and no T-junction, and each face's triangles are proven after its last split.
 
 use alloc::vec::Vec;
 use glam::DVec3;
 use hashbrown::HashMap;
 
-use super::refine::WorkMesh;
+use super::refine::{Criteria, WorkMesh};
 use crate::nurbs::{NurbsCurve, Surface};
+use crate::Error;
+
+const NONE: u32 = u32::MAX;
 
 /// One face while the model is sewn.
 pub(crate) struct FaceWork<'a> {
     pub surface: &'a dyn Surface,
     pub curves: Vec<&'a NurbsCurve>,
     pub mesh: WorkMesh,
+    /// The limits its triangles must meet.
+    pub crit: Criteria,
 }
 
-struct Candidate {
-    s: f64,
-    q: DVec3,
-}
-
+#[cfg(feature = "std")]
 type Cell = (i64, i64, i64);
 
+#[cfg(feature = "std")]
 fn cell_of(p: DVec3, inv: f64) -> Cell {
     let c = p * inv;
     (crate::math::floor(c.x) as i64, crate::math::floor(c.y) as i64, crate::math::floor(c.z) as i64)
 }
 
-/// Makes the faces' borders conform; returns, per face, the triangles that changed.
-///
-/// `sew`: how far apart two borders may be and still be one edge; `reach`:
-/// how far a border vertex may lie from the other face's chord (chordal
-/// tolerance plus `sew`).
-pub(crate) fn conform(faces: &mut [FaceWork<'_>], sew: f64, reach: f64) -> Vec<Vec<u32>> {
-    let mut changed: Vec<Vec<u32>> = faces.iter().map(|_| Vec::new()).collect();
-    if faces.is_empty() || sew.is_nan() || sew <= 0.0 || !reach.is_finite() {
-        return changed;
-    }
-    // Border vertices of every face, hashed on a grid about one border edge long.
-    let borders: Vec<Vec<(u32, u32)>> = faces.iter().map(|f| f.mesh.boundary_edges()).collect();
-    let mut total_len = 0.0;
-    let mut count = 0usize;
-    for (f, edges) in faces.iter().zip(&borders) {
-        for &(a, b) in edges {
-            total_len += f.mesh.pos[a as usize].distance(f.mesh.pos[b as usize]);
-            count += 1;
-        }
-    }
-    if count == 0 {
-        return changed;
-    }
-    let h = (total_len / count as f64).max(reach).max(1e-300);
-    let inv = 1.0 / h;
-    let mut grid: HashMap<Cell, Vec<(u32, u32)>> = HashMap::new();
-    for (fi, (f, edges)) in faces.iter().zip(&borders).enumerate() {
-        let mut seen = hashbrown::HashSet::new();
-        for &(a, b) in edges {
-            for v in [a, b] {
-                if seen.insert(v) {
-                    grid.entry(cell_of(f.mesh.pos[v as usize], inv)).or_default().push((fi as u32, v));
-                }
-            }
-        }
-    }
-    // Phase 1: for every border edge, the other faces' border vertices on it.
-    let mut plans: Vec<Vec<(u32, u32, Vec<Candidate>)>> = faces.iter().map(|_| Vec::new()).collect();
-    for (fi, f) in faces.iter().enumerate() {
-        for &(a, b) in &borders[fi] {
-            let (pa, pb) = (f.mesh.pos[a as usize], f.mesh.pos[b as usize]);
-            let lo = cell_of(pa.min(pb) - DVec3::splat(reach), inv);
-            let hi = cell_of(pa.max(pb) + DVec3::splat(reach), inv);
-            let mut found: Vec<Candidate> = Vec::new();
-            for x in lo.0..=hi.0 {
-                for y in lo.1..=hi.1 {
-                    for z in lo.2..=hi.2 {
-                        let Some(list) = grid.get(&(x, y, z)) else { continue };
-                        for &(g, v) in list {
-                            if g as usize == fi && (v == a || v == b) {
-                                continue;
-                            }
-                            let q = faces[g as usize].mesh.pos[v as usize];
-                            if let Some(s) = on_border(f, a, b, q, sew, reach) {
-                                if !found.iter().any(|c| c.q.distance(q) <= sew) {
-                                    found.push(Candidate { s, q });
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-            if !found.is_empty() {
-                found.sort_by(|x, y| x.s.total_cmp(&y.s));
-                plans[fi].push((a, b, found));
-            }
-        }
-    }
-    // Phase 2: split the edges at those vertices.
-    for (fi, plan) in plans.into_iter().enumerate() {
-        let f = &mut faces[fi];
-        for (a, b, cands) in plan {
-            let mut from = a;
-            let mut done = 0.0;
-            for c in cands {
-                let frac = ((c.s - done) / (1.0 - done)).clamp(1e-6, 1.0 - 1e-6);
-                match f.mesh.split_edge_at(f.surface, &f.curves, from, b, frac, Some(c.q), &mut changed[fi]) {
-                    Some(m) => {
-                        from = m;
-                        done = c.s;
-                    }
-                    None => break,
-                }
-            }
-        }
-    }
-    snap(faces, sew, &mut changed);
-    for c in &mut changed {
-        c.sort_unstable();
-        c.dedup();
-    }
-    changed
-}
-
-/// Where `q` lies on the exact border under edge `a-b` of face `f`: the
-/// fraction from `a`, when it is within `sew` of that border and not at its ends.
-fn on_border(f: &FaceWork<'_>, a: u32, b: u32, q: DVec3, sew: f64, reach: f64) -> Option<f64> {
-    let (pa, pb) = (f.mesh.pos[a as usize], f.mesh.pos[b as usize]);
-    if q.distance(pa) <= sew || q.distance(pb) <= sew {
-        return None;
-    }
-    let ab = pb - pa;
-    let l2 = ab.length_squared();
-    if l2 <= 0.0 {
-        return None;
-    }
-    let s0 = ((q - pa).dot(ab) / l2).clamp(0.0, 1.0);
-    if q.distance(pa + ab * s0) > reach || s0 <= 0.0 || s0 >= 1.0 {
-        return None;
-    }
-    // Golden-section search of the distance to the exact border around s0.
-    let dist =
-        |s: f64| f.mesh.boundary_point(f.surface, &f.curves, a, b, s).map_or(f64::INFINITY, |(_, p)| p.distance(q));
-    let (mut lo, mut hi) = ((s0 - 0.25).max(0.0), (s0 + 0.25).min(1.0));
+/// Golden-section search of `dist` over `[lo, hi]`: the argument of its
+/// smallest value found, and that value.
+fn golden(dist: &dyn Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
     let g = 0.618_033_988_749_895;
     let mut x1 = hi - g * (hi - lo);
     let mut x2 = lo + g * (hi - lo);
@@ -171,62 +65,615 @@ fn on_border(f: &FaceWork<'_>, a: u32, b: u32, q: DVec3, sew: f64, reach: f64) -
             break;
         }
     }
-    let (s, d) = if f1 < f2 { (x1, f1) } else { (x2, f2) };
-    (d <= sew && s > 1e-9 && s < 1.0 - 1e-9).then_some(s)
+    if f1 < f2 {
+        (x1, f1)
+    } else {
+        (x2, f2)
+    }
 }
 
-/// Snaps border vertices that lie within `sew` of each other to one position
-/// (the first one's), so welding joins them exactly: across faces, and within
-/// one face along a seam its loop runs up on one side and down on the other.
-fn snap(faces: &mut [FaceWork<'_>], sew: f64, changed: &mut [Vec<u32>]) {
-    let inv = 1.0 / sew;
-    let mut grid: HashMap<Cell, Vec<(u32, u32)>> = HashMap::new();
-    let mut moved: Vec<Vec<u32>> = faces.iter().map(|_| Vec::new()).collect();
-    for fi in 0..faces.len() {
-        let edges = faces[fi].mesh.boundary_edges();
-        let mut verts: Vec<u32> = edges.iter().flat_map(|&(a, b)| [a, b]).collect();
-        verts.sort_unstable();
-        verts.dedup();
-        for v in verts {
-            let p = faces[fi].mesh.pos[v as usize];
-            let (kx, ky, kz) = cell_of(p, inv);
-            let mut target = None;
-            'look: for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for dz in -1..=1 {
-                        let Some(list) = grid.get(&(kx + dx, ky + dy, kz + dz)) else { continue };
-                        for &(g, w) in list {
-                            if g as usize != fi || w != v {
-                                let q = faces[g as usize].mesh.pos[w as usize];
-                                if q.distance(p) <= sew {
-                                    target = Some(q);
-                                    break 'look;
+/// Sewing of face outlines before they are triangulated.
+#[cfg(feature = "std")]
+mod outlines {
+    use alloc::vec::Vec;
+    use glam::DVec3;
+    use hashbrown::HashMap;
+
+    use super::{cell_of, golden, Cell};
+    use crate::nurbs::Surface;
+    use crate::tessellate::face::Outline;
+    use crate::tessellate::trim::CurveRef;
+
+    /// A node of some face's outline: face, loop, index.
+    type NodeRef = (u32, u32, u32);
+
+    /// Per face, per loop, per node.
+    type PerNode<T> = Vec<Vec<Vec<T>>>;
+
+    /// Per segment, the nodes to add to it: (fraction, curve parameter, the node it stands for).
+    type Additions = PerNode<Vec<(f64, f64, NodeRef)>>;
+
+    /// Makes the outlines of all faces agree and names their nodes.
+    ///
+    /// Each node has a reach: `sew`, but at most 0.3 of its shortest loop
+    /// segment (so two nodes of one segment are never one). A node of one
+    /// outline that lies on another outline's exact border within its reach,
+    /// where the two run side by side and no more than four times as far as
+    /// the nearest other face's border, is added to that border at its own
+    /// curve's nearest point (unless it is within reach of a node there
+    /// already). Then nodes within both reaches of each other get one id in
+    /// [`Outline::gids`]. Within one face (a seam) `tight` takes the place of
+    /// `sew`: a face's loops meet themselves exactly, and a face narrower
+    /// than `sew` must not be folded shut. Returns the ids given.
+    ///
+    /// `reach`: how far a node may lie from the other border's chord
+    /// (chordal tolerance plus `sew`).
+    pub(crate) fn unify(
+        faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>],
+        bodies: &[u32],
+        sew: f64,
+        tight: f64,
+        reach: f64,
+    ) -> u32 {
+        let tight = tight.min(sew).max(0.0);
+        let sew = if sew.is_finite() { sew.max(0.0) } else { 0.0 };
+        let pos = positions(faces);
+        let (mut total, mut count) = (0.0, 0usize);
+        for p in pos.iter().flatten() {
+            for i in 0..p.len() {
+                total += p[i].distance(p[(i + 1) % p.len()]);
+                count += 1;
+            }
+        }
+        if count == 0 {
+            return 0;
+        }
+        let mut twins: Vec<(NodeRef, NodeRef)> = Vec::new();
+        let mut sew_used = tight;
+        if sew > 0.0 && reach.is_finite() {
+            let (adds, used) = insertions(faces, bodies, &pos, sew, tight, reach, total / count as f64);
+            sew_used = used;
+            twins = insert(faces, &adds);
+        }
+        name_nodes(faces, bodies, &radii(&pos, sew_used), &twins, sew_used, tight)
+    }
+
+    /// Each outline node's point on its face's surface.
+    fn positions(faces: &[Option<(&dyn Surface, &mut Outline<'_>)>]) -> PerNode<DVec3> {
+        faces
+            .iter()
+            .map(|item| {
+                item.as_ref().map_or_else(Vec::new, |(s, o)| {
+                    o.loops.polys.iter().map(|p| p.uv.iter().map(|&q| s.point(q)).collect()).collect()
+                })
+            })
+            .collect()
+    }
+
+    /// Each node's reach: `sew`, at most 0.3 of its shortest loop segment
+    /// (zero-length segments along a pole aside).
+    fn radii(pos: &PerNode<DVec3>, sew: f64) -> PerNode<f64> {
+        pos.iter()
+            .map(|f| {
+                f.iter()
+                    .map(|p| {
+                        let n = p.len();
+                        let scale = p.iter().fold(0.0f64, |m, q| m.max(q.abs().max_element())).max(1e-300);
+                        let length = |i: usize| {
+                            let l = p[i].distance(p[(i + 1) % n]);
+                            if l <= 1e-12 * scale {
+                                f64::INFINITY
+                            } else {
+                                l
+                            }
+                        };
+                        (0..n)
+                            .map(|i| sew.min(0.3 * length(i).min(length((i + n - 1) % n))).max(1e-12 * scale))
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Per segment, the nodes of other borders to add to it: (fraction,
+    /// curve parameter, the node it stands for), in order along it; and the
+    /// sewing distance used.
+    ///
+    /// The distance is what the model's gaps need, not `sew` blindly: four
+    /// times the 90th percentile of the distances from border nodes to the
+    /// nearest border of another face beside them, between `tight` and
+    /// `sew`. A file whose faces meet exactly is sewn tightly, so a face
+    /// pinched narrower than `sew` is not sewn across its neck; a patchwork
+    /// with gaps gets the distance its gaps take.
+    fn insertions(
+        faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
+        bodies: &[u32],
+        pos: &PerNode<DVec3>,
+        sew: f64,
+        tight: f64,
+        reach: f64,
+        mean_segment: f64,
+    ) -> (Additions, f64) {
+        let radius = radii(pos, sew);
+        // Nodes hashed on a grid about one loop segment long.
+        let inv = 1.0 / mean_segment.max(reach).max(1e-300);
+        let mut grid: HashMap<Cell, Vec<NodeRef>> = HashMap::new();
+        for (fi, f) in pos.iter().enumerate() {
+            for (k, p) in f.iter().enumerate() {
+                for (i, &q) in p.iter().enumerate() {
+                    grid.entry(cell_of(q, inv)).or_default().push((fi as u32, k as u32, i as u32));
+                }
+            }
+        }
+        let at = |n: NodeRef| pos[n.0 as usize][n.1 as usize][n.2 as usize];
+        let body = |f: usize| bodies.get(f).copied().unwrap_or(0);
+        let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
+        // Every node on some other segment: (segment, fraction, curve parameter, distance, node).
+        let mut cands: Vec<(NodeRef, f64, f64, f64, NodeRef)> = Vec::new();
+        for (fi, item) in faces.iter().enumerate() {
+            let Some((surface, o)) = item else { continue };
+            for (k, poly) in o.loops.polys.iter().enumerate() {
+                let n = poly.uv.len();
+                for i in 0..n {
+                    let j = (i + 1) % n;
+                    let (na, nb) = ((fi as u32, k as u32, i as u32), (fi as u32, k as u32, j as u32));
+                    let (pa, pb) = (at(na), at(nb));
+                    let ab = pb - pa;
+                    let dir = ab.normalize_or_zero();
+                    let (curve, ta, tb) = poly.seg[i];
+                    let Some(c) = o.loops.curves.get(curve as usize) else { continue };
+                    let on_curve = |s: f64| surface.point(c.point(ta + (tb - ta) * s).truncate());
+                    let lo = cell_of(pa.min(pb) - DVec3::splat(reach), inv);
+                    let hi = cell_of(pa.max(pb) + DVec3::splat(reach), inv);
+                    for x in lo.0..=hi.0 {
+                        for y in lo.1..=hi.1 {
+                            for z in lo.2..=hi.2 {
+                                let Some(list) = grid.get(&(x, y, z)) else { continue };
+                                for &qn in list {
+                                    let (g, kk, jj) = (qn.0 as usize, qn.1 as usize, qn.2 as usize);
+                                    if qn == na || qn == nb || body(g) != body(fi) {
+                                        continue;
+                                    }
+                                    let q = at(qn);
+                                    let limit = if g == fi { tight.min(r_of(qn)) } else { r_of(qn) };
+                                    let s0 = ((q - pa).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
+                                    if s0 <= 0.0 || s0 >= 1.0 || q.distance(pa + ab * s0) > reach {
+                                        continue;
+                                    }
+                                    // The other border must run along this
+                                    // one at q, not merely pass near it.
+                                    let m = pos[g][kk].len();
+                                    let parallel = [(jj + m - 1) % m, (jj + 1) % m]
+                                        .iter()
+                                        .any(|&nb| (pos[g][kk][nb] - q).normalize_or_zero().dot(dir).abs() >= 0.8);
+                                    if !parallel {
+                                        continue;
+                                    }
+                                    let (s, d) = golden(
+                                        &|s: f64| on_curve(s).distance(q),
+                                        (s0 - 0.25).max(0.0),
+                                        (s0 + 0.25).min(1.0),
+                                    );
+                                    if d <= limit && s > 1e-9 && s < 1.0 - 1e-9 {
+                                        cands.push((na, s, ta + (tb - ta) * s, d, qn));
+                                    } else if q.distance(pa).min(q.distance(pb)) <= limit {
+                                        // At an end: recorded for the gap estimate only.
+                                        cands.push((na, -1.0, 0.0, q.distance(pa).min(q.distance(pb)), qn));
+                                    }
                                 }
                             }
                         }
                     }
                 }
             }
-            match target {
-                Some(q) => {
-                    if q != p {
-                        faces[fi].mesh.pos[v as usize] = q;
-                        moved[fi].push(v);
+        }
+        // A node goes only onto borders about as near as the nearest other
+        // face's: a face thinner than `sew` keeps its far border to itself.
+        // Of one face's borders it goes onto the nearest only (and onto
+        // another as near within `tight`, the other side of a seam): a face
+        // pinched narrower than `sew` is not sewn across its neck.
+        let mut nearest: HashMap<NodeRef, f64> = HashMap::new();
+        let mut nearest_in: HashMap<(NodeRef, u32), f64> = HashMap::new();
+        for &(seg, _, _, d, q) in &cands {
+            if seg.0 != q.0 {
+                let e = nearest.entry(q).or_insert(f64::INFINITY);
+                *e = e.min(d);
+            }
+            let e = nearest_in.entry((q, seg.0)).or_insert(f64::INFINITY);
+            *e = e.min(d);
+        }
+        // The gaps the model has.
+        let mut gaps: Vec<f64> = nearest.values().copied().collect();
+        gaps.sort_by(f64::total_cmp);
+        let q90 = gaps.get((gaps.len() * 9) / 10).copied().unwrap_or(0.0);
+        let sew = (4.0 * q90).clamp(tight, sew.max(tight));
+        let radius = radii(pos, sew);
+        let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
+        let mut adds: Additions =
+            pos.iter().map(|f| f.iter().map(|p| alloc::vec![Vec::new(); p.len()]).collect()).collect();
+        cands.sort_by(|x, y| x.3.total_cmp(&y.3));
+        for &(seg, s, t, d, q) in &cands {
+            let (fi, k, i) = (seg.0 as usize, seg.1 as usize, seg.2 as usize);
+            let limit = if seg.0 == q.0 { tight.min(r_of(q)) } else { r_of(q) };
+            let n = pos[fi][k].len();
+            let (na, nb) = (seg, (seg.0, seg.1, ((i + 1) % n) as u32));
+            let qp = at(q);
+            // Beyond reach, or within reach of an end (it will be that node).
+            if s < 0.0
+                || d > limit
+                || qp.distance(at(na)) <= limit.min(r_of(na))
+                || qp.distance(at(nb)) <= limit.min(r_of(nb))
+            {
+                continue;
+            }
+            if seg.0 != q.0 && d > tight.max(4.0 * nearest.get(&q).copied().unwrap_or(0.0)) {
+                continue;
+            }
+            if d > nearest_in.get(&(q, seg.0)).copied().unwrap_or(0.0) + tight {
+                continue;
+            }
+            let list = &mut adds[fi][k][i];
+            // Two nodes within reach of each other will be one: add one.
+            if !list.iter().any(|c| at(c.2).distance(qp) <= r_of(c.2).min(r_of(q))) {
+                list.push((s, t, q));
+            }
+        }
+        for list in adds.iter_mut().flatten().flatten() {
+            list.sort_by(|x, y| x.0.total_cmp(&y.0));
+        }
+        (adds, sew)
+    }
+
+    /// Adds the nodes to the outlines; returns each new node with the node
+    /// it stands for (both by their places in the new outlines).
+    fn insert(faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>], adds: &Additions) -> Vec<(NodeRef, NodeRef)> {
+        let mut twins = Vec::new();
+        // Where each old node went.
+        let mut moved: PerNode<u32> =
+            adds.iter().map(|f| f.iter().map(|p| (0..p.len() as u32).collect()).collect()).collect();
+        for (fi, item) in faces.iter_mut().enumerate() {
+            let Some((_, o)) = item else { continue };
+            for (k, add) in adds[fi].iter().enumerate() {
+                if add.iter().all(Vec::is_empty) {
+                    continue;
+                }
+                let poly = &mut o.loops.polys[k];
+                let (mut uv, mut at, mut seg) = (Vec::new(), Vec::new(), Vec::new());
+                // Twins are named by their index in the new loop, fixed below.
+                let mut new_twins = Vec::new();
+                for i in 0..poly.uv.len() {
+                    let (curve, ta, tb) = poly.seg[i];
+                    moved[fi][k][i] = uv.len() as u32;
+                    uv.push(poly.uv[i]);
+                    at.push(poly.at[i]);
+                    let mut from = ta;
+                    for &(_, t, q) in &add[i] {
+                        let Some(c) = o.loops.curves.get(curve as usize) else { break };
+                        seg.push((curve, from, t));
+                        new_twins.push((uv.len() as u32, q));
+                        uv.push(c.point(t).truncate());
+                        at.push(CurveRef { curve, t });
+                        from = t;
+                    }
+                    seg.push((curve, from, tb));
+                }
+                poly.uv = uv;
+                poly.at = at;
+                poly.seg = seg;
+                o.gids[k] = alloc::vec![u32::MAX; poly.uv.len()];
+                twins.extend(new_twins.into_iter().map(|(i, q)| ((fi as u32, k as u32, i), q)));
+            }
+        }
+        for (_, q) in &mut twins {
+            q.2 = moved[q.0 as usize][q.1 as usize][q.2 as usize];
+        }
+        twins
+    }
+
+    /// Union-find over nodes, each cluster with its nodes' faces, points and reaches.
+    struct Clusters {
+        parent: Vec<u32>,
+        members: Vec<Vec<(u32, DVec3, f64)>>,
+        tight: f64,
+    }
+
+    impl Clusters {
+        fn find(&mut self, mut x: u32) -> u32 {
+            while self.parent[x as usize] != x {
+                let p = self.parent[x as usize];
+                self.parent[x as usize] = self.parent[p as usize];
+                x = p;
+            }
+            x
+        }
+
+        /// Joins the clusters of `a` and `b` unless that would make two
+        /// nodes of one face one node that could not be one directly
+        /// (farther apart than `tight` or than either's reach).
+        fn union(&mut self, a: u32, b: u32) {
+            let (x, y) = (self.find(a), self.find(b));
+            if x == y {
+                return;
+            }
+            let tight = self.tight;
+            let clash = self.members[x as usize].iter().any(|&(f, p, rp)| {
+                self.members[y as usize].iter().any(|&(g, q, rq)| f == g && p.distance(q) > tight.min(rp).min(rq))
+            });
+            if clash {
+                return;
+            }
+            let (small, big) =
+                if self.members[x as usize].len() < self.members[y as usize].len() { (x, y) } else { (y, x) };
+            let moved = core::mem::take(&mut self.members[small as usize]);
+            self.members[big as usize].extend(moved);
+            self.parent[small as usize] = big;
+        }
+    }
+
+    /// Gives nodes within both their reaches of each other one id (within
+    /// `tight` inside one face), new nodes the id of the node they stand for.
+    fn name_nodes(
+        faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>],
+        bodies: &[u32],
+        radius_before: &PerNode<f64>,
+        twins: &[(NodeRef, NodeRef)],
+        sew: f64,
+        tight: f64,
+    ) -> u32 {
+        let pos = positions(faces);
+        // Reach after insertion: a new node has its twin's, an old one keeps its own.
+        let mut radius: PerNode<f64> =
+            pos.iter().map(|f| f.iter().map(|p| alloc::vec![0.0; p.len()]).collect()).collect();
+        let mut index: PerNode<u32> = pos.iter().map(|f| f.iter().map(|p| alloc::vec![0; p.len()]).collect()).collect();
+        let mut flat: Vec<(u32, DVec3)> = Vec::new();
+        for (fi, item) in faces.iter().enumerate() {
+            let Some((_, o)) = item else { continue };
+            for (k, poly) in o.loops.polys.iter().enumerate() {
+                let mut old = 0usize;
+                let new_here: hashbrown::HashSet<u32> =
+                    twins.iter().filter(|(n, _)| n.0 as usize == fi && n.1 as usize == k).map(|(n, _)| n.2).collect();
+                for i in 0..poly.uv.len() {
+                    if !new_here.contains(&(i as u32)) {
+                        radius[fi][k][i] = radius_before[fi][k].get(old).copied().unwrap_or(0.0);
+                        old += 1;
+                    }
+                    index[fi][k][i] = flat.len() as u32;
+                    flat.push((fi as u32, pos[fi][k][i]));
+                }
+            }
+        }
+        for &(n, q) in twins {
+            let r = radius_before[q.0 as usize][q.1 as usize].get(q.2 as usize).copied().unwrap_or(0.0);
+            radius[n.0 as usize][n.1 as usize][n.2 as usize] = r;
+        }
+        let r_flat: Vec<f64> = radius.iter().flatten().flatten().copied().collect();
+        let mut cl = Clusters {
+            parent: (0..flat.len() as u32).collect(),
+            members: flat.iter().zip(&r_flat).map(|(&(f, p), &r)| alloc::vec![(f, p, r)]).collect(),
+            tight,
+        };
+        // Twins first (they are one node by construction), then neighbours by distance.
+        let id_of = |n: NodeRef, index: &PerNode<u32>| index[n.0 as usize][n.1 as usize].get(n.2 as usize).copied();
+        for &(n, q) in twins {
+            if let (Some(a), Some(b)) = (id_of(n, &index), id_of(q, &index)) {
+                cl.union(a, b);
+            }
+        }
+        if sew > 0.0 {
+            let inv = 1.0 / sew;
+            let mut grid: HashMap<Cell, Vec<u32>> = HashMap::new();
+            for (i, &(_, p)) in flat.iter().enumerate() {
+                grid.entry(cell_of(p, inv)).or_default().push(i as u32);
+            }
+            let mut pairs: Vec<(f64, u32, u32)> = Vec::new();
+            for (i, &(fi, p)) in flat.iter().enumerate() {
+                let (kx, ky, kz) = cell_of(p, inv);
+                for dx in -1..=1 {
+                    for dy in -1..=1 {
+                        for dz in -1..=1 {
+                            let Some(list) = grid.get(&(kx + dx, ky + dy, kz + dz)) else { continue };
+                            for &j in list {
+                                if j as usize <= i {
+                                    continue;
+                                }
+                                let (fj, q) = flat[j as usize];
+                                let body = |f: u32| bodies.get(f as usize).copied().unwrap_or(0);
+                                if body(fi) != body(fj) {
+                                    continue;
+                                }
+                                let d = p.distance(q);
+                                let limit = if fi == fj { tight } else { sew };
+                                if d <= limit.min(r_flat[i]).min(r_flat[j as usize]) {
+                                    pairs.push((d, i as u32, j));
+                                }
+                            }
+                        }
                     }
                 }
-                None => grid.entry((kx, ky, kz)).or_default().push((fi as u32, v)),
+            }
+            pairs.sort_by(|x, y| x.0.total_cmp(&y.0));
+            for (_, a, b) in pairs {
+                cl.union(a, b);
+            }
+        }
+        // Compact ids.
+        let mut ids: HashMap<u32, u32> = HashMap::new();
+        for (fi, item) in faces.iter_mut().enumerate() {
+            let Some((_, o)) = item else { continue };
+            for k in 0..o.gids.len() {
+                for i in 0..o.gids[k].len() {
+                    let root = cl.find(index[fi][k][i]);
+                    let next = ids.len() as u32;
+                    o.gids[k][i] = *ids.entry(root).or_insert(next);
+                }
+            }
+        }
+        ids.len() as u32
+    }
+}
+
+#[cfg(feature = "std")]
+pub(crate) use outlines::unify;
+
+/// Where each model edge (a pair of node ids) is used: face and local ends.
+type Uses = HashMap<(u32, u32), Vec<(u32, u32, u32)>>;
+
+fn node_key(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+/// Every border edge between two different nodes, by its node pair.
+fn border_uses(faces: &[FaceWork<'_>]) -> Uses {
+    let mut uses: Uses = HashMap::new();
+    for (fi, f) in faces.iter().enumerate() {
+        for (a, b) in f.mesh.boundary_edges() {
+            let (ga, gb) = (f.mesh.gid[a as usize], f.mesh.gid[b as usize]);
+            if ga != NONE && gb != NONE && ga != gb {
+                uses.entry(node_key(ga, gb)).or_default().push((fi as u32, a, b));
             }
         }
     }
-    for (fi, vs) in moved.iter().enumerate() {
-        if vs.is_empty() {
-            continue;
+    uses
+}
+
+/// The fraction from `a` of the point of the exact border under edge `a-b`
+/// of face `f` nearest `q`.
+fn nearest_on_border(f: &FaceWork<'_>, a: u32, b: u32, q: DVec3) -> f64 {
+    let (pa, pb) = (f.mesh.pos[a as usize], f.mesh.pos[b as usize]);
+    let ab = pb - pa;
+    let s0 = ((q - pa).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
+    let dist =
+        |s: f64| f.mesh.boundary_point(f.surface, &f.curves, a, b, s).map_or(f64::INFINITY, |(_, p)| p.distance(q));
+    golden(&dist, (s0 - 0.25).max(0.0), (s0 + 0.25).min(1.0)).0
+}
+
+/// Refines every face until its triangles pass (or its budget or the minimum
+/// edge stops it), making each split of a shared border edge in every face
+/// that shares it and refining again what that split changed there. Node ids
+/// continue from `ids`. `progress(done, total)` is called as each face's first
+/// refinement ends; `false` cancels. Returns whether the budget stopped a face.
+///
+/// # Errors
+/// [`Error::Cancelled`] when `progress` says so.
+pub(crate) fn refine_all(
+    faces: &mut [FaceWork<'_>],
+    mut ids: u32,
+    budget: usize,
+    progress: &mut dyn FnMut(usize, usize) -> bool,
+) -> Result<bool, Error> {
+    let mut uses = border_uses(faces);
+    for list in uses.values().filter(|l| l.len() > 1) {
+        for &(fi, a, b) in list {
+            faces[fi as usize].mesh.shared.insert((a.min(b), a.max(b)));
         }
-        let set: hashbrown::HashSet<u32> = vs.iter().copied().collect();
-        for (t, tri) in faces[fi].mesh.tris.iter().enumerate() {
-            if tri.iter().any(|v| set.contains(v)) {
-                changed[fi].push(t as u32);
+    }
+    let mut total: usize = faces.iter().map(|f| f.mesh.tris.len()).sum();
+    let mut pending: Vec<Vec<u32>> = faces.iter().map(|f| (0..f.mesh.tris.len() as u32).collect()).collect();
+    let mut budget_hit = false;
+    // First every face in order, then the faces that splits elsewhere changed.
+    let mut queue: alloc::collections::VecDeque<usize> = (0..faces.len()).collect();
+    let mut queued: Vec<bool> = alloc::vec![true; faces.len()];
+    let mut rounds = 0usize;
+    while let Some(fi) = queue.pop_front() {
+        queued[fi] = false;
+        rounds += 1;
+        let todo = core::mem::take(&mut pending[fi]);
+        let f = &mut faces[fi];
+        let before = f.mesh.tris.len();
+        let room = budget.saturating_sub(total - before);
+        budget_hit |= f.mesh.refine_from(f.surface, &f.curves, &f.crit, room, todo);
+        total = total - before + f.mesh.tris.len();
+        let events = core::mem::take(&mut f.mesh.events);
+        for (a, b, m) in events {
+            let (ga, gb) = (faces[fi].mesh.gid[a as usize], faces[fi].mesh.gid[b as usize]);
+            let Some(list) = uses.remove(&node_key(ga, gb)) else { continue };
+            let g = ids;
+            ids += 1;
+            faces[fi].mesh.gid[m as usize] = g;
+            let p = faces[fi].mesh.pos[m as usize];
+            let mut lo_side = alloc::vec![(fi as u32, a, m)];
+            let mut hi_side = alloc::vec![(fi as u32, m, b)];
+            for (gj, c, d) in list {
+                let j = gj as usize;
+                if j == fi && node_key(c, d) == node_key(a, b) {
+                    continue;
+                }
+                let h = &mut faces[j];
+                // Orient the other use like a→b.
+                let (c, d) = if h.mesh.gid[c as usize] == ga { (c, d) } else { (d, c) };
+                let frac = nearest_on_border(h, c, d, p).clamp(1e-6, 1.0 - 1e-6);
+                let mut changed = Vec::new();
+                let before = h.mesh.tris.len();
+                // At its own border's point; where that would not split the
+                // edge, at the other face's point itself.
+                let n = match h.mesh.split_edge_at(h.surface, &h.curves, c, d, frac, None, &mut changed) {
+                    Some(n) => n,
+                    None => match h.mesh.split_edge_at(h.surface, &h.curves, c, d, frac, Some(p), &mut changed) {
+                        Some(n) => n,
+                        None => continue,
+                    },
+                };
+                total += h.mesh.tris.len() - before;
+                h.mesh.gid[n as usize] = g;
+                h.mesh.forget(&changed);
+                lo_side.push((gj, c, n));
+                hi_side.push((gj, n, d));
+                pending[j].extend_from_slice(&changed);
+                if !queued[j] {
+                    queued[j] = true;
+                    queue.push_back(j);
+                }
+            }
+            uses.insert(node_key(ga, g), lo_side);
+            uses.insert(node_key(g, gb), hi_side);
+        }
+        if rounds <= faces.len() && !progress(rounds, faces.len()) {
+            return Err(Error::Cancelled);
+        }
+        if rounds > 64 * faces.len() + 1024 {
+            break;
+        }
+    }
+    Ok(budget_hit)
+}
+
+/// Gives every node of the model one position, the mean of where its faces
+/// put it (so each moves by half the gap between them), and returns per
+/// face the triangles whose corners moved by more than `negligible` (the
+/// rest keep their measures: they changed by less than that).
+pub(crate) fn settle_nodes(faces: &mut [FaceWork<'_>], negligible: f64) -> Vec<Vec<u32>> {
+    // Per node: sum of positions, count, and whether they all agree already.
+    let mut sum: HashMap<u32, (DVec3, f64, DVec3, bool)> = HashMap::new();
+    for f in faces.iter() {
+        for (v, &g) in f.mesh.gid.iter().enumerate() {
+            if g != NONE {
+                let p = f.mesh.pos[v];
+                let e = sum.entry(g).or_insert((DVec3::ZERO, 0.0, p, true));
+                e.0 += p;
+                e.1 += 1.0;
+                e.3 &= e.2 == p;
             }
         }
     }
+    let mut changed = Vec::with_capacity(faces.len());
+    for f in faces.iter_mut() {
+        let mut moved = hashbrown::HashSet::new();
+        for v in 0..f.mesh.pos.len() {
+            let g = f.mesh.gid[v];
+            let Some(&(s, n, _, same)) = sum.get(&g) else { continue };
+            if n > 1.0 && !same {
+                let p = s / n;
+                if p.distance(f.mesh.pos[v]) > negligible {
+                    moved.insert(v as u32);
+                }
+                f.mesh.pos[v] = p;
+            }
+        }
+        let tris: Vec<u32> = (0..f.mesh.tris.len() as u32)
+            .filter(|&t| f.mesh.tris[t as usize].iter().any(|v| moved.contains(v)))
+            .collect();
+        changed.push(tris);
+    }
+    changed
 }

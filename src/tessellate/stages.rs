@@ -104,7 +104,7 @@ impl<'a> FaceStages<'a> {
 
     /// Stage 2: the iso-parametric grid over the face's (trimmed) parameter rectangle.
     pub fn grid(&self, d: &Discretized<'_>) -> Grid {
-        let (pu, pv) = grid(self.surface(), d.lo, d.hi, &self.setup.lim);
+        let (pu, pv) = grid(self.surface(), d.lo, d.hi, &self.setup.lim, d.loops.as_ref());
         Grid { pu, pv }
     }
 
@@ -139,7 +139,7 @@ impl<'a> FaceStages<'a> {
             Some(loops) => {
                 let band = Band::new(self.surface(), &loops, &g.pu, &g.pv);
                 let tris = band.triangulate(self.index)?;
-                band.build(self.surface(), &tris, &mut mesh);
+                band.build(self.surface(), &tris, &mut mesh, None);
                 Ok(Initial { mesh, curves: loops.curves })
             }
         }
@@ -150,5 +150,17 @@ impl<'a> FaceStages<'a> {
         let Initial { mut mesh, curves } = initial;
         mesh.refine(self.surface(), &curves, &self.setup.crit, self.budget);
         mesh.tris.len()
+    }
+}
+
+impl FaceStages<'_> {
+    /// Debugging aid: the (u,v) corners of every triangle of `initial` (after
+    /// refinement when `refined`), each with whether it is inverted.
+    pub fn uv_triangles(&self, initial: Initial<'_>, refined: bool) -> Vec<([DVec2; 3], bool)> {
+        let Initial { mut mesh, curves } = initial;
+        if refined {
+            mesh.refine(self.surface(), &curves, &self.setup.crit, self.budget);
+        }
+        (0..mesh.tris.len()).map(|t| (mesh.uvs[t], mesh.inverted(self.surface(), t))).collect()
     }
 }

@@ -89,6 +89,20 @@ impl Loops<'_> {
         inside
     }
 
+    /// The pieces of the iso-line at `s` (v = s when `along_u`, else u = s)
+    /// inside the loops, as intervals of the line's running parameter (even-odd).
+    pub fn line_pieces(&self, along_u: bool, s: f64) -> Vec<(f64, f64)> {
+        let mut xs: Vec<f64> = Vec::new();
+        for (a, b) in self.segments() {
+            let (a, b) = if along_u { (a, b) } else { (DVec2::new(a.y, a.x), DVec2::new(b.y, b.x)) };
+            if (a.y > s) != (b.y > s) {
+                xs.push(a.x + (s - a.y) / (b.y - a.y) * (b.x - a.x));
+            }
+        }
+        xs.sort_by(|p, q| p.total_cmp(q));
+        xs.chunks_exact(2).map(|c| (c[0], c[1])).collect()
+    }
+
     /// Even-odd inside test against all loops.
     pub fn contains(&self, q: DVec2) -> bool {
         let mut inside = false;
@@ -154,6 +168,7 @@ pub(crate) fn prepare_loops<'a>(
             }
         }
         dedup_closed(&mut poly);
+        merge_close(&mut poly, surface, lim.min_edge);
         let n = poly.at.len();
         poly.seg = (0..n)
             .map(|i| {
@@ -206,6 +221,32 @@ pub(crate) fn prepare_loops<'a>(
         }
     }
     Ok(out)
+}
+
+/// Drops a node that lies within `eps` of the next one in model space and
+/// next to it in (u,v) too (a trim curve a few nanometres long that bridges
+/// two others in a file): such a segment would only make slivers. The later
+/// node stays, so the segment before it follows the curve that goes on.
+/// Nodes along a pole stay, far apart in (u,v) though one point in space.
+fn merge_close(p: &mut Polyline, surface: &dyn Surface, eps: f64) {
+    let [lo, hi] = surface.domain();
+    let near_uv = 1e-4 * (hi - lo).length();
+    let n = p.uv.len();
+    if n < 4 || eps.is_nan() || eps <= 0.0 {
+        return;
+    }
+    let pts: Vec<DVec3> = p.uv.iter().map(|&q| surface.point(q)).collect();
+    let keep: Vec<bool> = (0..n)
+        .map(|i| {
+            let j = (i + 1) % n;
+            !(pts[i].distance(pts[j]) < eps && p.uv[i].distance(p.uv[j]) < near_uv)
+        })
+        .collect();
+    if keep.iter().filter(|&&k| k).count() < 3 {
+        return;
+    }
+    p.uv = p.uv.iter().zip(&keep).filter(|(_, &k)| k).map(|(&q, _)| q).collect();
+    p.at = p.at.iter().zip(&keep).filter(|(_, &k)| k).map(|(&a, _)| a).collect();
 }
 
 /// Removes consecutive duplicate nodes, including last-equals-first.

@@ -65,7 +65,11 @@ fn check_common(name: &str, r: &MeshResult, rel: f64) -> usize {
         let f = (p[1] - p[0]).cross(p[2] - p[0]);
         let i = &r.mesh.indices[3 * t..3 * t + 3];
         let n: DVec3 = i.iter().map(|&k| r.mesh.normals[k as usize]).sum();
-        assert!(f.dot(n) >= 0.0, "{name} @ {rel}: triangle {t} faces against the surface normals");
+        assert!(
+            f.dot(n) >= 0.0,
+            "{name} @ {rel}: triangle {t} faces against the surface normals {p:?} {:?}",
+            i.iter().map(|&k| r.mesh.normals[k as usize]).collect::<Vec<_>>()
+        );
     }
     rep.triangles
 }
@@ -207,8 +211,7 @@ fn face_with_loops(loops: Vec<TrimLoop>) -> Model {
     Model {
         units: "mm".into(),
         faces: vec![Face { name: None, surface: FaceSurface::Nurbs(surface), loops }],
-        warnings: vec![],
-        tolerance: None,
+        ..Model::default()
     }
 }
 
@@ -369,7 +372,13 @@ fn mesh_two_faces_share_their_border_without_cracks() {
     let flat = height_patch(0.0, 10.0, |_, _| 0.0);
     let wavy = height_patch(10.0, 20.0, |x, t| if x > 10.0 { 8.0 * (t * 6.0).sin() } else { 0.0 });
     let face = |s| Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] };
-    let model = Model { units: "mm".into(), faces: vec![face(flat), face(wavy)], warnings: vec![], tolerance: None };
+    let model = Model {
+        units: "mm".into(),
+        faces: vec![face(flat), face(wavy)],
+        warnings: vec![],
+        tolerance: None,
+        bodies: vec![],
+    };
     for rel in RELS {
         let r = mesh(&model, rel);
         check_common("two faces", &r, rel);
@@ -407,7 +416,13 @@ fn mesh_reports_progress_and_stops_when_asked() {
     let flat = height_patch(0.0, 10.0, |_, _| 0.0);
     let wavy = height_patch(10.0, 20.0, |x, t| if x > 10.0 { 8.0 * (t * 6.0).sin() } else { 0.0 });
     let face = |s| Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] };
-    let model = Model { units: "mm".into(), faces: vec![face(flat), face(wavy)], warnings: vec![], tolerance: None };
+    let model = Model {
+        units: "mm".into(),
+        faces: vec![face(flat), face(wavy)],
+        warnings: vec![],
+        tolerance: None,
+        bodies: vec![],
+    };
     let mut seen = Vec::new();
     let r = surfmesh::mesh_model_with_progress(&model, &MeshOptions::default(), &mut |done, total| {
         seen.push((done, total));
@@ -441,8 +456,13 @@ fn mesh_split_surface_halves_reproduce_the_original() {
             }
         }
         let face = |x: surfmesh::NurbsSurface| Face { name: None, surface: FaceSurface::Nurbs(x), loops: vec![] };
-        let model =
-            Model { units: "mm".into(), faces: vec![face(left), face(right)], warnings: vec![], tolerance: None };
+        let model = Model {
+            units: "mm".into(),
+            faces: vec![face(left), face(right)],
+            warnings: vec![],
+            tolerance: None,
+            bodies: vec![],
+        };
         let r = mesh(&model, 1e-3);
         check_common("split sphere", &r, 1e-3);
         assert_eq!(r.report.boundary_edges, 0, "the two halves of a sphere close up");

@@ -41,6 +41,7 @@ fn model(loops: Vec<TrimLoop>) -> Model {
         faces: vec![Face { name: None, surface: FaceSurface::Nurbs(crowded_surface()), loops }],
         warnings: Vec::new(),
         tolerance: None,
+        bodies: Vec::new(),
     }
 }
 
@@ -188,6 +189,7 @@ fn reparam_force_on_degenerate_faces_falls_back_or_holds_tolerance() {
         faces: vec![Face { name: None, surface: FaceSurface::Nurbs(flat), loops: Vec::new() }],
         warnings: Vec::new(),
         tolerance: None,
+        bodies: Vec::new(),
     };
     let r = mesh_model(&m, &MeshOptions::default().with_tolerance(0.01).with_reparam(Reparam::Force));
     let r = r.unwrap();

@@ -204,6 +204,7 @@ impl ModelSpec {
                 .collect(),
             warnings: Vec::new(),
             tolerance: None,
+            bodies: Vec::new(),
         }
     }
 

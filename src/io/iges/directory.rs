@@ -24,6 +24,8 @@ pub(super) struct Entity {
     /// Subordinate switch of the status number (0 independent, 1 physically,
     /// 2 logically dependent, 3 both).
     pub subordinate: u8,
+    /// Blank status of the status number: the entity is hidden (not to be displayed).
+    pub blanked: bool,
     /// File line of its first P record.
     pub pline: usize,
     /// Parameters; `params[0]` is the entity type.
@@ -111,6 +113,7 @@ impl Directory {
             let status = a.data.get(64..72).unwrap_or(&[]);
             let digit = |i: usize| status.get(i).filter(|c| c.is_ascii_digit()).map_or(0, |c| c - b'0');
             let subordinate = digit(2) * 10 + digit(3);
+            let blanked = digit(0) * 10 + digit(1) == 1;
             let pcount = field(b, 3)?;
             let form = field(b, 4)?;
             let (pline, params) = parameters(p, de, kind, pstart, pcount, param, record)?;
@@ -120,6 +123,7 @@ impl Directory {
                 form,
                 xform: usize::try_from(xform.max(0)).unwrap_or(0),
                 subordinate,
+                blanked,
                 pline,
                 params,
             });

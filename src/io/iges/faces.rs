@@ -23,7 +23,9 @@ use crate::Error;
 
 /// The faces of the file, in directory order, with warnings for what was
 /// skipped; the first skip's error is kept for files where nothing is left.
-pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face>, Option<Error>) {
+/// Also each face's body: the B-rep shell (514, or 186's) it belongs to, 0
+/// for faces outside any.
+pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face>, Vec<u32>, Option<Error>) {
     let dir = ctx.dir;
     // Surfaces that faces (or offsets) use are not faces themselves.
     let mut used: HashSet<usize> = HashSet::new();
@@ -52,9 +54,26 @@ pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face
         }
     }
     let mut out = Vec::new();
+    let mut bodies: Vec<u32> = Vec::new();
+    let mut shell_body: hashbrown::HashMap<usize, u32> = hashbrown::HashMap::new();
     let mut first_error: Option<Error> = None;
     let mut unsupported: Vec<(u32, usize)> = Vec::new();
+    // Hidden (blanked) faces are not part of what the file shows, unless
+    // the file shows nothing else.
+    let face_entity = |e: &Entity| match e.kind {
+        144 | 143 | 186 => true,
+        514 => !shell_in_solid.contains(&e.de),
+        510 => !in_shell.contains(&e.de),
+        108 => !used.contains(&e.de),
+        k => is_surface(k) && !used.contains(&e.de) && e.subordinate & 1 == 0,
+    };
+    let any_shown = dir.entities.iter().any(|e| face_entity(e) && !e.blanked);
+    let mut hidden = 0usize;
     for e in &dir.entities {
+        if any_shown && e.blanked && face_entity(e) {
+            hidden += 1;
+            continue;
+        }
         let jobs: Vec<(usize, Job)> = match e.kind {
             144 => alloc::vec![(e.de, Job::Trimmed)],
             143 => alloc::vec![(e.de, Job::Bounded)],
@@ -102,17 +121,32 @@ pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face
                 Ok(mut face) => {
                     face.name = name_of(ctx, fe, &job);
                     out.push(face);
+                    let body = match &job {
+                        Job::Brep(parents) if !parents.is_empty() => {
+                            let next = shell_body.len() as u32 + 1;
+                            *shell_body.entry(parents[0]).or_insert(next)
+                        }
+                        _ => 0,
+                    };
+                    bodies.push(body);
                 }
                 Err(err) => skip(warnings, &mut first_error, fe, err),
             }
         }
+    }
+    if hidden > 0 {
+        warnings
+            .push(alloc::format!("{hidden} hidden (blanked) surface entities skipped: the file does not show them"));
     }
     for (kind, n) in unsupported {
         warnings.push(alloc::format!(
             "{n} entities of type {kind} (subfigures, instances, perforated planes) skipped: not supported"
         ));
     }
-    (out, first_error)
+    if bodies.iter().all(|&b| b == 0) {
+        bodies.clear();
+    }
+    (out, bodies, first_error)
 }
 
 /// How one face is read.

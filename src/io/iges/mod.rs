@@ -146,7 +146,7 @@ pub fn read_iges(bytes: &[u8]) -> Result<Model, Error> {
         world: DAffine3::from_scale(glam::DVec3::splat(1.0 / g.scale)),
         resolution: g.resolution.map(|r| r / g.scale),
     };
-    let (faces, first_error) = faces::read_faces(&ctx, &mut warnings);
+    let (faces, bodies, first_error) = faces::read_faces(&ctx, &mut warnings);
     if faces.is_empty() {
         return Err(first_error.unwrap_or_else(|| {
             iges_error(
@@ -157,7 +157,7 @@ pub fn read_iges(bytes: &[u8]) -> Result<Model, Error> {
             )
         }));
     }
-    Ok(Model { units: g.units, faces, warnings, tolerance: ctx.resolution })
+    Ok(Model { units: g.units, faces, warnings, tolerance: ctx.resolution, bodies })
 }
 
 /// The Global section: delimiters (fields 1–2), model space scale (13),

@@ -143,6 +143,15 @@ pub fn read_step_parts(bytes: &[u8]) -> Result<StepModel, Error> {
         });
         face_parts.push(k);
     }
-    let model = Model { units: plan.units.clone(), faces, warnings, tolerance: plan.tolerance };
+    // Each shell instance is a body of its own.
+    let mut bodies = alloc::vec![0u32; faces.len()];
+    for (k, s) in shapes.shells.iter().enumerate() {
+        for f in s.faces.clone() {
+            if let Some(b) = bodies.get_mut(f) {
+                *b = k as u32;
+            }
+        }
+    }
+    let model = Model { units: plan.units.clone(), faces, warnings, tolerance: plan.tolerance, bodies };
     Ok(StepModel { model, shells: shapes.shells, parts, face_parts, face_colours: shapes.colours })
 }
