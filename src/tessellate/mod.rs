@@ -220,6 +220,13 @@ pub fn mesh_model_with_progress(
                 if budget_hit { "triangle budget reached" } else { "edges at the minimum length" }
             ));
         }
+        if out.creased > 0 {
+            report.warnings.push(format!(
+                "face {index}: {} triangles turn more than the angle limit where the surface folds or creases; \
+                 not split below a tenth of the tolerance",
+                out.creased
+            ));
+        }
         outcomes.push(out);
     }
     let mut mesh = Mesh::default();

@@ -343,3 +343,24 @@ fn corpus_meshes_within_tolerance_watertight() {
     }
     assert!(failures.is_empty(), "STEP corpus failures:\n{}", failures.join("\n"));
 }
+
+/// Found by fuzzing (a timeout): a mutated bicubic sheet whose control point
+/// pulled far out folds the surface inside the face. Across the fold the
+/// normal flips however small the triangle, so the angle limit split down to
+/// the minimum edge: 111k triangles at relative 0.05 (3.9M and two minutes at
+/// 1e-3). Triangles that fail only the angle limit are no longer split below
+/// a tenth of the tolerance, and the report says where that happened.
+#[test]
+fn fuzz_timeout_folded_sheet_meshes_without_exploding() {
+    let model = read_step(&data("step_fuzz_timeout_fold.stp")).unwrap();
+    assert_eq!(model.faces.len(), 1);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(0.05)).expect("meshes");
+    let rep = &r.report;
+    assert!(rep.triangles > 0 && rep.triangles < 30_000, "{} triangles", rep.triangles);
+    assert!(rep.max_deviation <= rep.tolerance, "deviation {} > {}", rep.max_deviation, rep.tolerance);
+    assert!(
+        rep.warnings.iter().any(|w| w.starts_with("face 0: ") && w.contains("folds or creases")),
+        "{:?}",
+        rep.warnings
+    );
+}
