@@ -295,18 +295,18 @@ fn domain_outline<'a>(surface: &dyn Surface, loops: &'a [crate::TrimLoop], lim: 
 /// an iso-line (all of them when `whole`, else those that collapse to a point).
 #[cfg(feature = "std")]
 fn align_to_grid(surface: &dyn Surface, loops: &mut super::trim::Loops<'_>, pu: &[f64], pv: &[f64], whole: bool) {
-    use super::trim::CurveRef;
+    use super::trim::Polyline;
     let span = (pu.last().copied().unwrap_or(0.0) - pu.first().copied().unwrap_or(0.0)).abs()
         + (pv.last().copied().unwrap_or(0.0) - pv.first().copied().unwrap_or(0.0)).abs();
     let eps = 1e-9 * span.max(1e-300);
     for poly in &mut loops.polys {
         let n = poly.uv.len();
-        let (mut uv, mut at, mut seg) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+        let mut out = Polyline { uv: Vec::with_capacity(n), at: Vec::with_capacity(n), seg: Vec::with_capacity(n) };
         for i in 0..n {
             let (a, b) = (poly.uv[i], poly.uv[(i + 1) % n]);
             let (curve, ta, tb) = poly.seg[i];
-            uv.push(a);
-            at.push(poly.at[i]);
+            out.uv.push(a);
+            out.at.push(poly.at[i]);
             let c = loops.curves.get(curve as usize);
             let (pa, pb) = (surface.point(a), surface.point(b));
             let collapsed = pa.distance(pb) <= 1e-12 * (1.0 + pa.length());
@@ -332,17 +332,12 @@ fn align_to_grid(surface: &dyn Surface, loops: &mut super::trim::Loops<'_>, pu: 
                     if q.distance(a.lerp(b, (x - x0) / (x1 - x0))) > 1e3 * eps {
                         continue;
                     }
-                    seg.push((curve, from, t));
-                    uv.push(q);
-                    at.push(CurveRef { curve, t });
-                    from = t;
+                    out.push_on_curve(curve, &mut from, t, q);
                 }
             }
-            seg.push((curve, from, tb));
+            out.seg.push((curve, from, tb));
         }
-        poly.uv = uv;
-        poly.at = at;
-        poly.seg = seg;
+        *poly = out;
     }
 }
 

@@ -82,7 +82,7 @@ mod outlines {
     use super::{cell_of, golden, Cell};
     use crate::nurbs::Surface;
     use crate::tessellate::face::Outline;
-    use crate::tessellate::trim::CurveRef;
+    use crate::tessellate::trim::Polyline;
 
     /// A node of some face's outline: face, loop, index.
     type NodeRef = (u32, u32, u32);
@@ -339,28 +339,23 @@ mod outlines {
                     continue;
                 }
                 let poly = &mut o.loops.polys[k];
-                let (mut uv, mut at, mut seg) = (Vec::new(), Vec::new(), Vec::new());
+                let mut out = Polyline::default();
                 // Twins are named by their index in the new loop, fixed below.
                 let mut new_twins = Vec::new();
                 for i in 0..poly.uv.len() {
                     let (curve, ta, tb) = poly.seg[i];
-                    moved[fi][k][i] = uv.len() as u32;
-                    uv.push(poly.uv[i]);
-                    at.push(poly.at[i]);
+                    moved[fi][k][i] = out.uv.len() as u32;
+                    out.uv.push(poly.uv[i]);
+                    out.at.push(poly.at[i]);
                     let mut from = ta;
                     for &(_, t, q) in &add[i] {
                         let Some(c) = o.loops.curves.get(curve as usize) else { break };
-                        seg.push((curve, from, t));
-                        new_twins.push((uv.len() as u32, q));
-                        uv.push(c.point(t).truncate());
-                        at.push(CurveRef { curve, t });
-                        from = t;
+                        new_twins.push((out.uv.len() as u32, q));
+                        out.push_on_curve(curve, &mut from, t, c.point(t).truncate());
                     }
-                    seg.push((curve, from, tb));
+                    out.seg.push((curve, from, tb));
                 }
-                poly.uv = uv;
-                poly.at = at;
-                poly.seg = seg;
+                *poly = out;
                 o.gids[k] = alloc::vec![u32::MAX; poly.uv.len()];
                 twins.extend(new_twins.into_iter().map(|(i, q)| ((fi as u32, k as u32, i), q)));
             }

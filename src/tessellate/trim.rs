@@ -30,6 +30,17 @@ pub(crate) struct Polyline {
     pub seg: Vec<(u32, f64, f64)>,
 }
 
+impl Polyline {
+    /// Appends a node at parameter `t` of `curve` (at `q` in (u,v)) inside the
+    /// segment being built, which follows `curve` from `*from`; `*from` moves on to `t`.
+    pub fn push_on_curve(&mut self, curve: u32, from: &mut f64, t: f64, q: DVec2) {
+        self.seg.push((curve, *from, t));
+        self.uv.push(q);
+        self.at.push(CurveRef { curve, t });
+        *from = t;
+    }
+}
+
 /// All loops of one face, discretized and oriented: outer counter-clockwise
 /// first, holes clockwise after it.
 #[derive(Debug, Clone, Default)]

@@ -365,20 +365,19 @@ fn open_edges_on_x10(m: &Mesh) -> usize {
     uses.iter().filter(|(e, &n)| n == 1 && on_seam(&e.0) && on_seam(&e.1)).count()
 }
 
+/// A flat face and a wavy one that meet along the straight line x = 10.
+fn flat_and_wavy() -> Model {
+    let flat = height_patch(0.0, 10.0, |_, _| 0.0);
+    let wavy = height_patch(10.0, 20.0, |x, t| if x > 10.0 { 8.0 * (t * 6.0).sin() } else { 0.0 });
+    let face = |s| Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] };
+    Model { units: "mm".into(), faces: vec![face(flat), face(wavy)], warnings: vec![], tolerance: None, bodies: vec![] }
+}
+
 #[test]
 fn mesh_two_faces_share_their_border_without_cracks() {
     // A flat face and a wavy one meet along the straight line x = 10: the wavy
     // face needs many more border nodes than the flat one.
-    let flat = height_patch(0.0, 10.0, |_, _| 0.0);
-    let wavy = height_patch(10.0, 20.0, |x, t| if x > 10.0 { 8.0 * (t * 6.0).sin() } else { 0.0 });
-    let face = |s| Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] };
-    let model = Model {
-        units: "mm".into(),
-        faces: vec![face(flat), face(wavy)],
-        warnings: vec![],
-        tolerance: None,
-        bodies: vec![],
-    };
+    let model = flat_and_wavy();
     for rel in RELS {
         let r = mesh(&model, rel);
         check_common("two faces", &r, rel);
@@ -413,16 +412,7 @@ fn mesh_saddle_refines_without_slivers() {
 
 #[test]
 fn mesh_reports_progress_and_stops_when_asked() {
-    let flat = height_patch(0.0, 10.0, |_, _| 0.0);
-    let wavy = height_patch(10.0, 20.0, |x, t| if x > 10.0 { 8.0 * (t * 6.0).sin() } else { 0.0 });
-    let face = |s| Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] };
-    let model = Model {
-        units: "mm".into(),
-        faces: vec![face(flat), face(wavy)],
-        warnings: vec![],
-        tolerance: None,
-        bodies: vec![],
-    };
+    let model = flat_and_wavy();
     let mut seen = Vec::new();
     let r = surfmesh::mesh_model_with_progress(&model, &MeshOptions::default(), &mut |done, total| {
         seen.push((done, total));
