@@ -9,7 +9,7 @@ use surfmesh::{mesh_model, read_iges, MeshOptions};
 fuzz_target!(|data: &[u8]| {
     if let Ok(model) = read_iges(data) {
         // A small budget keeps each run short; errors are fine, panics are not.
-        let options = MeshOptions::default().with_relative_tolerance(0.05).with_max_triangles(20_000);
+        let options = MeshOptions::default().with_relative_tolerance(0.05).with_max_triangles(5_000);
         let _ = mesh_model(&model, &options);
     }
 });
