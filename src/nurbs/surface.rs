@@ -146,6 +146,7 @@ impl NurbsSurface {
         match self.ku.degree().max(self.kv.degree()) {
             0..=3 => self.homogeneous_derivs_n::<4>(uv, order),
             4..=7 => self.homogeneous_derivs_n::<8>(uv, order),
+            8..=11 => self.homogeneous_derivs_n::<12>(uv, order),
             _ => self.homogeneous_derivs_n::<{ super::MAX_DEGREE + 1 }>(uv, order),
         }
     }
@@ -156,6 +157,7 @@ impl NurbsSurface {
         match self.ku.degree().max(self.kv.degree()) {
             0..=3 => self.points_on_grid_n::<4>(us, vs),
             4..=7 => self.points_on_grid_n::<8>(us, vs),
+            8..=11 => self.points_on_grid_n::<12>(us, vs),
             _ => self.points_on_grid_n::<{ super::MAX_DEGREE + 1 }>(us, vs),
         }
     }
