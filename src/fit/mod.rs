@@ -21,13 +21,13 @@ mod polynet;
 mod tessellate;
 mod trinet;
 
+use crate::collections::HashMap;
 use alloc::format;
 use alloc::string::String;
 use alloc::vec;
 use alloc::vec::Vec;
 use core::f64::consts::PI;
 use glam::DVec3;
-use hashbrown::HashMap;
 use serde::Serialize;
 
 pub use bezier::{Cubic, PatchPoint, TriPatch};
@@ -186,7 +186,7 @@ pub struct FitSurface {
 impl FitSurface {
     /// The curve net: every polygon edge once, as `(a, b, cubic from a to b)` with `a < b`.
     pub fn edges(&self) -> Vec<(u32, u32, Cubic)> {
-        let mut seen: HashMap<(u32, u32), ()> = HashMap::new();
+        let mut seen: HashMap<(u32, u32), ()> = HashMap::default();
         let mut out = Vec::new();
         for poly in &self.polygons {
             let n = poly.corners.len();
@@ -216,7 +216,7 @@ impl FitSurface {
     pub fn max_g1_angle(&self, samples: usize) -> f64 {
         let samples = samples.max(1);
         let mut worst: f64 = 0.0;
-        let mut by_edge: HashMap<(u32, u32), (usize, usize)> = HashMap::new();
+        let mut by_edge: HashMap<(u32, u32), (usize, usize)> = HashMap::default();
         for (pi, poly) in self.polygons.iter().enumerate() {
             let n = poly.patches.len();
             for i in 0..n {
@@ -493,7 +493,7 @@ fn merge_duplicates(points: &[DVec3], dist: f64) -> (Vec<DVec3>, Vec<u32>) {
     let mut index = Vec::with_capacity(points.len());
     if !(dist > 0.0) {
         // Exact duplicates only.
-        let mut seen: HashMap<[u64; 3], u32> = HashMap::new();
+        let mut seen: HashMap<[u64; 3], u32> = HashMap::default();
         for p in points {
             let key = p.to_array().map(|c| (c + 0.0).to_bits());
             let k = *seen.entry(key).or_insert_with(|| {
@@ -509,7 +509,7 @@ fn merge_duplicates(points: &[DVec3], dist: f64) -> (Vec<DVec3>, Vec<u32>) {
         let f = |x: f64| libm::floor(x * inv) as i64;
         (f(p.x), f(p.y), f(p.z))
     };
-    let mut grid: HashMap<(i64, i64, i64), Vec<u32>> = HashMap::new();
+    let mut grid: HashMap<(i64, i64, i64), Vec<u32>> = HashMap::default();
     let d2 = dist * dist;
     for p in points {
         let c = cell(*p);

@@ -17,10 +17,10 @@
 //! every corner normal within `max_tilt` of the polygon's plane normal, so
 //! that the projection stays faithful on curved surfaces.
 
+use crate::collections::HashMap;
 use alloc::vec;
 use alloc::vec::Vec;
 use glam::DVec3;
-use hashbrown::HashMap;
 
 use super::bezier::{Cubic, TriPatch};
 use super::curvenet::edge_curve;
@@ -72,7 +72,7 @@ fn acceptable(points: &[DVec3], normals: &[DVec3], corners: &[u32], opt: &PolyOp
 /// Merges the triangles into polygons (corner lists, counter-clockwise).
 pub(crate) fn merge(points: &[DVec3], normals: &[DVec3], tris: &[[u32; 3]], opt: &PolyOptions) -> Vec<Vec<u32>> {
     // Directed edge → triangle.
-    let mut by_edge: HashMap<(u32, u32), usize> = HashMap::new();
+    let mut by_edge: HashMap<(u32, u32), usize> = HashMap::default();
     for (t, tri) in tris.iter().enumerate() {
         for k in 0..3 {
             by_edge.insert((tri[k], tri[(k + 1) % 3]), t);

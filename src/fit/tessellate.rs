@@ -8,9 +8,9 @@
 //! vertices. A sub-patch whose net edge has more segments than its own
 //! level joins that edge to its first inner row by a zipper strip.
 
+use crate::collections::HashMap;
 use alloc::vec::Vec;
 use glam::DVec3;
-use hashbrown::HashMap;
 
 use super::bezier::TriPatch;
 use crate::mesh::{FaceRange, Mesh};
@@ -50,7 +50,7 @@ pub(crate) fn tessellate(
 ) -> Tessellation {
     let levels: Vec<usize> =
         polys.iter().map(|p| p.patches.iter().map(|s| s.level_for(tol, max_level)).max().unwrap_or(1).max(1)).collect();
-    let mut edge_level: HashMap<(u32, u32), usize> = HashMap::new();
+    let mut edge_level: HashMap<(u32, u32), usize> = HashMap::default();
     for (p, poly) in polys.iter().enumerate() {
         let n = poly.corners.len();
         for i in 0..n {
@@ -63,9 +63,9 @@ pub(crate) fn tessellate(
     let mut mesh = Mesh::default();
     let mut sources = Vec::new();
     // Net vertex → mesh vertex.
-    let mut corner_vertex: HashMap<u32, u32> = HashMap::new();
+    let mut corner_vertex: HashMap<u32, u32> = HashMap::default();
     // Net edge (low, high) → interior vertices, low to high.
-    let mut edge_vertices: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+    let mut edge_vertices: HashMap<(u32, u32), Vec<u32>> = HashMap::default();
     let push = |mesh: &mut Mesh, p: DVec3, n: DVec3| -> u32 {
         mesh.positions.push(p);
         mesh.normals.push(n);

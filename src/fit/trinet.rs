@@ -23,10 +23,10 @@
 //!    triangles after the swap agree clearly better with their corners'
 //!    tangent planes and stay well shaped.
 
+use crate::collections::{HashMap, HashSet};
 use alloc::vec::Vec;
 use core::f64::consts::{PI, TAU};
 use glam::{DVec2, DVec3};
-use hashbrown::{HashMap, HashSet};
 
 use super::delaunay::{orient, triangulate};
 use super::linalg::frame;
@@ -108,7 +108,7 @@ pub(crate) fn build(points: &[DVec3], normals: &[DVec3], nb: &Neighbours, opt: &
     let mut cands = propose(points, normals, nb, opt, &frames, cos_normal);
     cands.sort_by(|a, b| b.votes.cmp(&a.votes).then(b.quality.total_cmp(&a.quality)).then(a.tri.cmp(&b.tri)));
 
-    let mut net = Net { directed: HashSet::new(), arcs: alloc::vec![Vec::new(); points.len()], tris: Vec::new() };
+    let mut net = Net { directed: HashSet::default(), arcs: alloc::vec![Vec::new(); points.len()], tris: Vec::new() };
     for c in &cands {
         net.try_add(c.tri, &frames);
     }
@@ -127,7 +127,7 @@ fn propose(
     frames: &Frames,
     cos_normal: f64,
 ) -> Vec<Candidate> {
-    let mut map: HashMap<[u32; 3], usize> = HashMap::new();
+    let mut map: HashMap<[u32; 3], usize> = HashMap::default();
     let mut cands: Vec<Candidate> = Vec::new();
     let mut local: Vec<u32> = Vec::new();
     let mut flat: Vec<DVec2> = Vec::new();
@@ -246,7 +246,7 @@ fn fill_holes(
     let mut orphans: Vec<u32> = Vec::new();
     loop {
         let (mut open, mut borders) = (0, 0);
-        let mut widen: HashSet<u32> = HashSet::new();
+        let mut widen: HashSet<u32> = HashSet::default();
         for lp in boundary_loops(net, frames) {
             match classify(points, normals, &lp, max_edges) {
                 LoopKind::Border => borders += 1,
@@ -288,14 +288,14 @@ const HOLE_RETRIES: usize = 3;
 /// The closed boundary loops of the net (vertex lists in the direction of
 /// their boundary edges), split where a loop passes a vertex twice.
 fn boundary_loops(net: &Net, frames: &Frames) -> Vec<Vec<u32>> {
-    let mut out: HashMap<u32, Vec<u32>> = HashMap::new();
+    let mut out: HashMap<u32, Vec<u32>> = HashMap::default();
     let mut boundary: Vec<(u32, u32)> =
         net.directed.iter().filter(|(a, b)| !net.directed.contains(&(*b, *a))).copied().collect();
     boundary.sort_unstable();
     for &(a, b) in &boundary {
         out.entry(a).or_default().push(b);
     }
-    let mut seen: HashSet<(u32, u32)> = HashSet::new();
+    let mut seen: HashSet<(u32, u32)> = HashSet::default();
     let mut loops: Vec<Vec<u32>> = Vec::new();
     for &start in &boundary {
         if seen.contains(&start) {
@@ -516,7 +516,7 @@ fn delaunay_fill(
             tris.push([verts[t[0]], verts[t[1]], verts[t[2]]]);
         }
     }
-    let mut made: HashSet<(u32, u32)> = HashSet::new();
+    let mut made: HashSet<(u32, u32)> = HashSet::default();
     for t in &tris {
         if !faces_like_normals(points, normals, *t) {
             return None;
@@ -547,7 +547,7 @@ fn swap_edges(points: &[DVec3], normals: &[DVec3], tris: &mut [[u32; 3]]) -> usi
     let quality = |t: [u32; 3]| min_angle(points[t[0] as usize], points[t[1] as usize], points[t[2] as usize]);
     let mut swaps = 0;
     for _pass in 0..SWAP_PASSES {
-        let mut edges: HashMap<(u32, u32), usize> = HashMap::new();
+        let mut edges: HashMap<(u32, u32), usize> = HashMap::default();
         for (i, t) in tris.iter().enumerate() {
             for k in 0..3 {
                 edges.insert((t[k], t[(k + 1) % 3]), i);
@@ -649,7 +649,7 @@ mod tests {
         let (net, normals) = net_of(&pts, 16);
         assert_eq!((net.borders, net.holes_open), (1, 0));
         // Every directed edge once, every point used, triangles facing like the normals.
-        let mut directed = HashSet::new();
+        let mut directed = HashSet::default();
         let mut used = vec![false; pts.len()];
         for t in &net.tris {
             for k in 0..3 {

@@ -84,7 +84,7 @@ pub fn read_mesh(bytes: &[u8], format: MeshFormat) -> Result<Mesh, Error> {
 pub(crate) struct MeshBuilder {
     positions: Vec<DVec3>,
     indices: Vec<u32>,
-    ids: hashbrown::HashMap<[u64; 3], u32>,
+    ids: crate::collections::HashMap<[u64; 3], u32>,
 }
 
 impl MeshBuilder {

@@ -40,7 +40,7 @@ pub(super) struct SharedNodes {
 /// drops triangles that point past the vertex list, touch a non-finite
 /// position, or repeat a node; vertices no triangle uses are not nodes.
 pub(super) fn shared_nodes(mesh: &Mesh) -> SharedNodes {
-    let mut ids: hashbrown::HashMap<[u64; 3], u32> = hashbrown::HashMap::new();
+    let mut ids: crate::collections::HashMap<[u64; 3], u32> = crate::collections::HashMap::default();
     let mut node_of = alloc::vec![u32::MAX; mesh.positions.len()];
     let mut out = SharedNodes { positions: Vec::new(), faces: Vec::new(), owner: Vec::new() };
     for (face, range) in face_ranges(mesh).into_iter().enumerate() {
@@ -235,7 +235,7 @@ pub fn read_msh(bytes: &[u8]) -> Result<Mesh, Error> {
     let bound = text.len() / 2 + 1;
     let mut w = Words::new(text);
     let mut version_seen = false;
-    let mut tags: hashbrown::HashMap<u64, u32> = hashbrown::HashMap::new();
+    let mut tags: crate::collections::HashMap<u64, u32> = crate::collections::HashMap::default();
     let mut mesh = Mesh::default();
     let mut last_entity: Option<i64> = None;
     while let Some(section) = w.next_word() {
@@ -274,7 +274,7 @@ pub fn read_msh(bytes: &[u8]) -> Result<Mesh, Error> {
 fn read_nodes(
     w: &mut Words<'_>,
     bound: usize,
-    tags: &mut hashbrown::HashMap<u64, u32>,
+    tags: &mut crate::collections::HashMap<u64, u32>,
     mesh: &mut Mesh,
 ) -> Result<(), Error> {
     let blocks = w.count("the number of node blocks")?;
@@ -322,7 +322,7 @@ fn read_nodes(
 fn read_elements(
     w: &mut Words<'_>,
     bound: usize,
-    tags: &hashbrown::HashMap<u64, u32>,
+    tags: &crate::collections::HashMap<u64, u32>,
     mesh: &mut Mesh,
     last_entity: &mut Option<i64>,
 ) -> Result<(), Error> {

@@ -45,7 +45,7 @@ pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol
                 }
             }
         }
-        let mut ids: hashbrown::HashMap<(u32, u32), u32> = hashbrown::HashMap::new();
+        let mut ids: crate::collections::HashMap<(u32, u32), u32> = crate::collections::HashMap::default();
         for (v, m) in map.iter_mut().enumerate() {
             let next = ids.len() as u32;
             *m = *ids.entry((*m, body_of_vertex[v])).or_insert(next);
@@ -58,8 +58,8 @@ pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol
         pos[m as usize] = mesh.positions[i];
     }
     // Directed edge counts keyed by the undirected pair.
-    let mut edges: hashbrown::HashMap<(u32, u32), (u32, u32)> = hashbrown::HashMap::new();
-    let mut owner: hashbrown::HashMap<(u32, u32), u32> = hashbrown::HashMap::new();
+    let mut edges: crate::collections::HashMap<(u32, u32), (u32, u32)> = crate::collections::HashMap::default();
+    let mut owner: crate::collections::HashMap<(u32, u32), u32> = crate::collections::HashMap::default();
     for (ti, t) in mesh.indices.chunks_exact(3).enumerate() {
         let v = [map[t[0] as usize], map[t[1] as usize], map[t[2] as usize]];
         if v[0] == v[1] || v[1] == v[2] || v[2] == v[0] {
@@ -120,9 +120,9 @@ fn count_cracks(free: &[(u32, u32, u32)], pos: &[DVec3], sew: f64, body: &dyn Fn
         Vertex(u32),
         Mid,
     }
-    type Cells = hashbrown::HashMap<(i64, i64, i64), Vec<(DVec3, Tag, u32)>>;
-    let mut grid: Cells = hashbrown::HashMap::new();
-    let mut seen = hashbrown::HashSet::new();
+    type Cells = crate::collections::HashMap<(i64, i64, i64), Vec<(DVec3, Tag, u32)>>;
+    let mut grid: Cells = crate::collections::HashMap::default();
+    let mut seen = crate::collections::HashSet::default();
     for &(a, b, f) in free {
         for v in [a, b] {
             if seen.insert((v, f)) {

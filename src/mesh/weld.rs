@@ -8,7 +8,7 @@ use glam::DVec3;
 pub fn weld_positions(positions: &[DVec3], tol: f64) -> (Vec<u32>, usize) {
     let tol = if tol > 0.0 && tol.is_finite() { tol } else { 1e-12 };
     let inv = 1.0 / tol;
-    let mut cells: hashbrown::HashMap<(i64, i64, i64), Vec<u32>> = hashbrown::HashMap::new();
+    let mut cells: crate::collections::HashMap<(i64, i64, i64), Vec<u32>> = crate::collections::HashMap::default();
     let mut map = Vec::with_capacity(positions.len());
     let mut reps: Vec<DVec3> = Vec::new();
     let key = |p: DVec3| -> (i64, i64, i64) {

@@ -492,7 +492,7 @@ fn same_direction(a: &Piece, b: &Piece, samples: &[Samples]) -> bool {
 /// stay alone. The first piece of each group is its master.
 fn match_pieces(pieces: &[Piece], samples: &[Samples], sew: f64) -> Vec<Vec<usize>> {
     let mut groups: Vec<Vec<usize>> = Vec::new();
-    let mut by_key: hashbrown::HashMap<(u32, u32), Vec<usize>> = hashbrown::HashMap::new();
+    let mut by_key: crate::collections::HashMap<(u32, u32), Vec<usize>> = crate::collections::HashMap::default();
     for (i, p) in pieces.iter().enumerate() {
         let len = p.len();
         if len <= sew {

@@ -50,7 +50,7 @@ pub(crate) fn fill(pos: &[DVec2], h: &[f64], loops: &[Vec<u32>], max_nodes: usiz
         .exclude_outer_faces(true)
         .with_max_additional_vertices(max_nodes.saturating_sub(pos.len()));
     let result = cdt.refine(params);
-    let excluded: hashbrown::HashSet<usize> = result.excluded_faces.iter().map(|f| f.index()).collect();
+    let excluded: crate::collections::HashSet<usize> = result.excluded_faces.iter().map(|f| f.index()).collect();
     let mut out = Filled { pos: pos.to_vec(), h: h.to_vec(), ..Filled::default() };
     for v in cdt.vertices().skip(pos.len()) {
         let p = v.position();

@@ -254,7 +254,7 @@ fn fill_quality(mesh: &Mesh, qr: &mut QualityReport, weld: f64) {
         .count();
     qr.good_angle_fraction = good as f64 / n as f64;
     let (map, _) = weld_positions(&mesh.positions, weld);
-    let mut seen: hashbrown::HashSet<(u32, u32)> = hashbrown::HashSet::new();
+    let mut seen: crate::collections::HashSet<(u32, u32)> = crate::collections::HashSet::default();
     let (mut count, mut band, mut sum) = (0usize, 0usize, 0.0);
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for t in mesh.indices.chunks_exact(3) {

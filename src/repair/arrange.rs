@@ -26,12 +26,12 @@ const MARGIN: f64 = 1e-10;
 /// others as triangles that need them are sub-triangulated.
 pub(crate) struct Points {
     pub pos: Vec<DVec3>,
-    ids: hashbrown::HashMap<PointKey, u32>,
+    ids: crate::collections::HashMap<PointKey, u32>,
 }
 
 impl Points {
     pub(crate) fn new(vertices: &[DVec3]) -> Self {
-        Self { pos: vertices.to_vec(), ids: hashbrown::HashMap::new() }
+        Self { pos: vertices.to_vec(), ids: crate::collections::HashMap::default() }
     }
 
     fn id(&mut self, k: PointKey, g: &Geometry<'_>) -> u32 {

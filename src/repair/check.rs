@@ -26,7 +26,8 @@ pub struct EdgeCensus {
 }
 
 pub(crate) fn census(tris: &[[u32; 3]]) -> EdgeCensus {
-    let mut uses: hashbrown::HashMap<(u32, u32), (u32, u32)> = hashbrown::HashMap::with_capacity(tris.len() * 3 / 2);
+    let mut uses: crate::collections::HashMap<(u32, u32), (u32, u32)> =
+        crate::collections::HashMap::with_capacity_and_hasher(tris.len() * 3 / 2, Default::default());
     for t in tris {
         for k in 0..3 {
             let (a, b) = edge(t, k);

@@ -29,7 +29,7 @@ pub(crate) struct Intersections {
     /// Segments of triangle `t`: `by_tri[start[t] .. start[t + 1]]`.
     start: Vec<u32>,
     by_tri: Vec<u32>,
-    by_pair: hashbrown::HashMap<(u32, u32), u32>,
+    by_pair: crate::collections::HashMap<(u32, u32), u32>,
     /// Pairs whose boxes overlap (narrow-phase tests).
     pub candidates: usize,
     /// Pairs that touch or overlap in a way not handled (coplanar overlap, a
@@ -112,7 +112,7 @@ pub(crate) fn find_intersections(
     let start = count.clone();
     let mut by_tri = alloc::vec![0u32; 2 * segments.len()];
     let mut fill = count;
-    let mut by_pair = hashbrown::HashMap::with_capacity(segments.len());
+    let mut by_pair = crate::collections::HashMap::with_capacity_and_hasher(segments.len(), Default::default());
     for (i, s) in segments.iter().enumerate() {
         for t in s.tris {
             by_tri[fill[t as usize] as usize] = i as u32;

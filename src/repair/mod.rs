@@ -517,7 +517,8 @@ fn perturbed(positions: &[DVec3], size: f64) -> Vec<DVec3> {
 /// pocket), and only the first is kept when they face the same way.
 fn drop_collapsed_and_duplicates(tris: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
     let tris: Vec<[u32; 3]> = tris.into_iter().filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0]).collect();
-    let mut seen: hashbrown::HashMap<[u32; 3], (usize, bool)> = hashbrown::HashMap::with_capacity(tris.len());
+    let mut seen: crate::collections::HashMap<[u32; 3], (usize, bool)> =
+        crate::collections::HashMap::with_capacity_and_hasher(tris.len(), Default::default());
     let mut keep = alloc::vec![true; tris.len()];
     for (i, t) in tris.iter().enumerate() {
         let mut s = *t;

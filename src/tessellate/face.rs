@@ -547,7 +547,7 @@ impl Band {
     /// triangle on both sides (a seam) is an inner edge, not a trim edge.
     pub fn build(&self, surface: &dyn Surface, tris: &[[u32; 3]], wm: &mut WorkMesh, gids: Option<&[Vec<u32>]>) {
         let flat: Vec<u32> = gids.map(|g| g.iter().flatten().copied().collect()).unwrap_or_default();
-        let mut by_gid: hashbrown::HashMap<u32, u32> = hashbrown::HashMap::new();
+        let mut by_gid: crate::collections::HashMap<u32, u32> = crate::collections::HashMap::default();
         let mut vid = Vec::with_capacity(self.nodes.len());
         for (k, &q) in self.nodes.iter().enumerate() {
             let g = flat.get(k).copied().unwrap_or(u32::MAX);

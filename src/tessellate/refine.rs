@@ -3,9 +3,9 @@
 //! edge too long is split at its longest edge (with the neighbour across that
 //! edge, so the mesh stays conforming), until all pass.
 
+use crate::collections::HashMap;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
-use hashbrown::HashMap;
 
 use super::measure::{measure_projection, measure_triangle, TriMeasure};
 use crate::math::angle_between;
@@ -37,7 +37,7 @@ pub(crate) struct WorkMesh {
     pub gid: Vec<u32>,
     /// Border edges another face (or another stretch of this face's border,
     /// across a seam) shares: a split of one must be made in the other.
-    pub shared: hashbrown::HashSet<(u32, u32)>,
+    pub shared: crate::collections::HashSet<(u32, u32)>,
     /// Shared edges refinement split, as `(a, b, new vertex)`, for the caller
     /// to make the same split where the edge is shared.
     pub events: Vec<(u32, u32, u32)>,

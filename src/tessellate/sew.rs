@@ -12,9 +12,9 @@
 //! At the end every node takes one position. Welding then leaves no crack
 //! and no T-junction, and each face's triangles are proven after its last split.
 
+use crate::collections::HashMap;
 use alloc::vec::Vec;
 use glam::DVec3;
-use hashbrown::HashMap;
 
 use super::refine::{Criteria, WorkMesh};
 use crate::nurbs::{NurbsCurve, Surface};
@@ -75,9 +75,9 @@ fn golden(dist: &dyn Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
 /// Sewing of face outlines before they are triangulated.
 #[cfg(feature = "std")]
 mod outlines {
+    use crate::collections::HashMap;
     use alloc::vec::Vec;
     use glam::DVec3;
-    use hashbrown::HashMap;
 
     use super::{cell_of, golden, Cell};
     use crate::nurbs::Surface;
@@ -198,7 +198,7 @@ mod outlines {
         let radius = radii(pos, sew);
         // Nodes hashed on a grid about one loop segment long.
         let inv = 1.0 / mean_segment.max(reach).max(1e-300);
-        let mut grid: HashMap<Cell, Vec<NodeRef>> = HashMap::new();
+        let mut grid: HashMap<Cell, Vec<NodeRef>> = HashMap::default();
         for (fi, f) in pos.iter().enumerate() {
             for (k, p) in f.iter().enumerate() {
                 for (i, &q) in p.iter().enumerate() {
@@ -273,8 +273,8 @@ mod outlines {
         // Of one face's borders it goes onto the nearest only (and onto
         // another as near within `tight`, the other side of a seam): a face
         // pinched narrower than `sew` is not sewn across its neck.
-        let mut nearest: HashMap<NodeRef, f64> = HashMap::new();
-        let mut nearest_in: HashMap<(NodeRef, u32), f64> = HashMap::new();
+        let mut nearest: HashMap<NodeRef, f64> = HashMap::default();
+        let mut nearest_in: HashMap<(NodeRef, u32), f64> = HashMap::default();
         for &(seg, _, _, d, q) in &cands {
             if seg.0 != q.0 {
                 let e = nearest.entry(q).or_insert(f64::INFINITY);
@@ -426,7 +426,7 @@ mod outlines {
             let Some((_, o)) = item else { continue };
             for (k, poly) in o.loops.polys.iter().enumerate() {
                 let mut old = 0usize;
-                let new_here: hashbrown::HashSet<u32> =
+                let new_here: crate::collections::HashSet<u32> =
                     twins.iter().filter(|(n, _)| n.0 as usize == fi && n.1 as usize == k).map(|(n, _)| n.2).collect();
                 for i in 0..poly.uv.len() {
                     if !new_here.contains(&(i as u32)) {
@@ -457,7 +457,7 @@ mod outlines {
         }
         if sew > 0.0 {
             let inv = 1.0 / sew;
-            let mut grid: HashMap<Cell, Vec<u32>> = HashMap::new();
+            let mut grid: HashMap<Cell, Vec<u32>> = HashMap::default();
             for (i, &(_, p)) in flat.iter().enumerate() {
                 grid.entry(cell_of(p, inv)).or_default().push(i as u32);
             }
@@ -493,7 +493,7 @@ mod outlines {
             }
         }
         // Compact ids.
-        let mut ids: HashMap<u32, u32> = HashMap::new();
+        let mut ids: HashMap<u32, u32> = HashMap::default();
         for (fi, item) in faces.iter_mut().enumerate() {
             let Some((_, o)) = item else { continue };
             for k in 0..o.gids.len() {
@@ -520,7 +520,7 @@ fn node_key(a: u32, b: u32) -> (u32, u32) {
 
 /// Every border edge between two different nodes, by its node pair.
 fn border_uses(faces: &[FaceWork<'_>]) -> Uses {
-    let mut uses: Uses = HashMap::new();
+    let mut uses: Uses = HashMap::default();
     for (fi, f) in faces.iter().enumerate() {
         for (a, b) in f.mesh.boundary_edges() {
             let (ga, gb) = (f.mesh.gid[a as usize], f.mesh.gid[b as usize]);
@@ -639,7 +639,7 @@ pub(crate) fn refine_all(
 /// rest keep their measures: they changed by less than that).
 pub(crate) fn settle_nodes(faces: &mut [FaceWork<'_>], negligible: f64) -> Vec<Vec<u32>> {
     // Per node: sum of positions, count, and whether they all agree already.
-    let mut sum: HashMap<u32, (DVec3, f64, DVec3, bool)> = HashMap::new();
+    let mut sum: HashMap<u32, (DVec3, f64, DVec3, bool)> = HashMap::default();
     for f in faces.iter() {
         for (v, &g) in f.mesh.gid.iter().enumerate() {
             if g != NONE {
@@ -653,7 +653,7 @@ pub(crate) fn settle_nodes(faces: &mut [FaceWork<'_>], negligible: f64) -> Vec<V
     }
     let mut changed = Vec::with_capacity(faces.len());
     for f in faces.iter_mut() {
-        let mut moved = hashbrown::HashSet::new();
+        let mut moved = crate::collections::HashSet::default();
         for v in 0..f.mesh.pos.len() {
             let g = f.mesh.gid[v];
             let Some(&(s, n, _, same)) = sum.get(&g) else { continue };

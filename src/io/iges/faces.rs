@@ -6,10 +6,10 @@
 //! A face that cannot be read is skipped with a warning naming its directory
 //! entry and type.
 
+use crate::collections::HashSet;
 use alloc::string::String;
 use alloc::vec::Vec;
 use glam::DAffine3;
-use hashbrown::HashSet;
 
 use super::brep::{chain_transform, face_510, reverse_all, shell_faces};
 use super::curves::{model_curve, param_curve};
@@ -28,9 +28,9 @@ use crate::Error;
 pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face>, Vec<u32>, Option<Error>) {
     let dir = ctx.dir;
     // Surfaces that faces (or offsets) use are not faces themselves.
-    let mut used: HashSet<usize> = HashSet::new();
-    let mut in_shell: HashSet<usize> = HashSet::new();
-    let mut shell_in_solid: HashSet<usize> = HashSet::new();
+    let mut used: HashSet<usize> = HashSet::default();
+    let mut in_shell: HashSet<usize> = HashSet::default();
+    let mut shell_in_solid: HashSet<usize> = HashSet::default();
     for e in &dir.entities {
         let at = match e.kind {
             144 | 510 => Some(1),
@@ -55,7 +55,7 @@ pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face
     }
     let mut out = Vec::new();
     let mut bodies: Vec<u32> = Vec::new();
-    let mut shell_body: hashbrown::HashMap<usize, u32> = hashbrown::HashMap::new();
+    let mut shell_body: crate::collections::HashMap<usize, u32> = crate::collections::HashMap::default();
     let mut first_error: Option<Error> = None;
     let mut unsupported: Vec<(u32, usize)> = Vec::new();
     // Hidden (blanked) faces are not part of what the file shows, unless

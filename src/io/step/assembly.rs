@@ -11,11 +11,11 @@
 //! below it. Everything is computed in millimetres, then expressed in the
 //! unit of the first root, so parts in other units are scaled to it.
 
+use crate::collections::{HashMap, HashSet};
 use alloc::format;
 use alloc::string::String;
 use alloc::vec::Vec;
 use glam::{DAffine3, DVec3};
-use hashbrown::{HashMap, HashSet};
 
 use super::curves::Geo;
 use super::graph::{Ent, Graph, Value};
@@ -118,14 +118,14 @@ fn root(parent: &mut [usize], mut i: usize) -> usize {
 pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error> {
     // Representations.
     let mut reps: Vec<(u64, Vec<u64>, u64)> = Vec::new();
-    let mut rep_index: HashMap<u64, usize> = HashMap::new();
+    let mut rep_index: HashMap<u64, usize> = HashMap::default();
     for e in g.all() {
         if let Some((items, ctx)) = representation(e) {
             rep_index.insert(e.id(), reps.len());
             reps.push((e.id(), items, ctx));
         }
     }
-    let mut unit_cache: HashMap<u64, Units> = HashMap::new();
+    let mut unit_cache: HashMap<u64, Units> = HashMap::default();
     let units: Vec<Units> = reps
         .iter()
         .map(|(_, _, ctx)| *unit_cache.entry(*ctx).or_insert_with(|| context_units(g, *ctx, warnings)))
@@ -193,8 +193,8 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
     }
     // Groups and their children.
     let group = |parent: &mut Vec<usize>, rep: u64| rep_index.get(&rep).map(|&i| root(parent, i));
-    let mut children: HashMap<usize, Vec<(usize, DAffine3, Option<String>)>> = HashMap::new();
-    let mut is_child: HashSet<usize> = HashSet::new();
+    let mut children: HashMap<usize, Vec<(usize, DAffine3, Option<String>)>> = HashMap::default();
+    let mut is_child: HashSet<usize> = HashSet::default();
     for (p, c, m, name) in &edges {
         let (Some(gp), Some(gc)) = (group(&mut parent, *p), group(&mut parent, *c)) else { continue };
         if gp == gc {
@@ -203,7 +203,7 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
         children.entry(gp).or_default().push((gc, *m, name.clone()));
         is_child.insert(gc);
     }
-    let mut members: HashMap<usize, Vec<usize>> = HashMap::new();
+    let mut members: HashMap<usize, Vec<usize>> = HashMap::default();
     for i in 0..n {
         let r = root(&mut parent, i);
         members.entry(r).or_default().push(i);
@@ -225,8 +225,8 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
         .and_then(|ms| ms.first())
         .map_or(1.0, |&i| units[i].mm);
     let mut plan = Plan { units: unit_name(out_mm), ..Plan::default() };
-    let mut seen: HashSet<(u64, [u64; 12])> = HashSet::new();
-    let mut emitted: HashSet<u64> = HashSet::new();
+    let mut seen: HashSet<(u64, [u64; 12])> = HashSet::default();
+    let mut emitted: HashSet<u64> = HashSet::default();
     let mut tol: f64 = 0.0;
     let scale_out = DAffine3::from_scale(DVec3::splat(1.0 / out_mm));
     // Depth-first over placements, with the path kept to refuse cycles.
@@ -288,7 +288,7 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
         }
     }
     // Solids and surface models no representation lists.
-    let mut nested: HashSet<u64> = HashSet::new();
+    let mut nested: HashSet<u64> = HashSet::default();
     for p in &plan.placed {
         if let Some(e) = g.find(p.item) {
             if e.has("SHELL_BASED_SURFACE_MODEL") || e.has("MANIFOLD_SOLID_BREP") || e.has("BREP_WITH_VOIDS") {
@@ -319,7 +319,7 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
     }
     // Faces that a representation lists on their own but that a shell also
     // holds are references (annotations, PMI), not more geometry.
-    let mut in_shells: HashSet<u64> = HashSet::new();
+    let mut in_shells: HashSet<u64> = HashSet::default();
     for e in g.all() {
         if e.has("CLOSED_SHELL") || e.has("OPEN_SHELL") || e.has("CONNECTED_FACE_SET") {
             if let Ok(a) = e.chain(&[("REPRESENTATION_ITEM", 1), ("CONNECTED_FACE_SET", 1)]) {
@@ -454,7 +454,7 @@ fn si_prefix(p: &str) -> Option<f64> {
 /// Product definition and name of each representation a
 /// `SHAPE_DEFINITION_REPRESENTATION` ties to a product.
 fn rep_products(g: &Graph) -> HashMap<u64, (u64, Option<String>)> {
-    let mut out = HashMap::new();
+    let mut out = HashMap::default();
     for e in g.all() {
         if !e.has("SHAPE_DEFINITION_REPRESENTATION") {
             continue;
@@ -473,7 +473,7 @@ fn rep_products(g: &Graph) -> HashMap<u64, (u64, Option<String>)> {
 /// For each transformed relation a `CONTEXT_DEPENDENT_SHAPE_REPRESENTATION`
 /// names: the child part's name and product definition.
 fn cdsr_products(g: &Graph) -> HashMap<u64, (Option<String>, u64)> {
-    let mut out = HashMap::new();
+    let mut out = HashMap::default();
     for e in g.all() {
         if !e.has("CONTEXT_DEPENDENT_SHAPE_REPRESENTATION") {
             continue;

@@ -3,11 +3,11 @@
 //! (so the faces on both sides start from the same points). Each edge is
 //! read once and shared by the faces that use it.
 
+use crate::collections::HashMap;
 use alloc::format;
 use alloc::string::String;
 use alloc::vec::Vec;
 use glam::DVec3;
-use hashbrown::HashMap;
 
 use super::curves::{move_ends, param_of, period, pieces_between, rev_all, Curve3, CurveDef, Geo};
 use super::graph::Ent;

@@ -3,10 +3,10 @@
 //! so neither parsing nor dropping recurses, and read back through checked
 //! accessors whose errors name the instance and the parameter.
 
+use crate::collections::HashMap;
 use alloc::format;
 use alloc::string::String;
 use alloc::vec::Vec;
-use hashbrown::HashMap;
 
 use super::step_error;
 use crate::Error;

@@ -132,7 +132,7 @@ pub fn read_step_parts(bytes: &[u8]) -> Result<StepModel, Error> {
     }
     // Part instances in the order of first use.
     let mut parts: Vec<String> = Vec::new();
-    let mut index: hashbrown::HashMap<usize, u32> = hashbrown::HashMap::new();
+    let mut index: crate::collections::HashMap<usize, u32> = crate::collections::HashMap::default();
     let mut face_parts = Vec::with_capacity(faces.len());
     for &p in &shapes.placement {
         let placed = plan.placed.get(p);

@@ -10,12 +10,12 @@
 //! `same_sense` says is outside. A face that cannot be read is skipped with
 //! a warning naming its `#id`; the others go on.
 
+use crate::collections::{HashMap, HashSet};
 use alloc::boxed::Box;
 use alloc::format;
 use alloc::string::String;
 use alloc::vec::Vec;
 use glam::{DAffine3, DVec3};
-use hashbrown::{HashMap, HashSet};
 
 use super::assembly::{Placed, Plan};
 use super::curves::{bounded_pieces, rev_all, Geo};
@@ -76,10 +76,10 @@ pub(super) fn read_shapes(g: &Graph, plan: &Plan, warnings: &mut Vec<String>) ->
         edges: Edges::default(),
         warnings,
         first_error: None,
-        repaired: HashSet::new(),
+        repaired: HashSet::default(),
         edge_uses: Vec::new(),
     };
-    let mut cache: HashMap<(u64, u64, u64), ItemFaces> = HashMap::new();
+    let mut cache: HashMap<(u64, u64, u64), ItemFaces> = HashMap::default();
     let styles = colours(g);
     let mut out =
         Shapes { faces: Vec::new(), placement: Vec::new(), colours: Vec::new(), shells: Vec::new(), first_error: None };
@@ -256,7 +256,7 @@ impl Reader<'_, '_> {
         }
         // A closed shell uses each of its edges twice; one whose faces leave
         // edges used once is open whatever the file calls it.
-        let mut count: HashMap<u64, u32> = HashMap::new();
+        let mut count: HashMap<u64, u32> = HashMap::default();
         for &e in &self.edge_uses {
             *count.entry(e).or_default() += 1;
         }

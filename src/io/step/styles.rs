@@ -7,7 +7,7 @@
 //! surface and are passed over; so is anything malformed (colours are
 //! decoration: a bad style never stops the file).
 
-use hashbrown::HashMap;
+use crate::collections::HashMap;
 
 use super::graph::{Ent, Graph};
 
@@ -16,7 +16,7 @@ pub type Rgb = [f32; 3];
 
 /// The surface colour each styled item has, by item `#id`.
 pub(super) fn colours(g: &Graph) -> HashMap<u64, Rgb> {
-    let mut out = HashMap::new();
+    let mut out = HashMap::default();
     for e in g.all() {
         // Context-dependent over-riding styles colour one assembly instance,
         // not every use of the item: those are left out.
