@@ -471,5 +471,8 @@ pool.ready().then(
   },
 );
 
-// The default sample's jobs go out first; the shaders compile while the workers mesh.
-loadSample(boot.sample, boot.bytes).then(() => viewer.warmUp());
+// The boot script has already sent the default sample to the workers: the
+// shaders compile now, while they mesh (a warm-up after loadSample, which
+// waits for the sample's bytes, came after the preview on a 2-core machine).
+viewer.warmUp();
+loadSample(boot.sample, boot.bytes);
