@@ -148,12 +148,11 @@ pub(crate) fn mesh_face(
 ) -> Result<FaceResult, Error> {
     #[cfg(feature = "std")]
     {
-        let domain: Vec<crate::TrimLoop> =
-            if face.loops.is_empty() { domain_loop(&face.surface).into_iter().collect() } else { Vec::new() };
+        let domain = domain_loops(face);
         let loops = if face.loops.is_empty() { &domain } else { &face.loops };
         let mut o = outline(index, &face.surface, loops, face.loops.is_empty(), lim)?;
         super::sew::unify(&mut [Some((&face.surface as &dyn Surface, &mut o))], &[], tight, tight, tight + lim.tol);
-        let mut wm = initial_from_outline(index, &face.surface, &o, lim, budget)?;
+        let mut wm = initial_from_outline(index, &face.surface, &o, budget)?;
         let outcome = wm.refine(&face.surface, &o.loops.curves, crit, budget);
         Ok(FaceResult { mesh: wm, outcome })
     }
@@ -252,13 +251,8 @@ fn domain_outline<'a>(surface: &dyn Surface, loops: &'a [crate::TrimLoop], lim: 
     let [lp] = loops else { return None };
     let [lo, hi] = surface.domain();
     let (pu, pv) = grid(surface, lo, hi, lim, None);
-    // Border nodes counter-clockwise from (lo.x, lo.y), as the loop runs.
-    let mut uv: Vec<DVec2> = Vec::new();
-    uv.extend(pu.iter().map(|&u| DVec2::new(u, lo.y)));
-    uv.extend(pv[1..].iter().map(|&v| DVec2::new(hi.x, v)));
-    uv.extend(pu.iter().rev().skip(1).map(|&u| DVec2::new(u, hi.y)));
-    uv.extend(pv.iter().rev().skip(1).map(|&v| DVec2::new(lo.x, v)));
-    uv.pop();
+    // Border nodes as the loop runs.
+    let uv = rect_border(lo, hi, &pu, &pv);
     // Each node on the loop's straight pieces: curve and parameter.
     let ends: Vec<(DVec2, DVec2)> =
         lp.curves.iter().map(|c| (c.point(0.0).truncate(), c.point(1.0).truncate())).collect();
@@ -341,6 +335,30 @@ fn align_to_grid(surface: &dyn Surface, loops: &mut super::trim::Loops<'_>, pu: 
     }
 }
 
+/// The border of the rectangle `[lo, hi]` through the parameter lines `us`
+/// and `vs` (each from `lo` to `hi`, ends included), counter-clockwise from
+/// `lo`, each corner once.
+fn rect_border(lo: DVec2, hi: DVec2, us: &[f64], vs: &[f64]) -> Vec<DVec2> {
+    let mut out: Vec<DVec2> = Vec::with_capacity(2 * (us.len() + vs.len()));
+    out.extend(us.iter().map(|&u| DVec2::new(u, lo.y)));
+    out.extend(vs.iter().skip(1).map(|&v| DVec2::new(hi.x, v)));
+    out.extend(us.iter().rev().skip(1).map(|&u| DVec2::new(u, hi.y)));
+    out.extend(vs.iter().rev().skip(1).map(|&v| DVec2::new(lo.x, v)));
+    out.pop(); // back at the start
+    out
+}
+
+/// The loops an untrimmed face is meshed by: its domain's border
+/// ([`domain_loop`]), so that its borders sew like trim loops; none for a
+/// trimmed face, or without `std` (no CDT).
+pub(crate) fn domain_loops(face: &Face) -> Vec<crate::TrimLoop> {
+    if cfg!(feature = "std") && face.loops.is_empty() {
+        domain_loop(&face.surface).into_iter().collect()
+    } else {
+        Vec::new()
+    }
+}
+
 /// The loop around a surface's whole parameter domain, a straight (u,v)
 /// piece between each two knot lines (so the border has nodes where the
 /// surface may kink): an untrimmed face meshed as trimmed by it can take
@@ -352,12 +370,7 @@ pub(crate) fn domain_loop(surface: &dyn Surface) -> Option<crate::TrimLoop> {
     }
     let bu = super::params::initial_breaks(&surface.breaks(true), lo.x, hi.x, 16);
     let bv = super::params::initial_breaks(&surface.breaks(false), lo.y, hi.y, 16);
-    let mut corners: Vec<DVec2> = Vec::new();
-    corners.extend(bu.iter().map(|&u| DVec2::new(u, lo.y)));
-    corners.extend(bv[1..].iter().map(|&v| DVec2::new(hi.x, v)));
-    corners.extend(bu.iter().rev().skip(1).map(|&u| DVec2::new(u, hi.y)));
-    corners.extend(bv.iter().rev().skip(1).map(|&v| DVec2::new(lo.x, v)));
-    corners.pop(); // back at the start
+    let corners = rect_border(lo, hi, &bu, &bv);
     let n = corners.len();
     let mut curves = Vec::with_capacity(n);
     for i in 0..n {
@@ -385,10 +398,8 @@ pub(crate) fn initial_from_outline(
     index: usize,
     surface: &dyn Surface,
     o: &Outline<'_>,
-    lim: &Limits,
     budget: usize,
 ) -> Result<WorkMesh, Error> {
-    let _ = lim;
     check_grid(index, &o.pu, &o.pv, budget)?;
     let band = Band::new(surface, &o.loops, &o.pu, &o.pv);
     let tris = band.triangulate(index)?;

@@ -71,16 +71,9 @@ pub fn mesh_model_with_progress(
     let rebuilt = reparameterize(model, options.reparam, tol, &mut report);
     // Untrimmed faces are meshed as trimmed by their domain's border, so
     // that their borders can be sewn like trim loops.
-    let domain_of = |f: &crate::Face| -> Vec<crate::TrimLoop> {
-        if cfg!(feature = "std") && f.loops.is_empty() {
-            face::domain_loop(&f.surface).into_iter().collect()
-        } else {
-            Vec::new()
-        }
-    };
-    let domain_loops: Vec<Vec<crate::TrimLoop>> = model.faces.iter().map(domain_of).collect();
+    let domain_loops: Vec<Vec<crate::TrimLoop>> = model.faces.iter().map(face::domain_loops).collect();
     let rebuilt_domain_loops: Vec<Vec<crate::TrimLoop>> =
-        rebuilt.iter().map(|r| r.as_ref().map_or_else(Vec::new, |r| domain_of(&r.face))).collect();
+        rebuilt.iter().map(|r| r.as_ref().map_or_else(Vec::new, |r| face::domain_loops(&r.face))).collect();
     // Within one face (a seam) borders meet within a rounding, or the file's
     // own modelling tolerance.
     let auto_tight = {
@@ -162,27 +155,27 @@ pub fn mesh_model_with_progress(
             continue;
         };
         let budget = options.max_triangles.saturating_sub(used);
-        match c.initial(index, budget) {
+        let why = match c.initial(index, budget) {
             Ok((mesh, curves)) => {
                 used += mesh.tris.len();
                 works.push(sew::FaceWork { surface: &c.face.surface, curves, mesh, crit: c.crit });
                 fit_errors.push(c.fit_error);
+                continue;
             }
             Err(Error::Mesh { face, message }) if model.faces.len() > 1 => {
-                report.faces_skipped += 1;
-                report.warnings.push(format!("face {index}: skipped: {message}"));
+                let why = format!("face {index}: skipped: {message}");
                 first_failure.get_or_insert(Error::Mesh { face, message });
-                works.push(empty_work(f, crit));
-                fit_errors.push(0.0);
+                why
             }
             Err(Error::Limit(m)) if model.faces.len() > 1 && budget < options.max_triangles => {
-                report.faces_skipped += 1;
-                report.warnings.push(format!("face {index}: skipped, the triangle budget is spent ({m})"));
-                works.push(empty_work(f, crit));
-                fit_errors.push(0.0);
+                format!("face {index}: skipped, the triangle budget is spent ({m})")
             }
             Err(e) => return Err(e),
-        }
+        };
+        report.faces_skipped += 1;
+        report.warnings.push(why);
+        works.push(empty_work(f, crit));
+        fit_errors.push(0.0);
     }
     if let Some(e) = first_failure.filter(|_| works.iter().all(|w| w.mesh.tris.is_empty())) {
         return Err(e);
@@ -395,6 +388,8 @@ struct Chosen<'a> {
     #[cfg(feature = "std")]
     outline: face::Outline<'a>,
     fit_error: f64,
+    /// The grid's limits (with `std` they went into the outline).
+    #[cfg(not(feature = "std"))]
     lim: params::Limits,
     crit: refine::Criteria,
 }
@@ -418,6 +413,7 @@ impl<'a> Chosen<'a> {
             #[cfg(feature = "std")]
             outline,
             fit_error,
+            #[cfg(not(feature = "std"))]
             lim,
             crit,
         })
@@ -427,7 +423,7 @@ impl<'a> Chosen<'a> {
     fn initial(&self, index: usize, budget: usize) -> Result<(refine::WorkMesh, Vec<&'a crate::NurbsCurve>), Error> {
         #[cfg(feature = "std")]
         {
-            let wm = face::initial_from_outline(index, &self.face.surface, &self.outline, &self.lim, budget)?;
+            let wm = face::initial_from_outline(index, &self.face.surface, &self.outline, budget)?;
             Ok((wm, self.outline.loops.curves.clone()))
         }
         #[cfg(not(feature = "std"))]
