@@ -430,8 +430,7 @@ impl WorkMesh {
         let fold_limit = 2 * stack.iter().filter(|&&t| self.inverted(surface, t as usize)).count() + 16;
         while let Some(t) = stack.pop() {
             let t = t as usize;
-            let (m, turn) = self.measure(surface, t, c);
-            self.measures[t] = Some((m, turn));
+            let (m, turn) = self.cached_measure(surface, t, c);
             let (a, b, len) = self.longest_edge(t);
             let limits = (m.max > c.tol || turn > c.angle || len > c.max_edge) && !c.short_for_angle(&m, turn, len);
             // A folded sliver along a border is mended by splitting it, but
@@ -459,6 +458,17 @@ impl WorkMesh {
         budget_hit
     }
 
+    /// Triangle `t`'s measure, from the cache while it is valid (the cache
+    /// must already hold a slot per triangle).
+    fn cached_measure(&mut self, surface: &dyn Surface, t: usize, c: &Criteria) -> (TriMeasure, f64) {
+        if let Some(x) = self.measures[t] {
+            return x;
+        }
+        let x = self.measure(surface, t, c);
+        self.measures[t] = Some(x);
+        x
+    }
+
     /// Drops the cached measures of triangles `ts` (they changed).
     pub fn forget(&mut self, ts: &[u32]) {
         self.measures.resize(self.tris.len(), None);
@@ -475,14 +485,7 @@ impl WorkMesh {
         let mut out = Outcome::default();
         self.measures.resize(self.tris.len(), None);
         for t in 0..self.tris.len() {
-            let (m, turn) = match self.measures[t] {
-                Some(x) => x,
-                None => {
-                    let x = self.measure(surface, t, c);
-                    self.measures[t] = Some(x);
-                    x
-                }
-            };
+            let (m, turn) = self.cached_measure(surface, t, c);
             let (_, _, len) = self.longest_edge(t);
             if c.short_for_angle(&m, turn, len) {
                 out.creased += 1;
