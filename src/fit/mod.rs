@@ -504,34 +504,14 @@ fn merge_duplicates(points: &[DVec3], dist: f64) -> (Vec<DVec3>, Vec<u32>) {
         }
         return (kept, index);
     }
-    let inv = 1.0 / dist;
-    let cell = |p: DVec3| {
-        let f = |x: f64| libm::floor(x * inv) as i64;
-        (f(p.x), f(p.y), f(p.z))
-    };
-    let mut grid: HashMap<(i64, i64, i64), Vec<u32>> = HashMap::default();
+    let mut grid = crate::collections::CellGrid::new(1.0 / dist);
     let d2 = dist * dist;
     for p in points {
-        let c = cell(*p);
-        let mut found = None;
-        'search: for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    if let Some(list) = grid.get(&(c.0 + dx, c.1 + dy, c.2 + dz)) {
-                        for &k in list {
-                            if kept[k as usize].distance_squared(*p) <= d2 {
-                                found = Some(k);
-                                break 'search;
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        let found = grid.near(*p).copied().find(|&k| kept[k as usize].distance_squared(*p) <= d2);
         let k = found.unwrap_or_else(|| {
             kept.push(*p);
             let k = (kept.len() - 1) as u32;
-            grid.entry(c).or_default().push(k);
+            grid.insert(*p, k);
             k
         });
         index.push(k);

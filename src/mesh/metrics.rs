@@ -109,59 +109,41 @@ fn count_cracks(free: &[(u32, u32, u32)], pos: &[DVec3], sew: f64, body: &dyn Fn
     if free.is_empty() || !(sew > 0.0 && sew.is_finite()) {
         return 0;
     }
-    let inv = 1.0 / sew;
-    let key = |p: DVec3| {
-        let c = p * inv;
-        (crate::math::floor(c.x) as i64, crate::math::floor(c.y) as i64, crate::math::floor(c.z) as i64)
-    };
     // Points of interest: free-edge vertices (tag = vertex id) and midpoints (tag = edge index).
     #[derive(Clone, Copy)]
     enum Tag {
         Vertex(u32),
         Mid,
     }
-    type Cells = crate::collections::HashMap<(i64, i64, i64), Vec<(DVec3, Tag, u32)>>;
-    let mut grid: Cells = crate::collections::HashMap::default();
+    let mut grid = crate::collections::CellGrid::new(1.0 / sew);
     let mut seen = crate::collections::HashSet::default();
     for &(a, b, f) in free {
         for v in [a, b] {
             if seen.insert((v, f)) {
                 let p = pos[v as usize];
-                grid.entry(key(p)).or_default().push((p, Tag::Vertex(v), f));
+                grid.insert(p, (p, Tag::Vertex(v), f));
             }
         }
         let m = (pos[a as usize] + pos[b as usize]) * 0.5;
-        grid.entry(key(m)).or_default().push((m, Tag::Mid, f));
+        grid.insert(m, (m, Tag::Mid, f));
     }
     let mut cracks = 0;
     for &(a, b, face) in free {
         let (pa, pb) = (pos[a as usize], pos[b as usize]);
         // Relative to the edge too: an open border's own neighbours sit half an edge away.
         let reach = sew.min(0.2 * pa.distance(pb));
-        let mut hit = false;
-        'probe: for f in [0.25, 0.5, 0.75] {
+        let hit = [0.25, 0.5, 0.75].iter().any(|&f| {
             let q = pa.lerp(pb, f);
-            let (kx, ky, kz) = key(q);
-            for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for dz in -1..=1 {
-                        let Some(list) = grid.get(&(kx + dx, ky + dy, kz + dz)) else { continue };
-                        for &(p, tag, f) in list {
-                            let other = f != face
-                                && body(f) == body(face)
-                                && match tag {
-                                    Tag::Vertex(v) => v != a && v != b,
-                                    Tag::Mid => true,
-                                };
-                            if other && p.distance(q) < reach {
-                                hit = true;
-                                break 'probe;
-                            }
-                        }
-                    }
-                }
-            }
-        }
+            grid.near(q).any(|&(p, tag, f)| {
+                let other = f != face
+                    && body(f) == body(face)
+                    && match tag {
+                        Tag::Vertex(v) => v != a && v != b,
+                        Tag::Mid => true,
+                    };
+                other && p.distance(q) < reach
+            })
+        });
         if hit {
             cracks += 1;
         }

@@ -7,37 +7,17 @@ use glam::DVec3;
 /// `tol` share one (spatial hashing, cells of size `tol`). Returns `(map, count)`.
 pub fn weld_positions(positions: &[DVec3], tol: f64) -> (Vec<u32>, usize) {
     let tol = if tol > 0.0 && tol.is_finite() { tol } else { 1e-12 };
-    let inv = 1.0 / tol;
-    let mut cells: crate::collections::HashMap<(i64, i64, i64), Vec<u32>> = crate::collections::HashMap::default();
+    let mut cells = crate::collections::CellGrid::new(1.0 / tol);
     let mut map = Vec::with_capacity(positions.len());
     let mut reps: Vec<DVec3> = Vec::new();
-    let key = |p: DVec3| -> (i64, i64, i64) {
-        let c = p * inv;
-        (crate::math::floor(c.x) as i64, crate::math::floor(c.y) as i64, crate::math::floor(c.z) as i64)
-    };
     for &p in positions {
-        let (kx, ky, kz) = key(p);
-        let mut found = None;
-        'search: for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    if let Some(list) = cells.get(&(kx + dx, ky + dy, kz + dz)) {
-                        for &r in list {
-                            if reps[r as usize].distance_squared(p) <= tol * tol {
-                                found = Some(r);
-                                break 'search;
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        let found = cells.near(p).copied().find(|&r| reps[r as usize].distance_squared(p) <= tol * tol);
         let id = match found {
             Some(r) => r,
             None => {
                 let r = reps.len() as u32;
                 reps.push(p);
-                cells.entry((kx, ky, kz)).or_default().push(r);
+                cells.insert(p, r);
                 r
             }
         };

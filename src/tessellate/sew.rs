@@ -31,15 +31,6 @@ pub(crate) struct FaceWork<'a> {
     pub crit: Criteria,
 }
 
-#[cfg(feature = "std")]
-type Cell = (i64, i64, i64);
-
-#[cfg(feature = "std")]
-fn cell_of(p: DVec3, inv: f64) -> Cell {
-    let c = p * inv;
-    (crate::math::floor(c.x) as i64, crate::math::floor(c.y) as i64, crate::math::floor(c.z) as i64)
-}
-
 /// Golden-section search of `dist` over `[lo, hi]`: the argument of its
 /// smallest value found, and that value.
 fn golden(dist: &dyn Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
@@ -75,11 +66,11 @@ fn golden(dist: &dyn Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
 /// Sewing of face outlines before they are triangulated.
 #[cfg(feature = "std")]
 mod outlines {
-    use crate::collections::HashMap;
+    use crate::collections::{CellGrid, HashMap};
     use alloc::vec::Vec;
     use glam::DVec3;
 
-    use super::{cell_of, golden, Cell};
+    use super::golden;
     use crate::nurbs::Surface;
     use crate::tessellate::face::Outline;
     use crate::tessellate::trim::Polyline;
@@ -197,12 +188,11 @@ mod outlines {
     ) -> (Additions, f64) {
         let radius = radii(pos, sew);
         // Nodes hashed on a grid about one loop segment long.
-        let inv = 1.0 / mean_segment.max(reach).max(1e-300);
-        let mut grid: HashMap<Cell, Vec<NodeRef>> = HashMap::default();
+        let mut grid = CellGrid::new(1.0 / mean_segment.max(reach).max(1e-300));
         for (fi, f) in pos.iter().enumerate() {
             for (k, p) in f.iter().enumerate() {
                 for (i, &q) in p.iter().enumerate() {
-                    grid.entry(cell_of(q, inv)).or_default().push((fi as u32, k as u32, i as u32));
+                    grid.insert(q, (fi as u32, k as u32, i as u32));
                 }
             }
         }
@@ -224,45 +214,33 @@ mod outlines {
                     let (curve, ta, tb) = poly.seg[i];
                     let Some(c) = o.loops.curves.get(curve as usize) else { continue };
                     let on_curve = |s: f64| surface.point(c.point(ta + (tb - ta) * s).truncate());
-                    let lo = cell_of(pa.min(pb) - DVec3::splat(reach), inv);
-                    let hi = cell_of(pa.max(pb) + DVec3::splat(reach), inv);
-                    for x in lo.0..=hi.0 {
-                        for y in lo.1..=hi.1 {
-                            for z in lo.2..=hi.2 {
-                                let Some(list) = grid.get(&(x, y, z)) else { continue };
-                                for &qn in list {
-                                    let (g, kk, jj) = (qn.0 as usize, qn.1 as usize, qn.2 as usize);
-                                    if qn == na || qn == nb || body(g) != body(fi) {
-                                        continue;
-                                    }
-                                    let q = at(qn);
-                                    let limit = if g == fi { tight.min(r_of(qn)) } else { r_of(qn) };
-                                    let s0 = ((q - pa).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
-                                    if s0 <= 0.0 || s0 >= 1.0 || q.distance(pa + ab * s0) > reach {
-                                        continue;
-                                    }
-                                    // The other border must run along this
-                                    // one at q, not merely pass near it.
-                                    let m = pos[g][kk].len();
-                                    let parallel = [(jj + m - 1) % m, (jj + 1) % m]
-                                        .iter()
-                                        .any(|&nb| (pos[g][kk][nb] - q).normalize_or_zero().dot(dir).abs() >= 0.8);
-                                    if !parallel {
-                                        continue;
-                                    }
-                                    let (s, d) = golden(
-                                        &|s: f64| on_curve(s).distance(q),
-                                        (s0 - 0.25).max(0.0),
-                                        (s0 + 0.25).min(1.0),
-                                    );
-                                    if d <= limit && s > 1e-9 && s < 1.0 - 1e-9 {
-                                        cands.push((na, s, ta + (tb - ta) * s, d, qn));
-                                    } else if q.distance(pa).min(q.distance(pb)) <= limit {
-                                        // At an end: recorded for the gap estimate only.
-                                        cands.push((na, -1.0, 0.0, q.distance(pa).min(q.distance(pb)), qn));
-                                    }
-                                }
-                            }
+                    for &qn in grid.in_box(pa.min(pb) - DVec3::splat(reach), pa.max(pb) + DVec3::splat(reach)) {
+                        let (g, kk, jj) = (qn.0 as usize, qn.1 as usize, qn.2 as usize);
+                        if qn == na || qn == nb || body(g) != body(fi) {
+                            continue;
+                        }
+                        let q = at(qn);
+                        let limit = if g == fi { tight.min(r_of(qn)) } else { r_of(qn) };
+                        let s0 = ((q - pa).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
+                        if s0 <= 0.0 || s0 >= 1.0 || q.distance(pa + ab * s0) > reach {
+                            continue;
+                        }
+                        // The other border must run along this
+                        // one at q, not merely pass near it.
+                        let m = pos[g][kk].len();
+                        let parallel = [(jj + m - 1) % m, (jj + 1) % m]
+                            .iter()
+                            .any(|&nb| (pos[g][kk][nb] - q).normalize_or_zero().dot(dir).abs() >= 0.8);
+                        if !parallel {
+                            continue;
+                        }
+                        let (s, d) =
+                            golden(&|s: f64| on_curve(s).distance(q), (s0 - 0.25).max(0.0), (s0 + 0.25).min(1.0));
+                        if d <= limit && s > 1e-9 && s < 1.0 - 1e-9 {
+                            cands.push((na, s, ta + (tb - ta) * s, d, qn));
+                        } else if q.distance(pa).min(q.distance(pb)) <= limit {
+                            // At an end: recorded for the gap estimate only.
+                            cands.push((na, -1.0, 0.0, q.distance(pa).min(q.distance(pb)), qn));
                         }
                     }
                 }
@@ -456,34 +434,25 @@ mod outlines {
             }
         }
         if sew > 0.0 {
-            let inv = 1.0 / sew;
-            let mut grid: HashMap<Cell, Vec<u32>> = HashMap::default();
+            let mut grid = CellGrid::new(1.0 / sew);
             for (i, &(_, p)) in flat.iter().enumerate() {
-                grid.entry(cell_of(p, inv)).or_default().push(i as u32);
+                grid.insert(p, i as u32);
             }
+            let body = |f: u32| bodies.get(f as usize).copied().unwrap_or(0);
             let mut pairs: Vec<(f64, u32, u32)> = Vec::new();
             for (i, &(fi, p)) in flat.iter().enumerate() {
-                let (kx, ky, kz) = cell_of(p, inv);
-                for dx in -1..=1 {
-                    for dy in -1..=1 {
-                        for dz in -1..=1 {
-                            let Some(list) = grid.get(&(kx + dx, ky + dy, kz + dz)) else { continue };
-                            for &j in list {
-                                if j as usize <= i {
-                                    continue;
-                                }
-                                let (fj, q) = flat[j as usize];
-                                let body = |f: u32| bodies.get(f as usize).copied().unwrap_or(0);
-                                if body(fi) != body(fj) {
-                                    continue;
-                                }
-                                let d = p.distance(q);
-                                let limit = if fi == fj { tight } else { sew };
-                                if d <= limit.min(r_flat[i]).min(r_flat[j as usize]) {
-                                    pairs.push((d, i as u32, j));
-                                }
-                            }
-                        }
+                for &j in grid.near(p) {
+                    if j as usize <= i {
+                        continue;
+                    }
+                    let (fj, q) = flat[j as usize];
+                    if body(fi) != body(fj) {
+                        continue;
+                    }
+                    let d = p.distance(q);
+                    let limit = if fi == fj { tight } else { sew };
+                    if d <= limit.min(r_flat[i]).min(r_flat[j as usize]) {
+                        pairs.push((d, i as u32, j));
                     }
                 }
             }
