@@ -34,7 +34,7 @@ pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
 pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol: f64) -> EdgeCounts {
     let (mut map, mut nverts) = weld_positions(&mesh.positions, weld_tol);
     let face_of = face_lookup(mesh);
-    let body_of_face = |f: u32| bodies.get(f as usize).copied().unwrap_or(0);
+    let body_of_face = |f: u32| crate::model::body_of(bodies, f as usize);
     if !bodies.is_empty() {
         // Each vertex's body, from the triangles that use it (faces own their vertices).
         let mut body_of_vertex = alloc::vec![0u32; mesh.positions.len()];

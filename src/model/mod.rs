@@ -29,8 +29,13 @@ pub struct Model {
 impl Model {
     /// The body face `face` belongs to (0 when the model has no bodies).
     pub fn body(&self, face: usize) -> u32 {
-        self.bodies.get(face).copied().unwrap_or(0)
+        body_of(&self.bodies, face)
     }
+}
+
+/// The body of face `face` by [`Model::bodies`] (0 past its end, as for a model without bodies).
+pub(crate) fn body_of(bodies: &[u32], face: usize) -> u32 {
+    bodies.get(face).copied().unwrap_or(0)
 }
 
 /// A surface restricted to the region its loops enclose.

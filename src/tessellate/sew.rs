@@ -197,7 +197,7 @@ mod outlines {
             }
         }
         let at = |n: NodeRef| pos[n.0 as usize][n.1 as usize][n.2 as usize];
-        let body = |f: usize| bodies.get(f).copied().unwrap_or(0);
+        let body = |f: usize| crate::model::body_of(bodies, f);
         let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
         // Every node on some other segment: (segment, fraction, curve parameter, distance, node).
         let mut cands: Vec<(NodeRef, f64, f64, f64, NodeRef)> = Vec::new();
@@ -438,7 +438,7 @@ mod outlines {
             for (i, &(_, p)) in flat.iter().enumerate() {
                 grid.insert(p, i as u32);
             }
-            let body = |f: u32| bodies.get(f as usize).copied().unwrap_or(0);
+            let body = |f: u32| crate::model::body_of(bodies, f as usize);
             let mut pairs: Vec<(f64, u32, u32)> = Vec::new();
             for (i, &(fi, p)) in flat.iter().enumerate() {
                 for &j in grid.near(p) {
