@@ -84,7 +84,9 @@ function hideError() {
 // ---------------------------------------------------------------- stats
 
 const fmt = (x) => (x === 0 ? '0' : Math.abs(x) >= 1e-3 && Math.abs(x) < 1e5 ? x.toPrecision(4) : x.toExponential(2));
-const count = (n) => n.toLocaleString('en-US');
+// Thousands with commas. Not toLocaleString: its first call loads the locale
+// data, tens of milliseconds on the way to the first picture.
+const count = (n) => String(n).replace(/\B(?=(\d{3})+(?!\d))/g, ',');
 
 function setStat(id, text, cls = '') {
   const el = $(id);
@@ -245,12 +247,15 @@ function remesh({ fresh = false } = {}) {
     coarse.promise.then(
       ({ result, lines }) => {
         performance.mark('surfmesh:coarse-result', { detail: result.report.time_ms });
+        // The boot's requested mesh waits for this picture; a hidden tab draws no
+        // frames, so it starts a moment later regardless.
+        setTimeout(() => boot.release?.(), 250);
         if (run !== state.run || finished) return;
         learnDiagonal(result.report, COARSE_REL);
         display(result, lines, 'coarse', { fit: true });
         status(`Coarse preview (relative ${COARSE_REL}) shown; meshing at the requested tolerance…`);
       },
-      () => {}, // the requested run reports the same error
+      () => boot.release?.(), // the requested run reports the same error
     );
   }
   fine.promise.then(
@@ -300,6 +305,7 @@ function display(result, lines, quality, { fit }) {
       if (!firstShown) {
         firstShown = true;
         body.dataset.firstMeshMs = t;
+        boot.release?.();
       }
       if (quality === 'final' && !finalShown) {
         finalShown = true;

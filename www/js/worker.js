@@ -1,5 +1,5 @@
-// The meshing worker: loads the wasm module (compiled once by the page and
-// posted here, so a respawn after cancel() only instantiates it), meshes one
+// The meshing worker: loads the wasm module (compiled once and posted here,
+// so a respawn after cancel() only instantiates it), meshes one
 // model per request with progress events, and posts the arrays back as
 // transferred buffers (no copy). It also derives the line sets the viewer
 // draws, so the page's thread only uploads buffers:
@@ -8,8 +8,14 @@
 //   open:    edges with one triangle after welding coincident vertices across
 //            faces — the model's open border plus any crack.
 //
-// Messages in:  { type: 'init', module } then { type: 'mesh', id, bytes, format, options }
-// Messages out: { type: 'ready' } | { type: 'fatal', message }
+// The page's first worker boots itself instead ({ type: 'boot', wasm, sample, id, options }):
+// it fetches and compiles the module, posts it back for the other workers, and
+// meshes the default sample from its own fetch, so the first mesh never waits
+// for the page's thread (busy parsing three.js while this runs).
+//
+// Messages in:  { type: 'init', module } | { type: 'boot', wasm, sample?, id, options }
+//               then { type: 'mesh', id, bytes, format, options }
+// Messages out: { type: 'module', module } | { type: 'module', error } (after boot) | { type: 'ready' } | { type: 'fatal', message }
 //               { type: 'progress', id, done, total }
 //               { type: 'result', id, result, lines: { wire, borders, open } }
 //               { type: 'error', id, message }
@@ -23,10 +29,11 @@ const loaded = new Promise((resolve) => {
   settleLoad = resolve;
 });
 
-self.onmessage = async (event) => {
-  const msg = event.data;
-  if (msg.type === 'init') {
-    init({ module_or_path: msg.module }).then(
+/** Instantiates `module` (a promise of it); posts 'ready' or 'fatal'. */
+function load(module) {
+  module
+    .then((m) => init({ module_or_path: m }))
+    .then(
       () => {
         self.postMessage({ type: 'ready', version: version() });
         settleLoad(null);
@@ -37,10 +44,39 @@ self.onmessage = async (event) => {
         settleLoad(message);
       },
     );
+}
+
+self.onmessage = async (event) => {
+  const msg = event.data;
+  if (msg.type === 'init') {
+    load(Promise.resolve(msg.module));
     return;
   }
-  if (msg.type !== 'mesh') return;
-  const { id } = msg;
+  if (msg.type === 'boot') {
+    const module = WebAssembly.compileStreaming(fetch(msg.wasm));
+    module.then(
+      (m) => self.postMessage({ type: 'module', module: m }),
+      (e) => self.postMessage({ type: 'module', error: String(e.message ?? e) }),
+    );
+    load(module);
+    if (!msg.sample) return;
+    let bytes;
+    try {
+      const response = await fetch(msg.sample);
+      if (!response.ok) throw new Error(`HTTP ${response.status}`);
+      bytes = await response.arrayBuffer();
+    } catch (e) {
+      self.postMessage({ type: 'error', id: msg.id, message: `cannot fetch ${msg.sample}: ${e.message ?? e}` });
+      return;
+    }
+    run(msg.id, bytes, 'json', msg.options);
+    return;
+  }
+  if (msg.type === 'mesh') run(msg.id, msg.bytes, msg.format, msg.options);
+};
+
+/** Meshes one request once the module is loaded; posts its result or error. */
+async function run(id, bytes, format, options) {
   const failure = await loaded;
   if (failure) {
     self.postMessage({ type: 'error', id, message: failure });
@@ -48,7 +84,7 @@ self.onmessage = async (event) => {
   }
   let result;
   try {
-    result = meshWithProgress(new Uint8Array(msg.bytes), msg.format, msg.options, (done, total) => {
+    result = meshWithProgress(new Uint8Array(bytes), format, options, (done, total) => {
       self.postMessage({ type: 'progress', id, done, total });
     });
   } catch (e) {
@@ -61,7 +97,7 @@ self.onmessage = async (event) => {
     { type: 'result', id, result, lines },
     buffers.map((a) => a.buffer),
   );
-};
+}
 
 /** Wireframe index pairs, and face-border and open-edge segments (x, y, z pairs), of a mesh. */
 function edgeLines({ positions, indices, faceRanges }) {
