@@ -294,6 +294,7 @@ function learnDiagonal(report, rel) {
 
 let firstShown = false;
 let finalShown = false;
+let linesWarm = false;
 function display(result, lines, quality, { fit }) {
   state.shown = { result, lines, quality };
   body.dataset.quality = quality;
@@ -307,13 +308,18 @@ function display(result, lines, quality, { fit }) {
         body.dataset.firstMeshMs = t;
         boot.release?.();
       }
+      // A preview is drawn without line overlays; their shaders compile now, before the final mesh.
+      if (!linesWarm) {
+        linesWarm = true;
+        if (quality === 'coarse') viewer.warmUp('lines');
+      }
       if (quality === 'final' && !finalShown) {
         finalShown = true;
         body.dataset.finalMeshMs = t;
       }
     });
   };
-  viewer.show(result, lines, { fit });
+  viewer.show(result, lines, { fit, overlays: quality !== 'coarse' });
   showStats(result.report, quality);
   setExport(true);
 }

@@ -67,31 +67,38 @@ export class Viewer {
   }
 
   /**
-   * Draws every material once, on degenerate geometry that covers no pixel, so
-   * that shader compilation (slow with software GL) happens before the first
-   * mesh arrives rather than when it is drawn.
+   * Draws materials once on degenerate geometry that covers no pixel, so that
+   * shader compilation (slow with software GL) happens before a mesh is drawn
+   * with them rather than when it is. `faces` (the shaded materials) is done
+   * at start; `lines` (wireframe, borders, open edges) once the first picture
+   * is up: the coarse preview is drawn without them, so its frame waits for
+   * one compilation, not four.
    */
-  warmUp() {
-    const geometry = toBufferGeometry({
-      positions: new Float32Array(9),
-      normals: new Float32Array([0, 0, 1, 0, 0, 1, 0, 0, 1]),
-      indices: new Uint32Array([0, 1, 2]),
-      faceRanges: new Uint32Array([0, 1]),
-    });
-    const parts = [
-      new THREE.Mesh(geometry, this.faceMaterials),
-      new THREE.Mesh(geometry, this.plainMaterials),
-      segments(new Float32Array(6), this.wireMaterial),
-      segments(new Float32Array(6), this.borderMaterial),
-      segments(new Float32Array(6), this.openMaterial),
-    ];
+  warmUp(kind = 'faces') {
+    const parts = [];
+    const geometries = [];
+    if (kind === 'faces') {
+      const geometry = toBufferGeometry({
+        positions: new Float32Array(9),
+        normals: new Float32Array([0, 0, 1, 0, 0, 1, 0, 0, 1]),
+        indices: new Uint32Array([0, 1, 2]),
+        faceRanges: new Uint32Array([0, 1]),
+      });
+      geometries.push(geometry);
+      parts.push(new THREE.Mesh(geometry, this.faceMaterials));
+    } else {
+      for (const material of [this.wireMaterial, this.borderMaterial, this.openMaterial]) {
+        const part = segments(new Float32Array(6), material);
+        geometries.push(part.geometry);
+        parts.push(part);
+      }
+    }
     for (const part of parts) part.frustumCulled = false;
     this.scene.add(...parts);
     this.renderer.render(this.scene, this.camera);
     this.scene.remove(...parts);
-    geometry.dispose();
-    for (const part of parts.slice(2)) part.geometry.dispose();
-    performance.mark('surfmesh:shaders-compiled');
+    for (const geometry of geometries) geometry.dispose();
+    performance.mark(`surfmesh:shaders-compiled-${kind}`);
   }
 
   #shaded(color) {
@@ -106,8 +113,11 @@ export class Viewer {
     });
   }
 
-  /** Shows a mesh result and its line sets; `fit` re-frames the camera. */
-  show(result, lines, { fit = false } = {}) {
+  /**
+   * Shows a mesh result and its line sets; `fit` re-frames the camera. With
+   * `overlays: false` (a preview) the line sets are kept but not drawn.
+   */
+  show(result, lines, { fit = false, overlays = true } = {}) {
     this.clear();
     const geometry = toBufferGeometry(result, { materialCount: PALETTE.length });
     const shaded = new THREE.Mesh(geometry, this.faceMaterials);
@@ -119,7 +129,7 @@ export class Viewer {
     const borders = segments(lines.borders, this.borderMaterial);
     const open = segments(lines.open, this.openMaterial);
     open.renderOrder = 2;
-    this.parts = { geometry, shaded, wire, borders, open, faceRanges: result.faceRanges, picked: -1 };
+    this.parts = { geometry, shaded, wire, borders, open, overlays, faceRanges: result.faceRanges, picked: -1 };
     this.group.add(shaded, wire, borders, open);
     this.apply();
     if (fit) this.fit();
@@ -180,9 +190,10 @@ export class Viewer {
     if (!this.parts) return;
     const o = this.options;
     this.parts.shaded.material = o.faceColors ? this.faceMaterials : this.plainMaterials;
-    this.parts.wire.visible = o.wireframe;
-    this.parts.borders.visible = o.borders;
-    this.parts.open.visible = o.openEdges;
+    const overlays = this.parts.overlays;
+    this.parts.wire.visible = overlays && o.wireframe;
+    this.parts.borders.visible = overlays && o.borders;
+    this.parts.open.visible = overlays && o.openEdges;
     this.requestRender();
   }
 
