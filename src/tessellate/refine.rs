@@ -501,7 +501,8 @@ impl WorkMesh {
     /// Repairs folded triangles by edge flips: for each inverted triangle,
     /// its interior edges (not trim edges) are tried in turn, and a flip is
     /// kept when both new triangles face the surface's way, keep the (u,v)
-    /// orientation and pass the deviation and angle limits. Borders are not
+    /// orientation (or, where sewing moved nodes, face the surface's way in
+    /// space) and pass the deviation and angle limits. Borders are not
     /// touched, so a sewn border stays conforming. Returns the triangles
     /// changed.
     pub fn repair_inverted(&mut self, surface: &dyn Surface, c: &Criteria) -> Vec<u32> {
@@ -509,6 +510,7 @@ impl WorkMesh {
         let mut todo: Vec<u32> = (0..self.tris.len() as u32).filter(|&t| self.inverted(surface, t as usize)).collect();
         for _ in 0..8 {
             let mut next = Vec::new();
+            let mut flipped = false;
             for t in todo {
                 if !self.inverted(surface, t as usize) {
                     continue;
@@ -519,6 +521,7 @@ impl WorkMesh {
                     if let Some(u) = self.try_flip(surface, c, t, v[k], v[(k + 1) % 3]) {
                         changed.push(t);
                         changed.push(u);
+                        flipped = true;
                         fixed = true;
                         break;
                     }
@@ -535,6 +538,13 @@ impl WorkMesh {
                         break;
                     }
                 }
+            }
+            // A fold of several triangles (a fan on a border) unfolds one
+            // flip at a time: after a round with flips, the rest are tried again.
+            if flipped {
+                next.extend((0..self.tris.len() as u32).filter(|&t| self.inverted(surface, t as usize)));
+                next.sort_unstable();
+                next.dedup();
             }
             if next.is_empty() {
                 break;
@@ -576,7 +586,18 @@ impl WorkMesh {
         let sense = area(qb2, qa2, qd);
         let (t1, t2) = ([a, d, cv], [d, b, cv]);
         let (w1, w2) = ([qa, qd, qc], [qd, qb, qc]);
-        if !(area(w1[0], w1[1], w1[2]) * sense > 0.0 && area(w2[0], w2[1], w2[2]) * sense > 0.0) {
+        let uv_ok = area(w1[0], w1[1], w1[2]) * sense > 0.0 && area(w2[0], w2[1], w2[2]) * sense > 0.0;
+        // Sewing moves border nodes in space, not in (u,v): where it folded a
+        // triangle, the flip that unfolds it can look folded in the stale
+        // (u,v), so the new pair is judged in space against the surface's
+        // normal there too.
+        let space_ok = || {
+            let n = surface.normal((qa + qb + qc + qd) / 4.0);
+            let p = |v: u32| self.pos[v as usize];
+            let facing = |t: [u32; 3]| (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).dot(n) > 0.0;
+            facing(t1) && facing(t2)
+        };
+        if !uv_ok && !space_ok() {
             return None;
         }
         // Apply, then test; undo when worse.
