@@ -125,3 +125,28 @@ test('the bundler build loads as an ES module that imports its .wasm', () => {
   assert.equal(r.status, 0, r.stderr);
   assert.equal(Number(r.stdout.trim()), surfmesh.mesh(freeform, 'json').report.triangles);
 });
+
+test('an assembly meshed in shares of its bodies merges into the whole mesh', async () => {
+  const { mergeShares } = await import(join(root, 'www', 'js', 'pool.js'));
+  const bytes = readFileSync(join(root, 'tests', 'data', 'step_assembly.stp'));
+  const options = { toleranceRel: 1e-3 };
+  const whole = surfmesh.mesh(bytes, 'step', options);
+  const none = { wire: new Uint32Array(), borders: new Float32Array(), open: new Float32Array() };
+  const shares = [0, 1].map((i) => ({ result: surfmesh.mesh(bytes, 'step', { ...options, share: [i, 2] }), lines: none }));
+  for (const { result } of shares) {
+    assert.ok(result.report.triangles > 0 && result.report.triangles < whole.report.triangles, 'each share holds one block');
+  }
+  const { result } = mergeShares(shares);
+  // Bodies share no border: each face meshes as in the whole model, and the merge keeps face order.
+  assert.deepEqual(result.faceRanges, whole.faceRanges);
+  assert.deepEqual(result.indices, whole.indices);
+  assert.deepEqual(result.positions, whole.positions);
+  assert.deepEqual(result.normals, whole.normals);
+  assert.deepEqual(result.faceParts, whole.faceParts);
+  for (const key of ['triangles', 'vertices', 'free_edges', 'boundary_edges', 'inverted_triangles', 'max_deviation']) {
+    assert.equal(result.report[key], whole.report[key], key);
+  }
+  assert.ok(Math.abs(result.report.mean_deviation - whole.report.mean_deviation) <= 1e-9 * whole.report.tolerance);
+  assert.throws(() => surfmesh.mesh(bytes, 'step', { share: [2, 2] }), /option share: expected \[index, count\]/);
+  assert.throws(() => surfmesh.mesh(bytes, 'step', { share: [0, 2], mode: 'quality' }), /option share: meshes fast mode only/);
+});

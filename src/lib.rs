@@ -63,7 +63,7 @@ pub use reparam::{
 #[doc(hidden)]
 pub use tessellate::stages;
 pub use tessellate::{
-    mesh_model, mesh_model_with_progress, MeshMode, MeshOptions, MeshResult, OptionsError, Tolerance,
+    mesh_model, mesh_model_with_progress, share_of_faces, MeshMode, MeshOptions, MeshResult, OptionsError, Tolerance,
 };
 
 /// Reads `bytes` in `format` and meshes the model: the one call both doors use.

@@ -52,6 +52,12 @@ export interface MeshOptions {
   sizeRel?: number;
   /** Quality mode: "looping" (default, paper 003), "delaunay" (spade's refinement) or "best" (both, better per face). */
   method?: "looping" | "delaunay" | "best";
+  /**
+   * Fast mode: [index, count] meshes only share `index` of `count` of the model's bodies, so
+   * that `count` workers can mesh one model side by side; the other faces come back empty
+   * (count 0 in faceRanges). Bodies share no border, so the shares together are the whole mesh.
+   */
+  share?: [number, number];
 }
 
 /** What `mesh` returns. */
@@ -168,7 +174,7 @@ export function meshWithProgress(
 "#;
 
 /// Option names `mesh` accepts, in the order they are read.
-const OPTION_NAMES: [&str; 11] = [
+const OPTION_NAMES: [&str; 12] = [
     "tolerance",
     "toleranceRel",
     "angle",
@@ -180,6 +186,7 @@ const OPTION_NAMES: [&str; 11] = [
     "size",
     "sizeRel",
     "method",
+    "share",
 ];
 
 /// The crate version, so a page can show which mesher produced a mesh.
@@ -373,6 +380,20 @@ fn read_options(value: &JsValue) -> Result<MeshOptions, String> {
     options = options.with_quality(quality);
     if let Some(m) = word(object, "mode", &["fast", "quality"])? {
         options = options.with_mode([MeshMode::Fast, MeshMode::Quality][m]);
+    }
+    let share = Reflect::get(object, &JsValue::from_str("share")).map_err(|_| "option share: cannot be read")?;
+    if !(share.is_undefined() || share.is_null()) {
+        let pair: Option<[u32; 2]> = Array::is_array(&share)
+            .then(|| share.unchecked_ref::<Array>().to_vec())
+            .filter(|v| v.len() == 2)
+            .and_then(|v| {
+                let whole = |x: &JsValue| x.as_f64().filter(|n| n.fract() == 0.0 && *n >= 0.0 && *n <= u32::MAX as f64);
+                Some([whole(&v[0])? as u32, whole(&v[1])? as u32])
+            });
+        match pair {
+            Some([i, n]) if i < n => options = options.with_share(i, n),
+            _ => return Err("option share: expected [index, count] with whole numbers, index < count".into()),
+        }
     }
     Ok(options)
 }

@@ -22,7 +22,7 @@ use crate::nurbs::{Aabb, Surface};
 use crate::reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
 use crate::{Error, Mesh, Model, Report};
 
-pub use options::{MeshMode, MeshOptions, OptionsError, Tolerance};
+pub use options::{share_of_faces, MeshMode, MeshOptions, OptionsError, Tolerance};
 
 /// A mesh and what was measured on it.
 #[derive(Debug, Clone, Default)]
@@ -67,8 +67,13 @@ pub fn mesh_model_with_progress(
     let aim = crit.tol;
     let mut report = Report { tolerance: tol, angle: options.angle, faces: model.faces.len(), ..Report::default() };
     report.warnings.extend(model.warnings.iter().cloned());
+    // A share meshes its bodies only; the other faces stay empty (not skipped).
+    let mine = match options.share {
+        Some((index, count)) => share_of_faces(&model.bodies, model.faces.len(), index, count),
+        None => alloc::vec![true; model.faces.len()],
+    };
     // Paper 001: faces whose parameters crowd are rebuilt on even ones first.
-    let rebuilt = reparameterize(model, options.reparam, tol, &mut report);
+    let rebuilt = reparameterize(model, &mine, options.reparam, tol, &mut report);
     // Untrimmed faces are meshed as trimmed by their domain's border, so
     // that their borders can be sewn like trim loops.
     let domain_loops: Vec<Vec<crate::TrimLoop>> = model.faces.iter().map(face::domain_loops).collect();
@@ -84,6 +89,10 @@ pub fn mesh_model_with_progress(
     let mut chosen: Vec<Option<Chosen<'_>>> = Vec::with_capacity(model.faces.len());
     let mut first_failure: Option<Error> = None;
     for (index, original) in model.faces.iter().enumerate() {
+        if !mine[index] {
+            chosen.push(None);
+            continue;
+        }
         let (mut f, mut fit_error, cap) = match rebuilt.get(index) {
             Some(Some(r)) => (&r.face, r.fit_error, r.max_edge),
             _ => (original, 0.0, f64::INFINITY),
@@ -202,7 +211,7 @@ pub fn mesh_model_with_progress(
             }
         }
         if w.mesh.tris.is_empty() {
-            if !report.warnings.iter().any(|x| x.starts_with(&format!("face {index}: "))) {
+            if mine[index] && !report.warnings.iter().any(|x| x.starts_with(&format!("face {index}: "))) {
                 report.faces_skipped += 1;
                 report.warnings.push(format!("face {index}: produced no triangles"));
             }
@@ -259,15 +268,19 @@ pub fn mesh_model_with_progress(
     Ok(MeshResult { mesh, report })
 }
 
-/// Runs paper 001's ratio test on every face (unless `mode` is off) and
+/// Runs paper 001's ratio test on every face of the share `mine` (unless `mode` is off) and
 /// rebuilds those it flags (every face when forced); the report lists them.
 /// A rebuild that fails leaves the original face, with a warning.
-fn reparameterize(model: &Model, mode: Reparam, tol: f64, report: &mut Report) -> Vec<Option<Rebuilt>> {
+fn reparameterize(model: &Model, mine: &[bool], mode: Reparam, tol: f64, report: &mut Report) -> Vec<Option<Rebuilt>> {
     if mode == Reparam::Off {
         return Vec::new();
     }
     let mut out = Vec::with_capacity(model.faces.len());
     for (index, f) in model.faces.iter().enumerate() {
+        if !mine.get(index).copied().unwrap_or(true) {
+            out.push(None);
+            continue;
+        }
         let ratio = step_ratio(&f.surface);
         if mode == Reparam::Auto && ratio <= RATIO_LIMIT {
             out.push(None);

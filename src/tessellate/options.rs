@@ -1,5 +1,6 @@
 //! Meshing options: plain struct, documented defaults, validated at every entry.
 
+use alloc::vec::Vec;
 use core::fmt;
 
 use crate::quality::QualityOptions;
@@ -64,6 +65,34 @@ pub struct MeshOptions {
     pub mode: MeshMode,
     /// Settings of [`MeshMode::Quality`]: element size, method, weights.
     pub quality: QualityOptions,
+    /// `Some((index, count))`: mesh only share `index` of `count` of the
+    /// model's bodies (see [`share_of_faces`]), so that workers can mesh one
+    /// model side by side. Bodies share no border, so the shares' meshes
+    /// together are the whole model's mesh. Default `None`: every face.
+    /// Fast mode only.
+    pub share: Option<(u32, u32)>,
+}
+
+/// Which faces share `index` of `count` meshes: bodies go, the largest (most
+/// faces) first, to the share with the fewest faces so far; ties by body id
+/// and by share index, so every worker computes the same split.
+pub fn share_of_faces(bodies: &[u32], faces: usize, index: u32, count: u32) -> Vec<bool> {
+    let body = |f: usize| bodies.get(f).copied().unwrap_or(0);
+    let mut sizes: crate::collections::HashMap<u32, usize> = crate::collections::HashMap::default();
+    for f in 0..faces {
+        *sizes.entry(body(f)).or_insert(0) += 1;
+    }
+    let mut order: Vec<(u32, usize)> = sizes.into_iter().collect();
+    order.sort_unstable_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    let count = count.max(1) as usize;
+    let mut load = alloc::vec![0usize; count];
+    let mut owner: crate::collections::HashMap<u32, usize> = crate::collections::HashMap::default();
+    for (b, n) in order {
+        let to = (0..count).min_by_key(|&i| (load[i], i)).unwrap_or(0);
+        load[to] += n;
+        owner.insert(b, to);
+    }
+    (0..faces).map(|f| owner.get(&body(f)).copied() == Some(index as usize)).collect()
 }
 
 impl Default for MeshOptions {
@@ -80,6 +109,7 @@ impl Default for MeshOptions {
             reparam: Reparam::Off,
             mode: MeshMode::Fast,
             quality: QualityOptions::default(),
+            share: None,
         }
     }
 }
@@ -144,6 +174,12 @@ impl MeshOptions {
         self
     }
 
+    /// Meshes only share `index` of `count` of the bodies ([`MeshOptions::share`]).
+    pub fn with_share(mut self, index: u32, count: u32) -> Self {
+        self.share = Some((index, count));
+        self
+    }
+
     /// Sets when poorly parameterized faces are rebuilt (paper 001).
     pub fn with_reparam(mut self, mode: Reparam) -> Self {
         self.reparam = mode;
@@ -192,6 +228,14 @@ impl MeshOptions {
                 if m >= x {
                     return Err(OptionsError { option: "--min-edge", message: "must be below --max-edge" });
                 }
+            }
+        }
+        if let Some((i, n)) = self.share {
+            if n == 0 || i >= n {
+                return Err(OptionsError { option: "share", message: "index must be below a count of at least 1" });
+            }
+            if self.mode == MeshMode::Quality {
+                return Err(OptionsError { option: "share", message: "meshes fast mode only" });
             }
         }
         if let Some(s) = self.sew {

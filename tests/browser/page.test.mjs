@@ -193,13 +193,34 @@ test('a STEP assembly meshes, and a picked face names its part', async () => {
   assert.equal(await stat('stat-open-edges'), 0, 'two closed blocks');
   const box = await page.locator('#canvas').boundingBox();
   let text = '';
+  let at = null;
   for (const [fx, fy] of [[0.5, 0.5], [0.35, 0.5], [0.65, 0.5], [0.5, 0.4], [0.5, 0.6], [0.3, 0.4], [0.7, 0.6]]) {
-    await page.mouse.click(box.x + box.width * fx, box.y + box.height * fy);
+    at = [box.x + box.width * fx, box.y + box.height * fy];
+    await page.mouse.click(...at);
     text = await page.textContent('#status');
     if (text.startsWith('Face ')) break;
   }
   assert.match(text, /^Face \d+ of 12 \(Block\): \d+ triangles$/);
   await shot(page, '05b-step-assembly');
+  // A re-mesh splits the two blocks over the pool's workers; the merged mesh
+  // is the same closed assembly, every face in it, and still picks by face.
+  const before = await stat('stat-triangles');
+  const again = await settle(async () => {
+    await page.fill('#tol-value', '0.0002');
+    await page.press('#tol-value', 'Enter');
+  });
+  assert.equal(again, 'ready', await page.textContent('#error-message'));
+  assert.match(await page.textContent('#stat-time'), /· [2-4] workers$/);
+  assert.equal(await stat('stat-faces'), 12);
+  assert.equal(await stat('stat-open-edges'), 0, 'still two closed blocks');
+  assert.ok((await stat('stat-triangles')) >= before);
+  assert.ok((await stat('stat-max-deviation')) <= (await stat('stat-tolerance')));
+  await page.mouse.click(...at);
+  assert.match(await page.textContent('#status'), /^Face \d+ of 12 \(Block\): \d+ triangles$/);
+  await settle(async () => {
+    await page.fill('#tol-value', '0.001');
+    await page.press('#tol-value', 'Enter');
+  });
 });
 
 test('STL, OBJ and GLB exports hold the triangles the page shows', async () => {

@@ -364,3 +364,34 @@ fn fuzz_timeout_folded_sheet_meshes_without_exploding() {
         rep.warnings
     );
 }
+
+/// Two shares of a two-body assembly mesh one body each, and together they
+/// are the whole model's mesh face by face (bodies share no border); with
+/// more shares than bodies the extra share is empty, not an error.
+#[test]
+fn shares_of_the_bodies_make_the_whole_mesh() {
+    let model = read_step(&data("step_assembly.stp")).unwrap();
+    let options = MeshOptions::default().with_relative_tolerance(1e-3);
+    let whole = mesh_model(&model, &options).unwrap();
+    let shares: Vec<MeshResult> =
+        (0..2).map(|i| mesh_model(&model, &options.clone().with_share(i, 2)).unwrap()).collect();
+    let per_face = |r: &MeshResult| r.mesh.face_ranges.iter().map(|f| f.count).collect::<Vec<u32>>();
+    let (a, b, w) = (per_face(&shares[0]), per_face(&shares[1]), per_face(&whole));
+    assert_eq!(w.len(), 12);
+    for f in 0..12 {
+        assert!(a[f] == 0 || b[f] == 0, "face {f} is in both shares");
+        assert_eq!(a[f] + b[f], w[f], "face {f}: the shares' triangles are the whole mesh's");
+    }
+    assert!(a.iter().sum::<u32>() > 0 && b.iter().sum::<u32>() > 0, "each share meshes one body");
+    for s in &shares {
+        assert_eq!(s.report.tolerance, whole.report.tolerance, "one tolerance for the whole model");
+        assert!(s.report.max_deviation <= s.report.tolerance);
+        assert_eq!((s.report.free_edges, s.report.inverted_triangles, s.report.faces_skipped), (0, 0, 0));
+    }
+    assert_eq!(shares[0].report.triangles + shares[1].report.triangles, whole.report.triangles);
+    // More shares than bodies: the extra one is empty, not an error.
+    let empty = mesh_model(&model, &options.clone().with_share(2, 3)).unwrap();
+    assert_eq!(empty.report.triangles, 0);
+    assert_eq!(empty.report.faces_skipped, 0);
+    assert!(mesh_model(&model, &options.clone().with_share(2, 2)).is_err(), "an index past the count is refused");
+}

@@ -22,7 +22,8 @@ performance.mark('surfmesh:app-start');
 const boot = window.surfmeshBoot ?? { sample: 'grid50.json', workers: [] };
 boot.adopted = true;
 const pool = new MeshPool({
-  size: 2,
+  // A preview and a full mesh at once, and on more cores a model's bodies split over up to four.
+  size: Math.min(4, Math.max(2, navigator.hardwareConcurrency || 2)),
   module: boot.module,
   wasmUrl: new URL('../pkg/web/surfmesh_bg.wasm', import.meta.url),
   workerUrl: new URL('./worker.js', import.meta.url),
@@ -116,7 +117,8 @@ function showStats(report, quality) {
   setStat('stat-free-edges', count(report.free_edges), report.free_edges === 0 ? 'ok' : 'bad');
   setStat('stat-open-edges', count(report.boundary_edges));
   setStat('stat-nonmanifold', count(report.nonmanifold_edges), report.nonmanifold_edges === 0 ? '' : 'bad');
-  setStat('stat-time', `${report.parse_ms.toFixed(1)} / ${report.time_ms.toFixed(1)} ms`);
+  const workers = report.shares > 1 ? ` · ${report.shares} workers` : '';
+  setStat('stat-time', `${report.parse_ms.toFixed(1)} / ${report.time_ms.toFixed(1)} ms${workers}`);
   const badge = $('quality');
   badge.hidden = false;
   badge.textContent = quality === 'final' ? 'final' : 'coarse preview';
@@ -238,11 +240,14 @@ function remesh({ fresh = false } = {}) {
   const onProgress = (done, total) => {
     if (run === state.run) showProgress(done, total);
   };
-  const fine = adopt(options) ?? pool.mesh(bytes, format, options, onProgress);
-  fine.onProgress = onProgress;
   const coarseRel = options.toleranceRel === undefined || options.toleranceRel < COARSE_REL;
   // The coarse preview is a fast-mode mesh: not shown while quality mode is asked for.
-  if (fresh && coarseRel && options.mode !== 'quality') {
+  const withCoarse = fresh && coarseRel && options.mode !== 'quality';
+  // The requested mesh is split by bodies over the workers the preview leaves free.
+  const shares = withCoarse ? pool.size - 1 : pool.size;
+  const fine = adopt(options) ?? pool.meshShared(bytes, format, options, shares, onProgress);
+  fine.onProgress = onProgress;
+  if (withCoarse) {
     const coarse = adopt({ toleranceRel: COARSE_REL }) ?? pool.mesh(bytes, format, { toleranceRel: COARSE_REL });
     coarse.promise.then(
       ({ result, lines }) => {

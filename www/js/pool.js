@@ -7,9 +7,11 @@
 // with an Error whose message is "cancelled" and stops the work at once
 // (the worker is terminated: wasm cannot be interrupted mid-face otherwise).
 //
-// One model is never split by faces across workers: faces are sewn into one
-// watertight mesh after all of them are meshed, inside one call, so the pool
-// runs whole jobs (the page's coarse preview and the requested mesh side by side).
+// A model of several bodies (the solids and parts of an assembly) can be
+// split across workers with meshShared(): each worker meshes the bodies of
+// its share (the module's `share` option), and the results are merged in face
+// order. Bodies share no border, so that is the whole model's mesh. Faces of
+// one body are sewn together inside one call and always mesh in one worker.
 
 export class MeshPool {
   /**
@@ -64,6 +66,40 @@ export class MeshPool {
     job.format = format;
     this.queue.push(job);
     this.#dispatch();
+    return job;
+  }
+
+  /**
+   * As mesh(), split by bodies over `count` workers (at most the pool's size;
+   * quality mode is never split) and merged with mergeShares(). Progress is
+   * that of the least advanced share still running.
+   */
+  meshShared(bytes, format, options, count, onProgress = () => {}) {
+    const n = Math.min(count, this.size);
+    if (n <= 1 || options.mode === 'quality') return this.mesh(bytes, format, options, onProgress);
+    const done = new Array(n).fill(0);
+    const running = new Array(n).fill(true);
+    let total = 0;
+    const report = () => {
+      const left = done.filter((_, i) => running[i]);
+      if (left.length > 0) onProgress(Math.min(...left), total);
+    };
+    const parts = Array.from({ length: n }, (_, i) =>
+      this.mesh(bytes, format, { ...options, share: [i, n] }, (d, t) => {
+        done[i] = d;
+        total = t;
+        report();
+      }),
+    );
+    parts.forEach((p, i) => p.promise.then(() => ((running[i] = false), report()), () => {}));
+    const cancel = () => parts.forEach((p) => p.cancel());
+    const job = { cancel, onProgress };
+    job.promise = Promise.all(parts.map((p) => p.promise)).then(mergeShares, (e) => {
+      cancel();
+      throw e;
+    });
+    // The page replaces onProgress after the call, as with mesh().
+    Object.defineProperty(job, 'onProgress', { set: (f) => (onProgress = f), get: () => onProgress });
     return job;
   }
 
@@ -189,4 +225,105 @@ export class MeshPool {
     job.reject(new Error('cancelled'));
     this.#dispatch();
   }
+}
+
+/**
+ * One result from the results of a model's shares ({ result, lines } each, as
+ * a job resolves): every face's triangles and vertices from the share that
+ * meshed it, in face order, so faceRanges stay sorted; the line sets joined;
+ * the report's counts summed, its extremes the extremes, its mean deviation
+ * weighted by triangles (the 1st-percentile angle is the smallest share's).
+ */
+export function mergeShares(parts) {
+  const results = parts.map((p) => p.result);
+  const first = results[0];
+  const faces = first.faceRanges.length / 2;
+  let triangles = 0;
+  let vertices = 0;
+  const blocks = []; // per face: [share, first triangle, count, lowest vertex, highest vertex]
+  for (let f = 0; f < faces; f++) {
+    const s = results.findIndex((r) => r.faceRanges[2 * f + 1] > 0);
+    if (s < 0) {
+      blocks.push(null);
+      continue;
+    }
+    const r = results[s];
+    const [t0, n] = [r.faceRanges[2 * f], r.faceRanges[2 * f + 1]];
+    let lo = Infinity;
+    let hi = -1;
+    for (let k = 3 * t0; k < 3 * (t0 + n); k++) {
+      lo = Math.min(lo, r.indices[k]);
+      hi = Math.max(hi, r.indices[k]);
+    }
+    blocks.push([s, t0, n, lo, hi]);
+    triangles += n;
+    vertices += hi - lo + 1;
+  }
+  const positions = new Float32Array(3 * vertices);
+  const normals = new Float32Array(3 * vertices);
+  const indices = new Uint32Array(3 * triangles);
+  const faceRanges = new Uint32Array(2 * faces);
+  const remap = results.map((r) => new Int32Array(r.positions.length / 3).fill(-1));
+  let v = 0;
+  let t = 0;
+  for (let f = 0; f < faces; f++) {
+    faceRanges[2 * f] = t;
+    const b = blocks[f];
+    if (!b) continue;
+    const [s, t0, n, lo, hi] = b;
+    const r = results[s];
+    positions.set(r.positions.subarray(3 * lo, 3 * (hi + 1)), 3 * v);
+    normals.set(r.normals.subarray(3 * lo, 3 * (hi + 1)), 3 * v);
+    for (let x = lo; x <= hi; x++) remap[s][x] = v + x - lo;
+    for (let k = 3 * t0; k < 3 * (t0 + n); k++) indices[3 * t + k - 3 * t0] = remap[s][r.indices[k]];
+    faceRanges[2 * f + 1] = n;
+    v += hi - lo + 1;
+    t += n;
+  }
+  const wire = [];
+  parts.forEach((p, s) => {
+    const w = p.lines.wire;
+    for (let k = 0; k + 1 < w.length; k += 2) {
+      const [a, c] = [remap[s][w[k]], remap[s][w[k + 1]]];
+      if (a >= 0 && c >= 0) wire.push(a, c);
+    }
+  });
+  const join = (key) => {
+    const out = new Float32Array(parts.reduce((n, p) => n + p.lines[key].length, 0));
+    let at = 0;
+    for (const p of parts) {
+      out.set(p.lines[key], at);
+      at += p.lines[key].length;
+    }
+    return out;
+  };
+  const reps = results.map((r) => r.report);
+  const sum = (k) => reps.reduce((a, r) => a + (r[k] ?? 0), 0);
+  const max = (k) => Math.max(...reps.map((r) => r[k] ?? 0));
+  const meshed = reps.filter((r) => r.triangles > 0);
+  const min = (k) => (meshed.length ? Math.min(...meshed.map((r) => r[k])) : first.report[k]);
+  const report = {
+    ...first.report,
+    faces_skipped: sum('faces_skipped'),
+    triangles,
+    vertices,
+    max_deviation: max('max_deviation'),
+    mean_deviation: triangles > 0 ? reps.reduce((a, r) => a + r.mean_deviation * r.triangles, 0) / triangles : 0,
+    min_angle_deg: min('min_angle_deg'),
+    p1_angle_deg: min('p1_angle_deg'),
+    free_edges: sum('free_edges'),
+    boundary_edges: sum('boundary_edges'),
+    nonmanifold_edges: sum('nonmanifold_edges'),
+    inverted_triangles: sum('inverted_triangles'),
+    max_normal_turn: max('max_normal_turn'),
+    time_ms: max('time_ms'),
+    parse_ms: max('parse_ms'),
+    warnings: [...new Set(reps.flatMap((r) => r.warnings ?? []))],
+    reparameterized: reps.flatMap((r) => r.reparameterized ?? []),
+    shares: reps.length,
+  };
+  return {
+    result: { ...first, positions, normals, indices, faceRanges, report },
+    lines: { wire: new Uint32Array(wire), borders: join('borders'), open: join('open') },
+  };
 }
