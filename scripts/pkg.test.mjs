@@ -131,6 +131,7 @@ test('an assembly meshed in shares of its bodies merges into the whole mesh', as
   const bytes = readFileSync(join(root, 'tests', 'data', 'step_assembly.stp'));
   const options = { toleranceRel: 1e-3 };
   const whole = surfmesh.mesh(bytes, 'step', options);
+  assert.equal(whole.report.bodies, 2);
   const none = { wire: new Uint32Array(), borders: new Float32Array(), open: new Float32Array() };
   const shares = [0, 1].map((i) => ({ result: surfmesh.mesh(bytes, 'step', { ...options, share: [i, 2] }), lines: none }));
   for (const { result } of shares) {

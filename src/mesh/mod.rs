@@ -58,6 +58,9 @@ pub struct Report {
     pub faces: usize,
     /// Faces that produced no triangles (skipped with a warning).
     pub faces_skipped: usize,
+    /// Bodies in the model: sets of faces that share no border with each
+    /// other (solids, sheets, assembly parts); the `share` option splits by them.
+    pub bodies: usize,
     /// Triangles in the mesh.
     pub triangles: usize,
     /// Vertices in the mesh (per-face copies counted).

@@ -60,18 +60,35 @@ pub fn mesh_model_with_progress(
     options: &MeshOptions,
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<MeshResult, Error> {
+    let bodies = {
+        let mut ids: Vec<u32> = (0..model.faces.len()).map(|f| crate::model::body_of(&model.bodies, f)).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        ids.len()
+    };
     if options.mode == MeshMode::Quality {
-        return crate::quality::mesh_quality(model, options, progress);
+        let mut r = crate::quality::mesh_quality(model, options, progress)?;
+        r.report.bodies = bodies;
+        return Ok(r);
     }
-    let Setup { tol, diag, lim, crit } = setup(model, options)?;
-    let aim = crit.tol;
-    let mut report = Report { tolerance: tol, angle: options.angle, faces: model.faces.len(), ..Report::default() };
-    report.warnings.extend(model.warnings.iter().cloned());
     // A share meshes its bodies only; the other faces stay empty (not skipped).
     let mine = match options.share {
         Some((index, count)) => share_of_faces(&model.bodies, model.faces.len(), index, count),
         None => alloc::vec![true; model.faces.len()],
     };
+    if options.share.is_some() && !mine.contains(&true) {
+        // More shares than bodies: this one returns at once, without the
+        // bounding box a tolerance needs (its report's tolerance stays 0).
+        options.validate()?;
+        let mesh = Mesh { face_ranges: alloc::vec![FaceRange::default(); model.faces.len()], ..Mesh::default() };
+        let report = Report { angle: options.angle, faces: model.faces.len(), bodies, ..Report::default() };
+        return Ok(MeshResult { mesh, report });
+    }
+    let Setup { tol, diag, lim, crit } = setup(model, options)?;
+    let aim = crit.tol;
+    let mut report =
+        Report { tolerance: tol, angle: options.angle, faces: model.faces.len(), bodies, ..Report::default() };
+    report.warnings.extend(model.warnings.iter().cloned());
     // Paper 001: faces whose parameters crowd are rebuilt on even ones first.
     let rebuilt = reparameterize(model, &mine, options.reparam, tol, &mut report);
     // Untrimmed faces are meshed as trimmed by their domain's border, so

@@ -68,8 +68,9 @@ pub struct MeshOptions {
     /// `Some((index, count))`: mesh only share `index` of `count` of the
     /// model's bodies (see [`share_of_faces`]), so that workers can mesh one
     /// model side by side. Bodies share no border, so the shares' meshes
-    /// together are the whole model's mesh. Default `None`: every face.
-    /// Fast mode only.
+    /// together are the whole model's mesh (`Report::bodies` says how many
+    /// there are). A share given no body returns at once, its mesh empty and
+    /// its report's tolerance 0. Default `None`: every face. Fast mode only.
     pub share: Option<(u32, u32)>,
 }
 

@@ -390,8 +390,10 @@ fn shares_of_the_bodies_make_the_whole_mesh() {
     }
     assert_eq!(shares[0].report.triangles + shares[1].report.triangles, whole.report.triangles);
     // More shares than bodies: the extra one is empty, not an error.
+    assert_eq!(whole.report.bodies, 2);
     let empty = mesh_model(&model, &options.clone().with_share(2, 3)).unwrap();
     assert_eq!(empty.report.triangles, 0);
     assert_eq!(empty.report.faces_skipped, 0);
+    assert_eq!(empty.mesh.face_ranges.len(), 12, "every face is listed, with no triangles");
     assert!(mesh_model(&model, &options.clone().with_share(2, 2)).is_err(), "an index past the count is refused");
 }

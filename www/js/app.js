@@ -201,7 +201,8 @@ function formatOf(name) {
 }
 
 function load(name, bytes, { prestarted = false } = {}) {
-  state.model = { name, bytes, format: formatOf(name), prestarted };
+  // bodies: how many the model has, once a mesh of it has said (a re-mesh splits by them).
+  state.model = { name, bytes, format: formatOf(name), prestarted, bodies: 1 };
   state.diagonal = null;
   $('model-name').textContent = name;
   remesh({ fresh: true });
@@ -244,7 +245,7 @@ function remesh({ fresh = false } = {}) {
   // The coarse preview is a fast-mode mesh: not shown while quality mode is asked for.
   const withCoarse = fresh && coarseRel && options.mode !== 'quality';
   // The requested mesh is split by bodies over the workers the preview leaves free.
-  const shares = withCoarse ? pool.size - 1 : pool.size;
+  const shares = Math.min(withCoarse ? pool.size - 1 : pool.size, state.model.bodies);
   const fine = adopt(options) ?? pool.meshShared(bytes, format, options, shares, onProgress);
   fine.onProgress = onProgress;
   if (withCoarse) {
@@ -257,6 +258,7 @@ function remesh({ fresh = false } = {}) {
         setTimeout(() => boot.release?.(), 250);
         if (run !== state.run || finished) return;
         learnDiagonal(result.report, COARSE_REL);
+        learnBodies(result.report);
         display(result, lines, 'coarse', { fit: true });
         status(`Coarse preview (relative ${COARSE_REL}) shown; meshing at the requested tolerance…`);
       },
@@ -270,6 +272,7 @@ function remesh({ fresh = false } = {}) {
       finished = true;
       pool.cancelAll();
       learnDiagonal(result.report, options.toleranceRel);
+      learnBodies(result.report);
       display(result, lines, 'final', { fit: fresh && state.shown?.quality !== 'coarse' });
       hideProgress();
       setState('ready');
@@ -291,6 +294,10 @@ function remesh({ fresh = false } = {}) {
       showError(pool.error ? 'The mesher could not start' : `Could not mesh ${name}`, error.message);
     },
   );
+}
+
+function learnBodies(report) {
+  if (state.model && report.bodies > 0) state.model.bodies = report.bodies;
 }
 
 function learnDiagonal(report, rel) {
