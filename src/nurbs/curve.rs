@@ -3,8 +3,8 @@
 use alloc::vec::Vec;
 use glam::{DVec3, DVec4};
 
-use super::knots::{BasisDers, KnotVector};
-use super::{Aabb, NurbsError};
+use super::knots::{KnotVector, MAX_DERIV};
+use super::{Aabb, NurbsError, MAX_DEGREE};
 
 /// A (possibly rational) B-spline curve. 2-D curves (trim loops in (u,v)) keep z = 0.
 ///
@@ -103,37 +103,60 @@ impl NurbsCurve {
 
     /// C(t); `t` is clamped into the domain.
     pub fn point(&self, t: f64) -> DVec3 {
-        let mut b = BasisDers::default();
-        let span = self.knots.basis_ders(t, 0, &mut b);
+        // Basis scratch sized for the degree class, as for surfaces: zeroing
+        // the full 17-wide tables cost more than a cubic's arithmetic.
+        match self.degree() {
+            0..=3 => self.point_n::<4>(t),
+            4..=7 => self.point_n::<8>(t),
+            _ => self.point_n::<{ MAX_DEGREE + 1 }>(t),
+        }
+    }
+
+    fn point_n<const N: usize>(&self, t: f64) -> DVec3 {
+        let mut b = [[0.0; N]; MAX_DERIV + 1];
+        let span = self.knots.basis_into(t, 0, &mut b);
         let p = self.degree();
         let mut h = DVec4::ZERO;
         for j in 0..=p {
-            h += self.points[span - p + j] * b.0[0][j];
+            h += self.points[span - p + j] * b[0][j];
         }
         h.truncate() / h.w
     }
 
     /// C(t), C'(t), C''(t) (rational quotient rule).
     pub fn derivs(&self, t: f64) -> CurveDerivs {
-        let mut b = BasisDers::default();
-        let span = self.knots.basis_ders(t, 2, &mut b);
-        self.derivs_from(span, &b)
+        match self.degree() {
+            0..=3 => self.derivs_n::<4>(None, t),
+            4..=7 => self.derivs_n::<8>(None, t),
+            _ => self.derivs_n::<{ MAX_DEGREE + 1 }>(None, t),
+        }
     }
 
     /// As [`NurbsCurve::derivs`] with the polynomial piece of knot span
     /// `span`, also at its ends (one-sided limits at the knots).
     fn derivs_in(&self, span: usize, t: f64) -> CurveDerivs {
-        let mut b = BasisDers::default();
-        self.knots.basis_in_span(span, t, 2, &mut b.0);
-        self.derivs_from(span, &b)
+        match self.degree() {
+            0..=3 => self.derivs_n::<4>(Some(span), t),
+            4..=7 => self.derivs_n::<8>(Some(span), t),
+            _ => self.derivs_n::<{ MAX_DEGREE + 1 }>(Some(span), t),
+        }
     }
 
-    fn derivs_from(&self, span: usize, b: &BasisDers) -> CurveDerivs {
+    /// Derivatives at `t` in the span holding it, or in `span` when given.
+    fn derivs_n<const N: usize>(&self, span: Option<usize>, t: f64) -> CurveDerivs {
+        let mut b = [[0.0; N]; MAX_DERIV + 1];
+        let span = match span {
+            Some(s) => {
+                self.knots.basis_in_span(s, t, 2, &mut b);
+                s
+            }
+            None => self.knots.basis_into(t, 2, &mut b),
+        };
         let p = self.degree();
         let mut h = [DVec4::ZERO; 3];
         for (k, hk) in h.iter_mut().enumerate() {
             for j in 0..=p {
-                *hk += self.points[span - p + j] * b.0[k][j];
+                *hk += self.points[span - p + j] * b[k][j];
             }
         }
         let w = h[0].w;
