@@ -26,6 +26,8 @@ mod quality;
 mod repair;
 mod reparam;
 mod tessellate;
+#[cfg(test)]
+mod testing;
 #[cfg(all(target_arch = "wasm32", target_os = "unknown"))]
 mod wasm;
 

@@ -100,13 +100,7 @@ mod tests {
 
     #[test]
     fn random_points_give_an_empty_circle_triangulation_of_the_hull() {
-        let mut s = 99u64;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::testing::uniform(99u64);
         let pts: Vec<DVec2> = (0..30).map(|_| DVec2::new(rnd() * 3.0, rnd())).collect();
         let t = triangulate(&pts);
         let area: f64 = t.iter().map(|t| orient(pts[t[0]], pts[t[1]], pts[t[2]]) / 2.0).sum();

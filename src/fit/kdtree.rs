@@ -127,13 +127,7 @@ mod tests {
 
     #[test]
     fn nearest_matches_brute_force() {
-        let mut s = 12345u64;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::testing::uniform(12345u64);
         let pts: Vec<DVec3> = (0..500).map(|_| DVec3::new(rnd(), rnd(), rnd() * 0.1)).collect();
         let tree = KdTree::new(&pts);
         let mut out = Vec::new();

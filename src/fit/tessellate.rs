@@ -206,13 +206,7 @@ mod tests {
 
     /// Points on a wavy sheet z = 0.2 sin(3x) cos(2y) over the unit square, jittered grid.
     fn sheet() -> Vec<DVec3> {
-        let mut s = 5u64;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::testing::uniform(5u64);
         let mut pts = Vec::new();
         for i in 0..9 {
             for j in 0..9 {

@@ -632,13 +632,7 @@ mod tests {
 
     #[test]
     fn a_jittered_grid_gives_one_oriented_sheet_with_one_border() {
-        let mut s = 3u64;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::testing::uniform(3u64);
         let mut pts = Vec::new();
         for i in 0..12 {
             for j in 0..10 {

@@ -169,10 +169,63 @@ impl KnotVector {
             return;
         }
         let p = self.degree;
+        let nd = nd.min(MAX_DERIV);
+        let ndu = self.basis_triangle::<N>(span, t);
+        for j in 0..=p {
+            ders[0][j] = ndu[j][p];
+        }
+        if nd == 0 {
+            return;
+        }
+        // First and second derivatives from the degree p-1 and p-2 functions
+        // the triangle holds (The NURBS Book eq. 2.9, the terms of A2.3
+        // for k <= 2 written out): `basis(r, j)` is N of degree j, `gap(j, r)`
+        // a knot difference; a zero gap drops its term.
+        let basis = |r: usize, j: usize| ndu[r][j];
+        let gap = |j: usize, r: usize| ndu[j][r];
+        let over = |x: f64, gap: f64| if gap != 0.0 { x / gap } else { 0.0 };
+        let pf = p as f64;
+        for r in 0..=p {
+            // Coefficients of the degree p-1 functions in N', as A2.3's a[.][0] and a[.][1].
+            let c0 = if r >= 1 { over(1.0, gap(p, r - 1)) } else { 0.0 };
+            let c1 = if r < p { -over(1.0, gap(p, r)) } else { 0.0 };
+            let mut d1 = 0.0;
+            if r >= 1 {
+                d1 += c0 * basis(r - 1, p - 1);
+            }
+            if r < p {
+                d1 += c1 * basis(r, p - 1);
+            }
+            ders[1][r] = pf * d1;
+            if nd >= 2 {
+                if p < 2 {
+                    ders[2][r] = 0.0;
+                    continue;
+                }
+                let mut d2 = 0.0;
+                if r >= 2 {
+                    d2 += over(c0, gap(p - 1, r - 2)) * basis(r - 2, p - 2);
+                }
+                if r >= 1 && r < p {
+                    d2 += over(c1 - c0, gap(p - 1, r - 1)) * basis(r - 1, p - 2);
+                }
+                if r + 2 <= p {
+                    d2 += over(-c1, gap(p - 1, r)) * basis(r, p - 2);
+                }
+                ders[2][r] = pf * (pf - 1.0) * d2;
+            }
+        }
+    }
+
+    /// The Cox-de Boor triangle of A2.3 for the piece of span `span`
+    /// (clamped to `degree..control_count()`) at `t` (clamped): `[r][j]` for
+    /// `r <= j` is the degree-`j` function `N_{span-j+r}`, `[j][r]` for `r < j`
+    /// the knot difference it was divided by. Needs `N > degree`.
+    fn basis_triangle<const N: usize>(&self, span: usize, t: f64) -> [[f64; N]; N] {
+        let p = self.degree;
         let t = self.clamp(t);
         let span = span.clamp(p, self.control_count() - 1);
         let u = &self.knots;
-        let nd = nd.min(MAX_DERIV);
         let mut ndu = [[0.0f64; N]; N];
         let mut left = [0.0f64; N];
         let mut right = [0.0f64; N];
@@ -189,49 +242,7 @@ impl KnotVector {
             }
             ndu[j][j] = saved;
         }
-        for j in 0..=p {
-            ders[0][j] = ndu[j][p];
-        }
-        if nd == 0 {
-            return;
-        }
-        // First and second derivatives from the degree p-1 and p-2 functions
-        // the triangle above holds (The NURBS Book eq. 2.9, the terms of A2.3
-        // for k <= 2 written out): `basis(r, j)` is N of degree j, `gap(j, r)`
-        // a knot difference; a zero gap drops its term.
-        let basis = |r: usize, j: usize| ndu[r][j];
-        let over = |x: f64, gap: f64| if gap != 0.0 { x / gap } else { 0.0 };
-        let pf = p as f64;
-        for r in 0..=p {
-            // Coefficients of the degree p-1 functions in N', as A2.3's a[.][0] and a[.][1].
-            let c0 = if r >= 1 { over(1.0, ndu[p][r - 1]) } else { 0.0 };
-            let c1 = if r < p { -over(1.0, ndu[p][r]) } else { 0.0 };
-            let mut d1 = 0.0;
-            if r >= 1 {
-                d1 += c0 * basis(r - 1, p - 1);
-            }
-            if r < p {
-                d1 += c1 * basis(r, p - 1);
-            }
-            ders[1][r] = pf * d1;
-            if nd >= 2 {
-                if p < 2 {
-                    ders[2][r] = 0.0;
-                    continue;
-                }
-                let mut d2 = 0.0;
-                if r >= 2 {
-                    d2 += over(c0, ndu[p - 1][r - 2]) * basis(r - 2, p - 2);
-                }
-                if r >= 1 && r < p {
-                    d2 += over(c1 - c0, ndu[p - 1][r - 1]) * basis(r - 1, p - 2);
-                }
-                if r + 2 <= p {
-                    d2 += over(-c1, ndu[p - 1][r]) * basis(r, p - 2);
-                }
-                ders[2][r] = pf * (pf - 1.0) * d2;
-            }
-        }
+        ndu
     }
 
     /// Inserts knot `t` once (no validation of multiplicity beyond the degree);
@@ -265,28 +276,13 @@ impl Default for BasisDers {
 mod tests {
     use super::*;
 
-    /// The NURBS Book's A2.3 derivative loop as written there, for any order:
-    /// the oracle the written-out k <= 2 terms are checked against.
+    /// The NURBS Book's A2.3 derivative loop as written there, for any order,
+    /// on the same triangle: the oracle the written-out k <= 2 terms are checked against.
     fn reference(kv: &KnotVector, span: usize, t: f64, nd: usize) -> [[f64; MAX_DEGREE + 1]; MAX_DERIV + 1] {
         const N: usize = MAX_DEGREE + 1;
         let p = kv.degree;
-        let u = &kv.knots;
         let mut ders = [[0.0f64; N]; MAX_DERIV + 1];
-        let mut ndu = [[0.0f64; N]; N];
-        let (mut left, mut right) = ([0.0f64; N], [0.0f64; N]);
-        ndu[0][0] = 1.0;
-        for j in 1..=p {
-            left[j] = t - u[span + 1 - j];
-            right[j] = u[span + j] - t;
-            let mut saved = 0.0;
-            for r in 0..j {
-                ndu[j][r] = right[r + 1] + left[j - r];
-                let temp = if ndu[j][r] != 0.0 { ndu[r][j - 1] / ndu[j][r] } else { 0.0 };
-                ndu[r][j] = saved + right[r + 1] * temp;
-                saved = left[j - r] * temp;
-            }
-            ndu[j][j] = saved;
-        }
+        let ndu = kv.basis_triangle::<N>(span, t);
         for j in 0..=p {
             ders[0][j] = ndu[j][p];
         }
@@ -340,13 +336,7 @@ mod tests {
     /// scratch sizes the hot paths use.
     #[test]
     fn derivatives_match_the_general_algorithm() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::testing::uniform(0x2545_f491_4f6c_dd1du64);
         let mut checked = 0;
         for p in 1..=9usize {
             for shape in 0..4 {

@@ -78,7 +78,7 @@ pub struct MeshOptions {
 /// faces) first, to the share with the fewest faces so far; ties by body id
 /// and by share index, so every worker computes the same split.
 pub fn share_of_faces(bodies: &[u32], faces: usize, index: u32, count: u32) -> Vec<bool> {
-    let body = |f: usize| bodies.get(f).copied().unwrap_or(0);
+    let body = |f: usize| crate::model::body_of(bodies, f);
     let mut sizes: crate::collections::HashMap<u32, usize> = crate::collections::HashMap::default();
     for f in 0..faces {
         *sizes.entry(body(f)).or_insert(0) += 1;
