@@ -93,14 +93,21 @@ export class MeshPool {
     );
     parts.forEach((p, i) => p.promise.then(() => ((running[i] = false), report()), () => {}));
     const cancel = () => parts.forEach((p) => p.cancel());
-    const job = { cancel, onProgress };
-    job.promise = Promise.all(parts.map((p) => p.promise)).then(mergeShares, (e) => {
+    const promise = Promise.all(parts.map((p) => p.promise)).then(mergeShares, (e) => {
       cancel();
       throw e;
     });
     // The page replaces onProgress after the call, as with mesh().
-    Object.defineProperty(job, 'onProgress', { set: (f) => (onProgress = f), get: () => onProgress });
-    return job;
+    return {
+      promise,
+      cancel,
+      get onProgress() {
+        return onProgress;
+      },
+      set onProgress(f) {
+        onProgress = f;
+      },
+    };
   }
 
   #job(id, options, onProgress) {

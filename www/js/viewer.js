@@ -75,29 +75,25 @@ export class Viewer {
    * one compilation, not four.
    */
   warmUp(kind = 'faces') {
-    const parts = [];
-    const geometries = [];
-    if (kind === 'faces') {
-      const geometry = toBufferGeometry({
-        positions: new Float32Array(9),
-        normals: new Float32Array([0, 0, 1, 0, 0, 1, 0, 0, 1]),
-        indices: new Uint32Array([0, 1, 2]),
-        faceRanges: new Uint32Array([0, 1]),
-      });
-      geometries.push(geometry);
-      parts.push(new THREE.Mesh(geometry, this.faceMaterials));
-    } else {
-      for (const material of [this.wireMaterial, this.borderMaterial, this.openMaterial]) {
-        const part = segments(new Float32Array(6), material);
-        geometries.push(part.geometry);
-        parts.push(part);
-      }
-    }
+    const parts =
+      kind === 'faces'
+        ? [
+            new THREE.Mesh(
+              toBufferGeometry({
+                positions: new Float32Array(9),
+                normals: new Float32Array([0, 0, 1, 0, 0, 1, 0, 0, 1]),
+                indices: new Uint32Array([0, 1, 2]),
+                faceRanges: new Uint32Array([0, 1]),
+              }),
+              this.faceMaterials,
+            ),
+          ]
+        : [this.wireMaterial, this.borderMaterial, this.openMaterial].map((m) => segments(new Float32Array(6), m));
     for (const part of parts) part.frustumCulled = false;
     this.scene.add(...parts);
     this.renderer.render(this.scene, this.camera);
     this.scene.remove(...parts);
-    for (const geometry of geometries) geometry.dispose();
+    for (const part of parts) part.geometry.dispose();
     performance.mark(`surfmesh:shaders-compiled-${kind}`);
   }
 
