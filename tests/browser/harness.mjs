@@ -13,7 +13,7 @@ export const root = join(here, '..', '..');
 export const shots = join(here, 'screenshots');
 
 const CHROMIUM = process.env.CHROMIUM ?? '/usr/bin/chromium';
-const FLAGS = [
+export const FLAGS = [
   '--headless',
   '--no-sandbox',
   '--disable-gpu',
@@ -21,6 +21,10 @@ const FLAGS = [
   '--disable-component-update',
   '--disable-sync',
   '--no-first-run',
+  // Headless Chromium 156 otherwise keeps reloading its (never shown) omnibox
+  // popup WebUI in a renderer of its own, which kept one of this machine's two
+  // cores busy through every page load and slowed the page's first mesh by a third.
+  '--disable-features=WebUIOmniboxPopup,WebUIOmniboxAimPopup',
 ];
 
 /** Starts the server (page, package, three.js, plus `mounts`) and the browser. */
