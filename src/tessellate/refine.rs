@@ -45,6 +45,11 @@ pub(crate) struct WorkMesh {
     measures: Vec<Option<(TriMeasure, f64)>>,
 }
 
+/// One triangle of an edge being split: the triangle, its corners and their
+/// (u,v) starting at the edge, the new vertex's (u,v), and the edge's own
+/// (u,v) point at the split fraction.
+type SplitPlan = (u32, [u32; 3], [DVec2; 3], DVec2, DVec2);
+
 fn key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
 }
@@ -317,7 +322,7 @@ impl WorkMesh {
         }
         // First where the new vertex goes in each triangle on the edge, then
         // (when it is a real split) the change.
-        let mut plan: Vec<(u32, [u32; 3], [DVec2; 3], DVec2)> = Vec::with_capacity(2);
+        let mut plan: Vec<SplitPlan> = Vec::with_capacity(2);
         let mut m_pos: Option<DVec3> = None;
         let mut m_normal = DVec3::ZERO;
         for &t in adj.iter().filter(|&&t| t != NONE) {
@@ -344,9 +349,35 @@ impl WorkMesh {
                 m_pos = Some(target.unwrap_or_else(|| surface.point(uv_m)));
                 m_normal = surface.normal(uv_m);
             }
-            plan.push((t, [x0, x1, x2], [u0, u1, u2], uv_m));
+            plan.push((t, [x0, x1, x2], [u0, u1, u2], uv_m, guess));
         }
-        let p = m_pos?;
+        let mut p = m_pos?;
+        let area = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+        let folds = |u: [DVec2; 3], uv_m: DVec2| {
+            let whole = area(u[0], u[1], u[2]);
+            whole != 0.0 && (area(u[0], uv_m, u[2]) * whole <= 0.0 || area(uv_m, u[1], u[2]) * whole <= 0.0)
+        };
+        if target.is_some() {
+            // A sewing target whose (u,v) would fold the children (a thin
+            // triangle on a curved border) goes in at the edge's own point,
+            // on this face's surface: the children keep their (u,v)
+            // orientation and face the surface's way. Settling later moves
+            // the node halfway to where the other face has it; put there at
+            // once, a node off its (u,v) folded the thin children in space,
+            // and refinement split those folds down to slivers (99 on one
+            // cylinder of a valve body).
+            let mut moved = None;
+            for item in &mut plan {
+                if folds(item.2, item.3) {
+                    item.3 = item.4;
+                    moved.get_or_insert(item.4);
+                }
+            }
+            if let Some(uv) = moved {
+                p = surface.point(uv);
+                m_normal = surface.normal(uv);
+            }
+        }
         if target.is_none() {
             // A point that is not strictly inside the edge, or lands on a
             // triangle's third corner, or children that fold in (u,v) (a
@@ -355,14 +386,8 @@ impl WorkMesh {
             // again forever: the edge stays as it is.
             let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
             let near = 1e-6 * pa.distance(pb);
-            let area = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
             let bad = !(p.distance(pa) > near && p.distance(pb) > near)
-                || plan.iter().any(|&(_, x, u, uv_m)| {
-                    let whole = area(u[0], u[1], u[2]);
-                    p.distance(self.pos[x[2] as usize]) <= near
-                        || (whole != 0.0
-                            && (area(u[0], uv_m, u[2]) * whole <= 0.0 || area(uv_m, u[1], u[2]) * whole <= 0.0))
-                });
+                || plan.iter().any(|&(_, x, u, uv_m, _)| p.distance(self.pos[x[2] as usize]) <= near || folds(u, uv_m));
             if bad {
                 return None;
             }
@@ -371,7 +396,7 @@ impl WorkMesh {
         self.pos.push(p);
         self.normal.push(m_normal);
         self.gid.push(NONE);
-        for (t, [x0, x1, x2], [u0, u1, u2], uv_m) in plan {
+        for (t, [x0, x1, x2], [u0, u1, u2], uv_m, _) in plan {
             // Replace t by [x0, m, x2] and add [m, x1, x2].
             self.detach(x0, x1, t);
             self.detach(x1, x2, t);

@@ -2,8 +2,9 @@
 //! its SOURCES.md). Every one must read; the files in [`MESHED`] must also
 //! mesh at relative tolerances 1e-2 and 1e-3 with a measured deviation
 //! within the tolerance, no inverted triangle, no crack between faces, and
-//! (for [`CLOSED`] solids) no boundary edge at all. Files still missing from
-//! [`MESHED`] are named in the output. An unoptimized build (the plain
+//! (for [`CLOSED`] solids) no boundary edge at all. The others must mesh
+//! within the tolerance without inverted triangles (but for the runs in
+//! [`STILL_FOLDS`]); their cracks are printed. An unoptimized build (the plain
 //! `cargo test`) meshes only the files under [`DEBUG_MAX_BYTES`], to stay
 //! within CI's time; `cargo test --release` meshes them all.
 
@@ -45,6 +46,12 @@ const MESHED: [&str; 10] = [
     "nozzleAndCavity.igs",
 ];
 
+/// Runs (file, relative tolerance) that still leave inverted triangles.
+const STILL_FOLDS: [(&str, f64); 1] = [
+    // Two helical faces 0.0025 apart along an end cap, far below the tolerance.
+    ("bug22869_Spring.igs", 1e-3),
+];
+
 /// In a debug build, larger files are read but not meshed (meshing the
 /// 1.3 MB bearing unoptimized takes most of a minute).
 const DEBUG_MAX_BYTES: usize = 200_000;
@@ -82,14 +89,7 @@ fn corpus_reads_and_meshes_within_tolerance_without_cracks() {
             }
         };
         let parse_ms = start.elapsed().as_secs_f64() * 1e3;
-        if !MESHED.contains(&name.as_str()) {
-            println!(
-                "{name:<28} read only: {} faces, {} skipped (not yet meshed here)",
-                model.faces.len(),
-                skipped_faces(&model)
-            );
-            continue;
-        }
+        let whole = MESHED.contains(&name.as_str());
         if cfg!(debug_assertions) && bytes.len() > DEBUG_MAX_BYTES {
             println!(
                 "{name:<28} read only in a debug build: {} faces (cargo test --release meshes it)",
@@ -126,8 +126,15 @@ fn corpus_reads_and_meshes_within_tolerance_without_cracks() {
             if rep.max_deviation.is_nan() || rep.max_deviation > rep.tolerance {
                 problems.push(format!("max deviation {} above tolerance {}", rep.max_deviation, rep.tolerance));
             }
-            if rep.inverted_triangles != 0 {
+            if rep.inverted_triangles != 0 && (whole || !STILL_FOLDS.contains(&(name.as_str(), rel))) {
                 problems.push(format!("{} inverted triangles", rep.inverted_triangles));
+            }
+            if !whole {
+                // Not yet watertight: within the tolerance and unfolded is what holds.
+                if !problems.is_empty() {
+                    failures.push(format!("{name} @ {rel}: {}", problems.join("; ")));
+                }
+                continue;
             }
             if rep.free_edges != 0 {
                 problems.push(format!("{} free edges (cracks)", rep.free_edges));
