@@ -209,17 +209,33 @@ pub fn mesh_model_with_progress(
     // Refinement keeps shared borders shared: a split of a shared edge is
     // made on every side; then every node takes one position.
     let budget_hit = sew::refine_all(&mut works, ids, options.max_triangles, progress)?;
-    let settled = sew::settle_nodes(&mut works, 1e-6 * tol);
+    let (settled, places) = sew::settle_nodes(&mut works, 1e-6 * tol);
     for (w, moved) in works.iter_mut().zip(&settled) {
         w.mesh.forget(moved);
     }
     // Refinement may leave a thin triangle folded next to a border node it
     // cannot move: unfold by interior edge flips or by moving an inner
-    // vertex, which leaves the shared borders as they are.
+    // vertex, which leaves the shared borders as they are. What is still
+    // folded may unfold with a node at another face's place for it, and
+    // then by flips.
+    let mut folded: Vec<Vec<u32>> = Vec::with_capacity(works.len());
+    for w in works.iter_mut() {
+        let (changed, left) = w.mesh.repair_inverted(w.surface, &w.crit);
+        w.mesh.forget(&changed);
+        folded.push(left);
+    }
+    if folded.iter().any(|f| !f.is_empty()) {
+        let moved = sew::resettle_folds(&mut works, &places, &folded);
+        for (w, moved) in works.iter_mut().zip(&moved) {
+            if !moved.is_empty() {
+                w.mesh.forget(moved);
+                let (changed, _) = w.mesh.repair_inverted(w.surface, &w.crit);
+                w.mesh.forget(&changed);
+            }
+        }
+    }
     let mut outcomes: Vec<refine::Outcome> = Vec::with_capacity(works.len());
     for (index, (w, fit_error)) in works.iter_mut().zip(&fit_errors).enumerate() {
-        let changed = w.mesh.repair_inverted(w.surface, &w.crit);
-        w.mesh.forget(&changed);
         let mut out = w.mesh.outcome(w.surface, &w.crit);
         if *fit_error > 0.0 {
             // Reported against the original face: the mesh's distance to the new one plus the fit error.

@@ -530,9 +530,14 @@ impl WorkMesh {
     /// space) and pass the deviation and angle limits. Borders are not
     /// touched, so a sewn border stays conforming. Returns the triangles
     /// changed.
-    pub fn repair_inverted(&mut self, surface: &dyn Surface, c: &Criteria) -> Vec<u32> {
+    ///
+    /// Also returns the triangles still folded.
+    pub fn repair_inverted(&mut self, surface: &dyn Surface, c: &Criteria) -> (Vec<u32>, Vec<u32>) {
         let mut changed = Vec::new();
-        let mut todo: Vec<u32> = (0..self.tris.len() as u32).filter(|&t| self.inverted(surface, t as usize)).collect();
+        let mut todo: Vec<u32> = self.folded(surface);
+        if todo.is_empty() {
+            return (changed, todo);
+        }
         for _ in 0..8 {
             let mut next = Vec::new();
             let mut flipped = false;
@@ -578,7 +583,21 @@ impl WorkMesh {
         }
         changed.sort_unstable();
         changed.dedup();
-        changed
+        let left = self.folded(surface);
+        (changed, left)
+    }
+
+    /// Of triangles `ts`, how many fold against the surface or exceed the
+    /// deviation limit (judging a node's place, see [`super::sew::resettle_folds`]).
+    pub fn failing(&self, surface: &dyn Surface, c: &Criteria, ts: &[u32]) -> usize {
+        ts.iter()
+            .filter(|&&t| self.inverted(surface, t as usize) || self.measure(surface, t as usize, c).0.max > c.tol)
+            .count()
+    }
+
+    /// The triangles still folded against the surface.
+    pub fn folded(&self, surface: &dyn Surface) -> Vec<u32> {
+        (0..self.tris.len() as u32).filter(|&t| self.inverted(surface, t as usize)).collect()
     }
 
     /// Flips edge `a-b` of triangle `t` (where `t` runs a→b) if the result is better; see [`Self::repair_inverted`].

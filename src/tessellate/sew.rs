@@ -606,9 +606,13 @@ pub(crate) fn refine_all(
 /// put it (so each moves by half the gap between them), and returns per
 /// face the triangles whose corners moved by more than `negligible` (the
 /// rest keep their measures: they changed by less than that).
-pub(crate) fn settle_nodes(faces: &mut [FaceWork<'_>], negligible: f64) -> Vec<Vec<u32>> {
+///
+/// Also returns, per node whose faces disagreed, the places they put it,
+/// for [`resettle_folds`].
+pub(crate) fn settle_nodes(faces: &mut [FaceWork<'_>], negligible: f64) -> (Vec<Vec<u32>>, Places) {
     // Per node: sum of positions, count, and whether they all agree already.
     let mut sum: HashMap<u32, (DVec3, f64, DVec3, bool)> = HashMap::default();
+    let mut places: Places = HashMap::default();
     for f in faces.iter() {
         for (v, &g) in f.mesh.gid.iter().enumerate() {
             if g != NONE {
@@ -617,6 +621,13 @@ pub(crate) fn settle_nodes(faces: &mut [FaceWork<'_>], negligible: f64) -> Vec<V
                 e.0 += p;
                 e.1 += 1.0;
                 e.3 &= e.2 == p;
+                if !e.3 {
+                    let first = e.2;
+                    let list = places.entry(g).or_insert_with(|| alloc::vec![first]);
+                    if !list.contains(&p) {
+                        list.push(p);
+                    }
+                }
             }
         }
     }
@@ -639,5 +650,142 @@ pub(crate) fn settle_nodes(faces: &mut [FaceWork<'_>], negligible: f64) -> Vec<V
             .collect();
         changed.push(tris);
     }
+    (changed, places)
+}
+
+/// Per node, the places its faces put it before settling.
+pub(crate) type Places = HashMap<u32, Vec<DVec3>>;
+
+/// Where settling a node to the mean of its faces' places folded a thin
+/// triangle beside it (two faces' borders a hair apart, a sliver narrower
+/// than the gap), tries the node at each place a face put it instead and
+/// keeps the one that leaves fewest triangles around it, in all its faces,
+/// folded or beyond the tolerance; the mean wins ties. Every face still
+/// gets the node at one position, so shared borders stay closed. `folded`:
+/// per face, its folded triangles. Returns per face the triangles changed.
+pub(crate) fn resettle_folds(faces: &mut [FaceWork<'_>], places: &Places, folded: &[Vec<u32>]) -> Vec<Vec<u32>> {
+    let mut changed: Vec<Vec<u32>> = alloc::vec![Vec::new(); faces.len()];
+    // The nodes of folded triangles that had more than one place.
+    let mut nodes: Vec<u32> = Vec::new();
+    for (f, ts) in faces.iter().zip(folded) {
+        for &t in ts {
+            for &v in &f.mesh.tris[t as usize] {
+                let g = f.mesh.gid[v as usize];
+                if g != NONE && places.contains_key(&g) {
+                    nodes.push(g);
+                }
+            }
+        }
+    }
+    nodes.sort_unstable();
+    nodes.dedup();
+    if nodes.is_empty() {
+        return changed;
+    }
+    // Each such node's uses (face, vertex) and the triangles around each.
+    let wanted: crate::collections::HashSet<u32> = nodes.iter().copied().collect();
+    let mut uses: HashMap<u32, Vec<(usize, u32, Vec<u32>)>> = HashMap::default();
+    for (fi, f) in faces.iter().enumerate() {
+        let mut ring: HashMap<u32, Vec<u32>> = HashMap::default();
+        for (v, &g) in f.mesh.gid.iter().enumerate() {
+            if wanted.contains(&g) {
+                ring.insert(v as u32, Vec::new());
+            }
+        }
+        if ring.is_empty() {
+            continue;
+        }
+        for (t, tri) in f.mesh.tris.iter().enumerate() {
+            for v in tri {
+                if let Some(list) = ring.get_mut(v) {
+                    list.push(t as u32);
+                }
+            }
+        }
+        for (v, ts) in ring {
+            uses.entry(f.mesh.gid[v as usize]).or_default().push((fi, v, ts));
+        }
+    }
+    for g in nodes {
+        let (Some(list), Some(candidates)) = (uses.get(&g), places.get(&g)) else { continue };
+        let Some(&(f0, v0, _)) = list.first() else { continue };
+        let settled = faces[f0].mesh.pos[v0 as usize];
+        let score = |faces: &mut [FaceWork<'_>], p: DVec3| -> usize {
+            let mut bad = 0;
+            for (fi, v, ts) in list {
+                let f = &mut faces[*fi];
+                f.mesh.pos[*v as usize] = p;
+                bad += f.mesh.failing(f.surface, &f.crit, ts);
+            }
+            bad
+        };
+        let mut best = (score(faces, settled), settled);
+        if best.0 == 0 {
+            continue;
+        }
+        for &p in candidates {
+            let s = score(faces, p);
+            if s < best.0 {
+                best = (s, p);
+            }
+        }
+        score(faces, best.1);
+        if best.1 != settled {
+            for (fi, _, ts) in list {
+                changed[*fi].extend_from_slice(ts);
+            }
+        }
+    }
+    for c in &mut changed {
+        c.sort_unstable();
+        c.dedup();
+    }
     changed
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nurbs::analytic::bilinear;
+    use glam::DVec2;
+
+    /// One triangle on the plane z = 0 (u = x, v = y), its vertex `node` the model node 7.
+    fn face(corners: [(f64, f64); 3], node: usize) -> WorkMesh {
+        let mut m = WorkMesh::default();
+        for (x, y) in corners {
+            m.add_vertex(DVec3::new(x, y, 0.0), DVec3::Z);
+        }
+        m.gid[node] = 7;
+        m.add_triangle([0, 1, 2], corners.map(|(x, y)| DVec2::new(x, y)));
+        m
+    }
+
+    /// Two faces put node 7 0.06 apart; settled halfway, the first face's
+    /// sliver (0.01 high) folds. At the first face's own place neither face
+    /// folds, and both still have the node at one position.
+    #[test]
+    fn a_node_settled_into_a_fold_moves_to_a_place_that_folds_nothing() {
+        let corner = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        let plane = bilinear(
+            [[corner(-10.0, -10.0), corner(-10.0, 10.0)], [corner(10.0, -10.0), corner(10.0, 10.0)]],
+            [-10.0, 10.0],
+            [-10.0, 10.0],
+        )
+        .unwrap();
+        let crit = Criteria { tol: 0.1, angle: 0.5, max_edge: f64::INFINITY, min_edge: 0.0, steps: 4 };
+        let work = |mesh| FaceWork { surface: &plane, curves: Vec::new(), mesh, crit };
+        let mut faces = alloc::vec![
+            work(face([(0.0, 0.0), (1.0, 0.0), (0.5, 0.01)], 1)),
+            work(face([(1.0, 0.06), (2.0, 0.06), (1.5, 1.0)], 0)),
+        ];
+        let (_, places) = settle_nodes(&mut faces, 1e-9);
+        assert_eq!(faces[0].mesh.pos[1], corner(1.0, 0.03));
+        let folded: Vec<Vec<u32>> = faces.iter().map(|f| f.mesh.folded(&plane)).collect();
+        assert_eq!(folded, [alloc::vec![0], alloc::vec![]]);
+        let moved = resettle_folds(&mut faces, &places, &folded);
+        assert_eq!(moved, [alloc::vec![0], alloc::vec![0]]);
+        assert!(faces.iter().all(|f| f.mesh.folded(&plane).is_empty()));
+        assert_eq!(faces[0].mesh.pos[1], corner(1.0, 0.0));
+        assert_eq!(faces[1].mesh.pos[0], corner(1.0, 0.0));
+    }
 }

@@ -3,8 +3,7 @@
 //! mesh at relative tolerances 1e-2 and 1e-3 with a measured deviation
 //! within the tolerance, no inverted triangle, no crack between faces, and
 //! (for [`CLOSED`] solids) no boundary edge at all. The others must mesh
-//! within the tolerance without inverted triangles (but for the runs in
-//! [`STILL_FOLDS`]); their cracks are printed. An unoptimized build (the plain
+//! within the tolerance without inverted triangles; their cracks are printed. An unoptimized build (the plain
 //! `cargo test`) meshes only the files under [`DEBUG_MAX_BYTES`], to stay
 //! within CI's time; `cargo test --release` meshes them all.
 
@@ -44,12 +43,6 @@ const MESHED: [&str; 10] = [
     "cube_10x10_inventor.igs",
     "marsCapsule.igs",
     "nozzleAndCavity.igs",
-];
-
-/// Runs (file, relative tolerance) that still leave inverted triangles.
-const STILL_FOLDS: [(&str, f64); 1] = [
-    // Two helical faces 0.0025 apart along an end cap, far below the tolerance.
-    ("bug22869_Spring.igs", 1e-3),
 ];
 
 /// In a debug build, larger files are read but not meshed (meshing the
@@ -126,7 +119,7 @@ fn corpus_reads_and_meshes_within_tolerance_without_cracks() {
             if rep.max_deviation.is_nan() || rep.max_deviation > rep.tolerance {
                 problems.push(format!("max deviation {} above tolerance {}", rep.max_deviation, rep.tolerance));
             }
-            if rep.inverted_triangles != 0 && (whole || !STILL_FOLDS.contains(&(name.as_str(), rel))) {
+            if rep.inverted_triangles != 0 {
                 problems.push(format!("{} inverted triangles", rep.inverted_triangles));
             }
             if !whole {
