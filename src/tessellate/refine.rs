@@ -366,16 +366,12 @@ impl WorkMesh {
             // once, a node off its (u,v) folded the thin children in space,
             // and refinement split those folds down to slivers (99 on one
             // cylinder of a valve body).
-            let mut moved = None;
-            for item in &mut plan {
-                if folds(item.2, item.3) {
+            if plan.iter().any(|item| folds(item.2, item.3)) {
+                for item in &mut plan {
                     item.3 = item.4;
-                    moved.get_or_insert(item.4);
                 }
-            }
-            if let Some(uv) = moved {
-                p = surface.point(uv);
-                m_normal = surface.normal(uv);
+                p = surface.point(plan[0].4);
+                m_normal = surface.normal(plan[0].4);
             }
         }
         if target.is_none() {
