@@ -186,7 +186,9 @@ impl SurfDef {
                 }
                 let d = surface.derivs(pr.uv);
                 let (lu, lv) = (d.su.length(), d.sv.length());
-                let tiny = 1e-9 * (lu + lv);
+                // A collapsed edge written with control points a hair apart
+                // (3e-8 against 4.4 across it, in one STEP file) is a pole too.
+                let tiny = 1e-6 * (lu + lv);
                 Native { q: pr.uv, free: [lu <= tiny, lv <= tiny] }
             }
             Self::Plane { origin, x, y } => {
@@ -669,4 +671,37 @@ fn revolution_120(ctx: &Ctx<'_>, e: &Entity, m: DAffine3, depth: usize) -> Resul
     }
     let s = revolve(&profile, a0, axis, sa, ta).map_err(|err| e.error(alloc::format!("{err}")))?;
     Ok((nurbs_def(s), false))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A triangle-like bilinear patch whose edge u = 0 is collapsed to a
+    /// point up to `hair` (control points that far apart).
+    fn wedge(hair: f64) -> SurfDef {
+        let p = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        let surface = crate::nurbs::analytic::bilinear(
+            [[p(0.0, 0.0), p(0.0, hair)], [p(4.0, -2.0), p(4.0, 2.0)]],
+            [0.0, 1.0],
+            [0.0, 1.0],
+        )
+        .unwrap();
+        SurfDef::Nurbs { surface, periods: [None; 2], natural: None }
+    }
+
+    /// At a pole written with control points a hair apart (3e-8 against
+    /// 4.4 across it in a STEP file) v is as free as at an exact one, so a
+    /// trim curve reaching it keeps its own v instead of the projection's.
+    #[test]
+    fn a_pole_a_hair_wide_leaves_its_coordinate_free() {
+        for hair in [0.0, 3e-8] {
+            let n = wedge(hair).invert(DVec3::new(0.0, 0.5 * hair, 0.0), Some(DVec2::new(0.1, 0.9)), &mut true);
+            assert!(n.q.x.abs() < 1e-6, "{hair}: {:?}", n.q);
+            assert_eq!(n.free, [false, true], "{hair}");
+        }
+        // Beside the pole both coordinates are fixed.
+        let n = wedge(3e-8).invert(DVec3::new(0.04, 0.0, 0.0), None, &mut true);
+        assert_eq!(n.free, [false, false]);
+    }
 }
