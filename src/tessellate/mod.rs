@@ -169,6 +169,22 @@ pub fn mesh_model_with_progress(
         None => (0.4 * tol, auto_tight),
     };
     let ids = unify_outlines(&mut chosen, &model.bodies, sew_tol, tight, aim + sew_tol);
+    // Faces whose loops now pass one node twice: a strip narrower than the
+    // sewing distance, its two sides sewn into one border.
+    let pinched: Vec<bool> = chosen
+        .iter()
+        .map(|c| {
+            c.as_ref().is_some_and(|c| {
+                c.outline.gids.iter().any(|g| {
+                    let mut ids: Vec<u32> = g.iter().copied().filter(|&x| x != u32::MAX).collect();
+                    let n = ids.len();
+                    ids.sort_unstable();
+                    ids.dedup();
+                    ids.len() < n
+                })
+            })
+        })
+        .collect();
     // Every face's first mesh (grid and trim band) on those nodes.
     let mut works: Vec<sew::FaceWork<'_>> = Vec::with_capacity(model.faces.len());
     let mut fit_errors: Vec<f64> = Vec::with_capacity(model.faces.len());
@@ -246,7 +262,14 @@ pub fn mesh_model_with_progress(
         if w.mesh.tris.is_empty() {
             if mine[index] && !report.warnings.iter().any(|x| x.starts_with(&format!("face {index}: "))) {
                 report.faces_skipped += 1;
-                report.warnings.push(format!("face {index}: produced no triangles"));
+                report.warnings.push(if pinched[index] {
+                    format!(
+                        "face {index}: produced no triangles: a strip narrower than the sewing distance, \
+                         its sides sewn into one border by its neighbours"
+                    )
+                } else {
+                    format!("face {index}: produced no triangles")
+                });
             }
         } else if out.unproven > 0 {
             report.warnings.push(format!(

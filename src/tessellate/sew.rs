@@ -416,8 +416,11 @@ mod outlines {
                 }
             }
         }
+        // Twins name their node by its place in the new outlines, where the
+        // loop above has just put the old nodes' reaches (reading the old
+        // places instead gave a new node some other node's reach, often none).
         for &(n, q) in twins {
-            let r = radius_before[q.0 as usize][q.1 as usize].get(q.2 as usize).copied().unwrap_or(0.0);
+            let r = radius[q.0 as usize][q.1 as usize].get(q.2 as usize).copied().unwrap_or(0.0);
             radius[n.0 as usize][n.1 as usize][n.2 as usize] = r;
         }
         let r_flat: Vec<f64> = radius.iter().flatten().flatten().copied().collect();
