@@ -171,20 +171,7 @@ pub fn mesh_model_with_progress(
     let ids = unify_outlines(&mut chosen, &model.bodies, sew_tol, tight, aim + sew_tol);
     // Faces whose loops now pass one node twice: a strip narrower than the
     // sewing distance, its two sides sewn into one border.
-    let pinched: Vec<bool> = chosen
-        .iter()
-        .map(|c| {
-            c.as_ref().is_some_and(|c| {
-                c.outline.gids.iter().any(|g| {
-                    let mut ids: Vec<u32> = g.iter().copied().filter(|&x| x != u32::MAX).collect();
-                    let n = ids.len();
-                    ids.sort_unstable();
-                    ids.dedup();
-                    ids.len() < n
-                })
-            })
-        })
-        .collect();
+    let pinched: Vec<bool> = chosen.iter().map(|c| c.as_ref().is_some_and(Chosen::pinched)).collect();
     // Every face's first mesh (grid and trim band) on those nodes.
     let mut works: Vec<sew::FaceWork<'_>> = Vec::with_capacity(model.faces.len());
     let mut fit_errors: Vec<f64> = Vec::with_capacity(model.faces.len());
@@ -489,6 +476,22 @@ impl<'a> Chosen<'a> {
     }
 
     /// The face's mesh before refinement, and the curves its trim edges follow.
+    /// Whether a loop of the sewn outline passes one node twice.
+    fn pinched(&self) -> bool {
+        #[cfg(feature = "std")]
+        {
+            self.outline.gids.iter().any(|g| {
+                let mut ids: Vec<u32> = g.iter().copied().filter(|&x| x != u32::MAX).collect();
+                let n = ids.len();
+                ids.sort_unstable();
+                ids.dedup();
+                ids.len() < n
+            })
+        }
+        #[cfg(not(feature = "std"))]
+        false
+    }
+
     fn initial(&self, index: usize, budget: usize) -> Result<(refine::WorkMesh, Vec<&'a crate::NurbsCurve>), Error> {
         #[cfg(feature = "std")]
         {
