@@ -169,9 +169,6 @@ pub fn mesh_model_with_progress(
         None => (0.4 * tol, auto_tight),
     };
     let ids = unify_outlines(&mut chosen, &model.bodies, sew_tol, tight, aim + sew_tol);
-    // Faces whose loops now pass one node twice: a strip narrower than the
-    // sewing distance, its two sides sewn into one border.
-    let pinched: Vec<bool> = chosen.iter().map(|c| c.as_ref().is_some_and(Chosen::pinched)).collect();
     // Every face's first mesh (grid and trim band) on those nodes.
     let mut works: Vec<sew::FaceWork<'_>> = Vec::with_capacity(model.faces.len());
     let mut fit_errors: Vec<f64> = Vec::with_capacity(model.faces.len());
@@ -249,7 +246,10 @@ pub fn mesh_model_with_progress(
         if w.mesh.tris.is_empty() {
             if mine[index] && !report.warnings.iter().any(|x| x.starts_with(&format!("face {index}: "))) {
                 report.faces_skipped += 1;
-                report.warnings.push(if pinched[index] {
+                // A loop that passes one node twice: a strip narrower than
+                // the sewing distance, its two sides sewn into one border.
+                let pinched = chosen.get(index).and_then(Option::as_ref).is_some_and(Chosen::pinched);
+                report.warnings.push(if pinched {
                     format!(
                         "face {index}: produced no triangles: a strip narrower than the sewing distance, \
                          its sides sewn into one border by its neighbours"
@@ -475,7 +475,6 @@ impl<'a> Chosen<'a> {
         })
     }
 
-    /// The face's mesh before refinement, and the curves its trim edges follow.
     /// Whether a loop of the sewn outline passes one node twice.
     fn pinched(&self) -> bool {
         #[cfg(feature = "std")]
@@ -492,6 +491,7 @@ impl<'a> Chosen<'a> {
         false
     }
 
+    /// The face's mesh before refinement, and the curves its trim edges follow.
     fn initial(&self, index: usize, budget: usize) -> Result<(refine::WorkMesh, Vec<&'a crate::NurbsCurve>), Error> {
         #[cfg(feature = "std")]
         {

@@ -13,7 +13,7 @@ export const root = join(here, '..', '..');
 export const shots = join(here, 'screenshots');
 
 const CHROMIUM = process.env.CHROMIUM ?? '/usr/bin/chromium';
-export const FLAGS = [
+const FLAGS = [
   '--headless',
   '--no-sandbox',
   '--disable-gpu',

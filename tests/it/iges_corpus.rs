@@ -3,9 +3,10 @@
 //! mesh at relative tolerances 1e-2 and 1e-3 with a measured deviation
 //! within the tolerance, no inverted triangle, no crack between faces, and
 //! (for [`CLOSED`] solids) no boundary edge at all. The others must mesh
-//! within the tolerance without inverted triangles; their cracks are printed. An unoptimized build (the plain
-//! `cargo test`) meshes only the files under [`DEBUG_MAX_BYTES`], to stay
-//! within CI's time; `cargo test --release` meshes them all.
+//! within the tolerance without inverted triangles; their cracks are
+//! printed. An unoptimized build (the plain `cargo test`) meshes only the
+//! files under [`DEBUG_MAX_BYTES`], to stay within CI's time;
+//! `cargo test --release` meshes them all.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
