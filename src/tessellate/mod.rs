@@ -234,15 +234,17 @@ pub fn mesh_model_with_progress(
             }
         }
     }
-    let mut outcomes: Vec<refine::Outcome> = Vec::with_capacity(works.len());
+    let (mut dev_sum, mut dev_count) = (0.0, 0u64);
     for (index, (w, fit_error)) in works.iter_mut().zip(&fit_errors).enumerate() {
-        let mut out = w.mesh.outcome(w.surface, &w.crit);
-        if *fit_error > 0.0 {
-            // Reported against the original face: the mesh's distance to the new one plus the fit error.
-            for m in &mut out.measures {
-                m.max += fit_error;
-            }
+        let out = w.mesh.outcome(w.surface, &w.crit);
+        // Reported against the original face: the mesh's distance to the new one plus the fit error.
+        if !w.mesh.tris.is_empty() {
+            report.max_deviation = report.max_deviation.max(out.max + fit_error);
         }
+        dev_sum += out.sum;
+        dev_count += out.count;
+        report.max_normal_turn = report.max_normal_turn.max(out.max_turn);
+        report.inverted_triangles += (0..w.mesh.tris.len()).filter(|&t| w.mesh.inverted(w.surface, t)).count();
         if w.mesh.tris.is_empty() {
             if mine[index] && !report.warnings.iter().any(|x| x.starts_with(&format!("face {index}: "))) {
                 report.faces_skipped += 1;
@@ -272,12 +274,19 @@ pub fn mesh_model_with_progress(
                 out.creased
             ));
         }
-        outcomes.push(out);
     }
-    let mut mesh = Mesh::default();
-    let (mut dev_sum, mut dev_count) = (0.0, 0u64);
-    for (w, out) in works.iter().zip(&outcomes) {
-        let wm = &w.mesh;
+    // The model's mesh, each face's working mesh freed once it is copied:
+    // wasm memory never shrinks, so the peak is what a page keeps.
+    drop((places, folded, settled));
+    let (nv, nt) = works.iter().fold((0, 0), |(v, t), w| (v + w.mesh.pos.len(), t + w.mesh.tris.len()));
+    let mut mesh = Mesh {
+        positions: Vec::with_capacity(nv),
+        normals: Vec::with_capacity(nv),
+        indices: Vec::with_capacity(3 * nt),
+        face_ranges: Vec::with_capacity(works.len()),
+    };
+    for w in works {
+        let wm = w.mesh;
         let first = mesh.triangle_count() as u32;
         let base = mesh.positions.len() as u32;
         mesh.positions.extend_from_slice(&wm.pos);
@@ -286,18 +295,8 @@ pub fn mesh_model_with_progress(
             mesh.indices.extend(t.iter().map(|&v| v + base));
         }
         mesh.face_ranges.push(FaceRange { first, count: wm.tris.len() as u32 });
-        for (t, m) in out.measures.iter().enumerate() {
-            report.max_deviation = report.max_deviation.max(m.max);
-            dev_sum += m.sum;
-            dev_count += u64::from(m.count);
-            if wm.inverted(w.surface, t) {
-                report.inverted_triangles += 1;
-            }
-        }
-        for &turn in &out.turns {
-            report.max_normal_turn = report.max_normal_turn.max(turn);
-        }
     }
+    drop(chosen);
     report.mean_deviation = if dev_count > 0 { dev_sum / dev_count as f64 } else { 0.0 };
     report.triangles = mesh.triangle_count();
     report.vertices = mesh.positions.len();

@@ -79,8 +79,13 @@ impl Criteria {
 /// Per-triangle results after refinement.
 #[derive(Debug, Default)]
 pub(crate) struct Outcome {
-    pub measures: Vec<TriMeasure>,
-    pub turns: Vec<f64>,
+    /// Largest measured distance over the triangles.
+    pub max: f64,
+    /// Sum and number of the distance samples, for the mean.
+    pub sum: f64,
+    pub count: u64,
+    /// Largest normal turn across a triangle.
+    pub max_turn: f64,
     /// Triangles left failing because the budget ran out or their edges hit `min_edge`.
     pub unproven: usize,
     /// Triangles within the tolerance that turn more than the angle limit but
@@ -88,9 +93,35 @@ pub(crate) struct Outcome {
     pub creased: usize,
 }
 
+/// Makes room for `extra` more elements, growing by a quarter: every face's
+/// mesh is held until the model is assembled, and wasm memory never shrinks,
+/// so the slack of doubling (up to half of each buffer) would stay with the page.
+fn room<T>(v: &mut Vec<T>, extra: usize) {
+    if v.capacity() - v.len() < extra {
+        v.reserve_exact(v.len() / 4 + extra.max(64));
+    }
+}
+
 impl WorkMesh {
+    /// Room for `verts` more vertices and `tris` more triangles.
+    fn room(&mut self, verts: usize, tris: usize) {
+        room(&mut self.pos, verts);
+        room(&mut self.normal, verts);
+        room(&mut self.gid, verts);
+        room(&mut self.tris, tris);
+        room(&mut self.uvs, tris);
+    }
+
+    /// A slot in the measure cache per triangle.
+    fn measure_slots(&mut self) {
+        let missing = self.tris.len().saturating_sub(self.measures.len());
+        room(&mut self.measures, missing);
+        self.measures.resize(self.tris.len(), None);
+    }
+
     /// Adds a vertex with its surface normal.
     pub fn add_vertex(&mut self, p: DVec3, n: DVec3) -> u32 {
+        self.room(1, 0);
         self.pos.push(p);
         self.normal.push(n);
         self.gid.push(NONE);
@@ -100,6 +131,7 @@ impl WorkMesh {
     /// Adds a triangle (counter-clockwise in (u,v)).
     pub fn add_triangle(&mut self, v: [u32; 3], uv: [DVec2; 3]) {
         let t = self.tris.len() as u32;
+        self.room(0, 1);
         self.tris.push(v);
         self.uvs.push(uv);
         for k in 0..3 {
@@ -389,6 +421,7 @@ impl WorkMesh {
             }
         }
         let m = self.pos.len() as u32;
+        self.room(1, plan.len());
         self.pos.push(p);
         self.normal.push(m_normal);
         self.gid.push(NONE);
@@ -446,7 +479,7 @@ impl WorkMesh {
         todo.reverse();
         let mut stack = todo;
         let mut changed = Vec::new();
-        self.measures.resize(self.tris.len(), None);
+        self.measure_slots();
         let mut fold_splits = 0usize;
         let fold_limit = 2 * stack.iter().filter(|&&t| self.inverted(surface, t as usize)).count() + 16;
         while let Some(t) = stack.pop() {
@@ -492,7 +525,7 @@ impl WorkMesh {
 
     /// Drops the cached measures of triangles `ts` (they changed).
     pub fn forget(&mut self, ts: &[u32]) {
-        self.measures.resize(self.tris.len(), None);
+        self.measure_slots();
         for &x in ts {
             if let Some(m) = self.measures.get_mut(x as usize) {
                 *m = None;
@@ -500,11 +533,12 @@ impl WorkMesh {
         }
     }
 
-    /// Every triangle's measure (from the cache where it is still valid) and
-    /// how many fail the limits.
+    /// The measures of every triangle (from the cache where it is still
+    /// valid), summed up, and how many fail the limits: a sum, not a list, so
+    /// that finished faces hold no per-triangle results.
     pub fn outcome(&mut self, surface: &dyn Surface, c: &Criteria) -> Outcome {
         let mut out = Outcome::default();
-        self.measures.resize(self.tris.len(), None);
+        self.measure_slots();
         for t in 0..self.tris.len() {
             let (m, turn) = self.cached_measure(surface, t, c);
             let (_, _, len) = self.longest_edge(t);
@@ -513,8 +547,10 @@ impl WorkMesh {
             } else if m.max > c.tol || turn > c.angle || len > c.max_edge {
                 out.unproven += 1;
             }
-            out.measures.push(m);
-            out.turns.push(turn);
+            out.max = out.max.max(m.max);
+            out.sum += m.sum;
+            out.count += u64::from(m.count);
+            out.max_turn = out.max_turn.max(turn);
         }
         out
     }

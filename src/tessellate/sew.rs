@@ -613,33 +613,50 @@ pub(crate) fn refine_all(
 /// Also returns, per node whose faces disagreed, the places they put it,
 /// for [`resettle_folds`].
 pub(crate) fn settle_nodes(faces: &mut [FaceWork<'_>], negligible: f64) -> (Vec<Vec<u32>>, Places) {
-    // Per node: sum of positions, count, and whether they all agree already.
-    let mut sum: HashMap<u32, (DVec3, f64, DVec3, bool)> = HashMap::default();
-    let mut places: Places = HashMap::default();
+    // Per node (ids are dense): sum of positions, count, its first place,
+    // and whether they all agree already; a table, not a map, for memory.
+    let ids = faces.iter().flat_map(|f| f.mesh.gid.iter()).filter(|&&g| g != NONE).max().map_or(0, |&g| g as usize + 1);
+    let mut sum: Vec<(DVec3, f64, DVec3, bool)> = alloc::vec![(DVec3::ZERO, 0.0, DVec3::ZERO, true); ids];
     for f in faces.iter() {
         for (v, &g) in f.mesh.gid.iter().enumerate() {
             if g != NONE {
                 let p = f.mesh.pos[v];
-                let e = sum.entry(g).or_insert((DVec3::ZERO, 0.0, p, true));
+                let e = &mut sum[g as usize];
+                if e.1 == 0.0 {
+                    e.2 = p;
+                }
                 e.0 += p;
                 e.1 += 1.0;
                 e.3 &= e.2 == p;
-                if !e.3 {
-                    let first = e.2;
-                    let list = places.entry(g).or_insert_with(|| alloc::vec![first]);
-                    if !list.contains(&p) {
-                        list.push(p);
-                    }
-                }
             }
         }
     }
+    // The places of the nodes whose faces disagree by more than a negligible
+    // distance (the others cannot fold anything by moving), in face order.
+    let mut wide = alloc::vec![false; ids];
+    for f in faces.iter() {
+        for (v, &g) in f.mesh.gid.iter().enumerate() {
+            if let Some(&(s, n, _, false)) = sum.get(g as usize) {
+                wide[g as usize] |= f.mesh.pos[v].distance(s / n) > negligible;
+            }
+        }
+    }
+    let mut places = Places::default();
+    for f in faces.iter() {
+        for (v, &g) in f.mesh.gid.iter().enumerate() {
+            if wide.get(g as usize).copied().unwrap_or(false) {
+                places.nodes.push(g);
+                places.points.push(f.mesh.pos[v]);
+            }
+        }
+    }
+    places.index();
     let mut changed = Vec::with_capacity(faces.len());
     for f in faces.iter_mut() {
         let mut moved = crate::collections::HashSet::default();
         for v in 0..f.mesh.pos.len() {
             let g = f.mesh.gid[v];
-            let Some(&(s, n, _, same)) = sum.get(&g) else { continue };
+            let Some(&(s, n, _, same)) = sum.get(g as usize) else { continue };
             if n > 1.0 && !same {
                 let p = s / n;
                 if p.distance(f.mesh.pos[v]) > negligible {
@@ -656,8 +673,45 @@ pub(crate) fn settle_nodes(faces: &mut [FaceWork<'_>], negligible: f64) -> (Vec<
     (changed, places)
 }
 
-/// Per node, the places its faces put it before settling.
-pub(crate) type Places = HashMap<u32, Vec<DVec3>>;
+/// Per node, the places its faces put it before settling: two flat lists
+/// sorted by node (a map of small lists costs several times the memory).
+#[derive(Debug, Default)]
+pub(crate) struct Places {
+    nodes: Vec<u32>,
+    points: Vec<DVec3>,
+}
+
+impl Places {
+    /// Sorts by node, keeping face order, and drops a node's repeated places.
+    fn index(&mut self) {
+        let mut order: Vec<u32> = (0..self.nodes.len() as u32).collect();
+        order.sort_by_key(|&i| self.nodes[i as usize]);
+        let (mut nodes, mut points) = (Vec::with_capacity(order.len()), Vec::with_capacity(order.len()));
+        let mut start = 0;
+        for i in order {
+            let (g, p) = (self.nodes[i as usize], self.points[i as usize]);
+            if nodes.last() != Some(&g) {
+                start = nodes.len();
+            }
+            if !points[start..].contains(&p) {
+                nodes.push(g);
+                points.push(p);
+            }
+        }
+        (self.nodes, self.points) = (nodes, points);
+    }
+
+    fn contains_key(&self, g: &u32) -> bool {
+        self.nodes.binary_search(g).is_ok()
+    }
+
+    /// The places of node `g`, if its faces disagreed.
+    fn get(&self, g: &u32) -> Option<&[DVec3]> {
+        let lo = self.nodes.partition_point(|&n| n < *g);
+        let hi = self.nodes.partition_point(|&n| n <= *g);
+        (hi > lo).then(|| &self.points[lo..hi])
+    }
+}
 
 /// Where settling a node to the mean of its faces' places folded a thin
 /// triangle beside it (two faces' borders a hair apart, a sliver narrower
