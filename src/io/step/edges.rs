@@ -27,6 +27,10 @@ pub(super) struct Edge {
 #[derive(Default)]
 pub(super) struct Edges {
     done: HashMap<(u64, bool), Result<Edge, Error>>,
+    /// Vertices the file gives as both ends of an open B-spline (found on
+    /// the first edge read): such a writer puts one vertex where the loop
+    /// has two corners, so no edge's curve is cut or moved to them.
+    reused: Option<crate::collections::HashSet<u64>>,
 }
 
 impl Edges {
@@ -37,7 +41,8 @@ impl Edges {
         if let Some(r) = self.done.get(&(e.id(), alone)) {
             return r.clone();
         }
-        let r = read_edge(geo, e, alone);
+        let reused = self.reused.get_or_insert_with(|| reused_vertices(geo));
+        let r = read_edge(geo, e, alone, reused);
         self.done.insert((e.id(), alone), r.clone());
         r
     }
@@ -52,7 +57,7 @@ pub(super) fn vertex(geo: &Geo<'_>, e: Ent<'_>) -> Result<DVec3, Error> {
     geo.point(a.ent(1)?)
 }
 
-fn read_edge(geo: &Geo<'_>, e: Ent<'_>, alone: bool) -> Result<Edge, Error> {
+fn read_edge(geo: &Geo<'_>, e: Ent<'_>, alone: bool, reused: &crate::collections::HashSet<u64>) -> Result<Edge, Error> {
     if !e.has("EDGE_CURVE") {
         return Err(e.error("expected an EDGE_CURVE"));
     }
@@ -62,9 +67,45 @@ fn read_edge(geo: &Geo<'_>, e: Ent<'_>, alone: bool) -> Result<Edge, Error> {
     let pe = if ve == vs { ps } else { vertex(geo, a.ent(2)?)? };
     let def = geo.curve(a.ent(3)?, 0)?;
     let same_sense = a.boolean(4, true)?;
+    let ends = Ends { ps, pe, trust: [!reused.contains(&vs), !reused.contains(&ve)] };
     let (pieces, repaired) =
-        cut(&def, ps, pe, same_sense, vs == ve || alone, geo.uncertainty).map_err(|m| e.error(m))?;
+        cut(&def, &ends, same_sense, vs == ve || alone, geo.uncertainty).map_err(|m| e.error(m))?;
     Ok(Edge { pieces, repaired })
+}
+
+/// An edge's two vertex points, and whether each can be trusted to lie at
+/// its end of the curve.
+struct Ends {
+    ps: DVec3,
+    pe: DVec3,
+    trust: [bool; 2],
+}
+
+/// The vertices some `EDGE_CURVE` gives as both its ends while its curve is
+/// an open B-spline whose ends lie far apart: a writer that reuses one vertex
+/// for two corners (within its uncertainty). One pass over the file's edges.
+fn reused_vertices(geo: &Geo<'_>) -> crate::collections::HashSet<u64> {
+    let mut out = crate::collections::HashSet::default();
+    for e in geo.g.all().filter(|e| e.has("EDGE_CURVE")) {
+        let Ok(a) = e.chain(&[("REPRESENTATION_ITEM", 1), ("EDGE", 2), ("EDGE_CURVE", 2)]) else { continue };
+        let (Ok(vs), Ok(ve)) = (a.refr(1), a.refr(2)) else { continue };
+        if vs != ve {
+            continue;
+        }
+        let Ok(CurveDef { curve: Curve3::Nurbs { c, closed: false }, range: None, .. }) =
+            a.ent(3).and_then(|x| geo.curve(x, 0))
+        else {
+            continue;
+        };
+        let (t0, t1) = c.domain();
+        let gap = c.point(t0).distance(c.point(t1));
+        // Ends half the curve's length apart: an open curve, however
+        // coarse the file's uncertainty (one such file's equals the gap).
+        if gap > 0.5 * length(&c) {
+            out.insert(vs);
+        }
+    }
+    out
 }
 
 /// Approximate length of a curve from 16 chords.
@@ -85,16 +126,20 @@ pub(super) fn length(c: &NurbsCurve) -> f64 {
 /// within the uncertainty (or 5% of the length) of a vertex are moved onto
 /// it, so the faces on both sides of the edge meet at the same points; a
 /// vertex farther from the curve is reported as a repair.
+///
+/// A vertex that cannot be trusted (see [`reused_vertices`]) neither cuts a
+/// B-spline, which then runs from its own end, nor moves the curve's end.
 fn cut(
     def: &CurveDef,
-    ps: DVec3,
-    pe: DVec3,
+    verts: &Ends,
     same_sense: bool,
     closed: bool,
     uncertainty: f64,
 ) -> Result<(Vec<NurbsCurve>, Option<String>), String> {
+    let (ps, pe) = (verts.ps, verts.pe);
     let forward = same_sense != def.reversed;
     let (a, b) = if forward { (ps, pe) } else { (pe, ps) };
+    let (trust_a, trust_b) = if forward { (verts.trust[0], verts.trust[1]) } else { (verts.trust[1], verts.trust[0]) };
     let size = a.distance(b);
     let mut pieces = match &def.curve {
         Curve3::Line { .. } => {
@@ -124,6 +169,15 @@ fn cut(
                     }
                 }
                 None => {}
+            }
+            if let (Curve3::Nurbs { c: n, closed: false }, None) = (c, def.range) {
+                let (x, y) = n.domain();
+                if !trust_a {
+                    ta = x;
+                }
+                if !trust_b {
+                    tb = y;
+                }
             }
             let scale = match c {
                 Curve3::Nurbs { c, .. } => {
@@ -167,7 +221,11 @@ fn cut(
     if let Some(first) = pieces.first_mut() {
         let (s, e) = ends(first);
         let gap = s.distance(ps);
-        if gap <= snap {
+        if !verts.trust[0] {
+            if gap > uncertainty {
+                Some(format!("its start vertex, which the file puts at two corners, lies {gap:.3e} from its curve; the curve's end is used"));
+            }
+        } else if gap <= snap {
             *first = move_ends(first, ps, e)?;
         } else {
             repaired = Some(format!("its start vertex lies {gap:.3e} from its curve; the curve's end is used"));
@@ -176,7 +234,11 @@ fn cut(
     if let Some(last) = pieces.last_mut() {
         let (s, e) = ends(last);
         let gap = e.distance(pe);
-        if gap <= snap {
+        if !verts.trust[1] {
+            if gap > uncertainty {
+                Some(format!("its end vertex, which the file puts at two corners, lies {gap:.3e} from its curve; the curve's end is used"));
+            }
+        } else if gap <= snap {
             *last = move_ends(last, s, pe)?;
         } else {
             repaired = Some(format!("its end vertex lies {gap:.3e} from its curve; the curve's end is used"));
