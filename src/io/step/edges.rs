@@ -223,7 +223,7 @@ fn cut(
         let gap = s.distance(ps);
         if !verts.trust[0] {
             if gap > uncertainty {
-                Some(format!("its start vertex, which the file puts at two corners, lies {gap:.3e} from its curve; the curve's end is used"));
+                repaired = Some(format!("its start vertex, which the file puts at two corners, lies {gap:.3e} from its curve; the curve's end is used"));
             }
         } else if gap <= snap {
             *first = move_ends(first, ps, e)?;
@@ -236,7 +236,7 @@ fn cut(
         let gap = e.distance(pe);
         if !verts.trust[1] {
             if gap > uncertainty {
-                Some(format!("its end vertex, which the file puts at two corners, lies {gap:.3e} from its curve; the curve's end is used"));
+                repaired = Some(format!("its end vertex, which the file puts at two corners, lies {gap:.3e} from its curve; the curve's end is used"));
             }
         } else if gap <= snap {
             *last = move_ends(last, s, pe)?;
