@@ -645,8 +645,7 @@ pub(crate) fn settle_nodes(faces: &mut [FaceWork<'_>], negligible: f64) -> (Vec<
     for f in faces.iter() {
         for (v, &g) in f.mesh.gid.iter().enumerate() {
             if wide.get(g as usize).copied().unwrap_or(false) {
-                places.nodes.push(g);
-                places.points.push(f.mesh.pos[v]);
+                places.0.push((g, f.mesh.pos[v]));
             }
         }
     }
@@ -673,43 +672,34 @@ pub(crate) fn settle_nodes(faces: &mut [FaceWork<'_>], negligible: f64) -> (Vec<
     (changed, places)
 }
 
-/// Per node, the places its faces put it before settling: two flat lists
+/// Per node, the places its faces put it before settling: one flat list
 /// sorted by node (a map of small lists costs several times the memory).
 #[derive(Debug, Default)]
-pub(crate) struct Places {
-    nodes: Vec<u32>,
-    points: Vec<DVec3>,
-}
+pub(crate) struct Places(Vec<(u32, DVec3)>);
 
 impl Places {
-    /// Sorts by node, keeping face order, and drops a node's repeated places.
+    /// Sorts by node, keeping face order (the sort is stable), and drops a
+    /// node's repeated places.
     fn index(&mut self) {
-        let mut order: Vec<u32> = (0..self.nodes.len() as u32).collect();
-        order.sort_by_key(|&i| self.nodes[i as usize]);
-        let (mut nodes, mut points) = (Vec::with_capacity(order.len()), Vec::with_capacity(order.len()));
+        self.0.sort_by_key(|&(g, _)| g);
+        let mut kept: Vec<(u32, DVec3)> = Vec::with_capacity(self.0.len());
         let mut start = 0;
-        for i in order {
-            let (g, p) = (self.nodes[i as usize], self.points[i as usize]);
-            if nodes.last() != Some(&g) {
-                start = nodes.len();
+        for &(g, p) in &self.0 {
+            if kept.last().is_none_or(|&(h, _)| h != g) {
+                start = kept.len();
             }
-            if !points[start..].contains(&p) {
-                nodes.push(g);
-                points.push(p);
+            if !kept[start..].iter().any(|&(_, q)| q == p) {
+                kept.push((g, p));
             }
         }
-        (self.nodes, self.points) = (nodes, points);
-    }
-
-    fn contains_key(&self, g: &u32) -> bool {
-        self.nodes.binary_search(g).is_ok()
+        self.0 = kept;
     }
 
     /// The places of node `g`, if its faces disagreed.
-    fn get(&self, g: &u32) -> Option<&[DVec3]> {
-        let lo = self.nodes.partition_point(|&n| n < *g);
-        let hi = self.nodes.partition_point(|&n| n <= *g);
-        (hi > lo).then(|| &self.points[lo..hi])
+    fn get(&self, g: u32) -> Option<impl Iterator<Item = DVec3> + '_> {
+        let lo = self.0.partition_point(|&(n, _)| n < g);
+        let hi = self.0.partition_point(|&(n, _)| n <= g);
+        (hi > lo).then(|| self.0[lo..hi].iter().map(|&(_, p)| p))
     }
 }
 
@@ -728,7 +718,7 @@ pub(crate) fn resettle_folds(faces: &mut [FaceWork<'_>], places: &Places, folded
         for &t in ts {
             for &v in &f.mesh.tris[t as usize] {
                 let g = f.mesh.gid[v as usize];
-                if g != NONE && places.contains_key(&g) {
+                if g != NONE && places.get(g).is_some() {
                     nodes.push(g);
                 }
             }
@@ -764,7 +754,7 @@ pub(crate) fn resettle_folds(faces: &mut [FaceWork<'_>], places: &Places, folded
         }
     }
     for g in nodes {
-        let (Some(list), Some(candidates)) = (uses.get(&g), places.get(&g)) else { continue };
+        let (Some(list), Some(candidates)) = (uses.get(&g), places.get(g)) else { continue };
         let Some(&(f0, v0, _)) = list.first() else { continue };
         let settled = faces[f0].mesh.pos[v0 as usize];
         let score = |faces: &mut [FaceWork<'_>], p: DVec3| -> usize {
@@ -780,7 +770,7 @@ pub(crate) fn resettle_folds(faces: &mut [FaceWork<'_>], places: &Places, folded
         if best.0 == 0 {
             continue;
         }
-        for &p in candidates {
+        for p in candidates {
             let s = score(faces, p);
             if s < best.0 {
                 best = (s, p);
