@@ -454,8 +454,9 @@ pub fn rebuild_face(face: &Face, tol: f64) -> Result<Rebuilt, String> {
     let new_surface = FaceSurface::Rebuilt(fit.surface.clone());
     let mut loops = Vec::with_capacity(face.loops.len());
     for (li, lp) in face.loops.iter().enumerate() {
+        let lp = split_at_corners(&face.surface, lp);
         let (curves, err) =
-            rebuild_loop(&face.surface, &new_surface, &fit, lp, limit).map_err(|e| format!("loop {li}: {e}"))?;
+            rebuild_loop(&face.surface, &new_surface, &fit, &lp, limit).map_err(|e| format!("loop {li}: {e}"))?;
         fit_error = fit_error.max(err);
         loops.push(TrimLoop { curves });
     }
@@ -504,6 +505,61 @@ fn edge_cap(surface: &FaceSurface, tol: f64) -> f64 {
     }
 }
 
+/// Model-space turn (radians) above which a trim curve's C0 knot is a
+/// corner: the rebuilt loop keeps it, since one cubic through samples
+/// either side would swing past it and curl in (u,v).
+const CORNER: f64 = 0.35;
+
+/// Width (in the new unit parameters) of the band along the border where a
+/// trim point is kept no nearer the border than the map puts it.
+const BORDER_BAND: f64 = 1e-3;
+
+/// `lp` with each curve cut at its corners (C0 knots where the curve's
+/// model-space direction on `surface` turns by more than [`CORNER`]), so that
+/// every piece is smooth enough to be interpolated as one cubic.
+fn split_at_corners(surface: &FaceSurface, lp: &TrimLoop) -> TrimLoop {
+    let mut curves = Vec::with_capacity(lp.curves.len());
+    for c in &lp.curves {
+        let (a, b) = c.domain();
+        let deg = c.degree();
+        let knots = c.knots().knots();
+        let mut cuts: Vec<f64> = Vec::new();
+        let mut i = deg + 1;
+        while i + deg < knots.len() {
+            let t = knots[i];
+            let mult = knots[i..].iter().take_while(|&&k| k == t).count();
+            if t > a && t < b && mult >= deg {
+                let h = 1e-4 * (b - a);
+                let at = |x: f64| surface.point(c.point(x.clamp(a, b)).truncate());
+                let (p0, p1, p2) = (at(t - h), at(t), at(t + h));
+                let turn = crate::math::angle_between(p1 - p0, p2 - p1);
+                if turn > CORNER && (p1 - p0).length() > 0.0 && (p2 - p1).length() > 0.0 {
+                    cuts.push(t);
+                }
+            }
+            i += mult.max(1);
+        }
+        let mut from = a;
+        let mut pieces = Vec::with_capacity(cuts.len() + 1);
+        for &t in cuts.iter().chain(core::iter::once(&b)) {
+            match crate::nurbs::reparam::segment(c, from, t) {
+                Ok(piece) => pieces.push(piece),
+                Err(_) => {
+                    pieces.clear();
+                    break;
+                }
+            }
+            from = t;
+        }
+        if pieces.is_empty() {
+            curves.push(c.clone());
+        } else {
+            curves.extend(pieces);
+        }
+    }
+    TrimLoop { curves }
+}
+
 /// Paper 001 step 5 for one loop: each model-space trim curve sampled evenly
 /// by arc length (51 points at least, doubled until within `goal`), each point
 /// projected onto the new surface from its mapped parameters, a cubic (u,v)
@@ -519,17 +575,43 @@ fn rebuild_loop(
     let map = |uv: DVec2| DVec2::new(fit.map_u.to_new(uv.x), fit.map_v.to_new(uv.y));
     let opts = ProjectionOptions { max_iterations: 12, ..ProjectionOptions::default() };
     let cell = DVec2::new(1.0 / (fit.map_u.new.len().max(2) - 1) as f64, 1.0 / (fit.map_v.new.len().max(2) - 1) as f64);
-    // Where an old (u,v) lands on the new surface.
+    let [lo, hi] = old.domain();
+    let edge = |x: f64, a: f64, b: f64| (x - a).abs() <= 1e-9 * (b - a) || (b - x).abs() <= 1e-9 * (b - a);
+    // A point inside the old domain stays as far inside the new one as the
+    // (monotone) map puts it, within [`BORDER_BAND`] of the border:
+    // projection alone would push a curve running just inside the border
+    // onto it, over the loop's own stretch along the border.
+    let inside = |x: f64, hint: f64| {
+        let cell = BORDER_BAND;
+        if hint > 1.0 - cell {
+            x.min(hint)
+        } else if hint < cell {
+            x.max(hint)
+        } else {
+            x
+        }
+    };
+    // Where an old (u,v) lands on the new surface; a coordinate on the old
+    // domain's border stays on the new one's (the map takes borders to
+    // borders, and the new border interpolates the old one's samples).
     let land = |uv: DVec2| -> DVec2 {
         let hint = map(uv);
         let p = old.point(uv);
         let pr = project_to_surface(new, p, Some(hint), &opts);
         let off = (pr.uv - hint).abs();
-        if off.x <= 2.0 * cell.x && off.y <= 2.0 * cell.y && pr.distance.is_finite() {
-            pr.uv
+        let mut at =
+            if off.x <= 2.0 * cell.x && off.y <= 2.0 * cell.y && pr.distance.is_finite() { pr.uv } else { hint };
+        if edge(uv.x, lo.x, hi.x) {
+            at.x = hint.x;
         } else {
-            hint
+            at.x = inside(at.x, hint.x);
         }
+        if edge(uv.y, lo.y, hi.y) {
+            at.y = hint.y;
+        } else {
+            at.y = inside(at.y, hint.y);
+        }
+        at
     };
     // Loop vertices landed once, so curves meet exactly.
     let ends: Vec<DVec2> = lp.curves.iter().map(|c| land(c.point(c.domain().0).truncate())).collect();

@@ -127,12 +127,31 @@ pub fn mesh_model_with_progress(
         if fit_error > 0.0 {
             // Paper 001's rebuild is kept where it pays: under `auto` the
             // original is meshed too and wins on more triangles or worse angles.
+            // The original goes first, so the rebuild's trial stops as soon
+            // as it takes more triangles (a creased face's rebuild can take 100×).
             let budget = options.max_triangles;
-            let fr = face::mesh_face(index, f, &face_lim, &face_crit, budget, auto_tight);
+            let auto = options.reparam == Reparam::Auto;
+            let orig = auto.then(|| face::mesh_face(index, original, &lim, &crit, budget, auto_tight));
+            let trial = match &orig {
+                Some(Ok(o)) => budget.min(o.mesh.tris.len().saturating_add(1)),
+                _ => budget,
+            };
+            let fr = face::mesh_face(index, f, &face_lim, &face_crit, trial, auto_tight);
             let failed = !matches!(&fr, Ok(r) if !r.mesh.tris.is_empty());
-            if failed || options.reparam == Reparam::Auto {
-                let orig = face::mesh_face(index, original, &lim, &crit, budget, auto_tight);
-                if let Some(why) = rebuild_loses(&fr, &orig) {
+            if failed || auto {
+                let orig = orig.unwrap_or_else(|| face::mesh_face(index, original, &lim, &crit, budget, auto_tight));
+                let mut why = rebuild_loses(&fr, &orig);
+                if why.is_some() && auto && cap.is_finite() {
+                    // The edge cap follows the sharpest bend; where that bend
+                    // is local, the rebuild may pay without it.
+                    let l = params::Limits { max_edge: lim.max_edge, ..face_lim };
+                    let c = refine::Criteria { max_edge: crit.max_edge, ..face_crit };
+                    let free = face::mesh_face(index, f, &l, &c, trial, auto_tight);
+                    if rebuild_loses(&free, &orig).is_none() {
+                        (why, face_lim, face_crit) = (None, l, c);
+                    }
+                }
+                if let Some(why) = why {
                     report.warnings.push(format!("face {index}: {why}; meshed the original"));
                     if let Some(r) = report.reparameterized.iter_mut().find(|r| r.face == index) {
                         r.rebuilt = false;
@@ -369,8 +388,10 @@ fn rebuild_loses(
     rebuilt: &Result<face::FaceResult, Error>,
     original: &Result<face::FaceResult, Error>,
 ) -> Option<alloc::string::String> {
-    let Some(new) = rebuilt.as_ref().ok().filter(|r| !r.mesh.tris.is_empty()) else {
-        return Some("the rebuilt face did not mesh".into());
+    let new = match rebuilt {
+        Ok(r) if !r.mesh.tris.is_empty() => r,
+        Ok(_) => return Some("the rebuilt face gave no triangles".into()),
+        Err(e) => return Some(format!("the rebuilt face did not mesh ({e})")),
     };
     let old = original.as_ref().ok()?;
     let p1 = |m: &refine::WorkMesh| {

@@ -153,6 +153,29 @@ fn reparam_trimmed_crowded_face_keeps_its_hole() {
     assert!((a - b).abs() < 2e-3 * a, "areas differ: off {a}, auto {b}");
 }
 
+/// A loop given as one polyline (as many IGES writers give a face's
+/// boundary): its corners are C0 knots and three of its sides run along the
+/// domain's border. Rebuilt, each side is interpolated on its own and the
+/// border sides stay on the border, so no slivers form between the loop's
+/// own nodes: the rebuild is kept, with fewer triangles and a higher angle.
+#[test]
+fn reparam_polyline_loop_along_the_border_keeps_its_corners() {
+    let corners = [(0.3, 0.0), (1.0, 0.0), (1.0, 1.0), (0.3, 1.0), (0.3, 0.0)];
+    let pts: Vec<DVec3> = corners.iter().map(|&(u, v)| DVec3::new(u, v, 0.0)).collect();
+    let knots = vec![0.0, 0.0, 1.0, 2.0, 3.0, 4.0, 4.0];
+    let lp = TrimLoop { curves: vec![NurbsCurve::try_new(1, knots, pts, None).unwrap()] };
+    let m = model(vec![lp]);
+    for rel in [1e-2, 1e-3] {
+        let (off, auto) = auto_against_off(&m, rel);
+        let (o, a) = (&off.report, &auto.report);
+        assert!(a.reparameterized[0].rebuilt, "rel {rel}: {:?}", a.warnings);
+        assert!(a.triangles <= o.triangles, "rel {rel}: {} > {} triangles", a.triangles, o.triangles);
+        assert!(a.p1_angle_deg > o.p1_angle_deg, "rel {rel}: p1 {} <= {}", a.p1_angle_deg, o.p1_angle_deg);
+        let (x, y) = (area(&off), area(&auto));
+        assert!((x - y).abs() < 2e-3 * x, "rel {rel}: areas differ: off {x}, auto {y}");
+    }
+}
+
 #[test]
 fn reparam_leaves_well_parameterized_surfaces_alone() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
