@@ -93,9 +93,11 @@ mod outlines {
     /// the nearest other face's border, is added to that border at its own
     /// curve's nearest point (unless it is within reach of a node there
     /// already). Then nodes within both reaches of each other get one id in
-    /// [`Outline::gids`]. Within one face (a seam) `tight` takes the place of
-    /// `sew`: a face's loops meet themselves exactly, and a face narrower
-    /// than `sew` must not be folded shut. Returns the ids given.
+    /// [`Outline::gids`], and a node left alone one short segment from a
+    /// shared node takes its id (a trim curve shorter than the gaps). Within
+    /// one face (a seam) `tight` takes the place of `sew`: a face's loops meet
+    /// themselves exactly, and a face narrower than `sew` must not be folded
+    /// shut. Returns the ids given.
     ///
     /// `reach`: how far a node may lie from the other border's chord
     /// (chordal tolerance plus `sew`).
@@ -285,6 +287,15 @@ mod outlines {
             {
                 continue;
             }
+            // Within reach of another node of that face, nearer than this
+            // border: it will be that node, and a copy here would be a second.
+            let box_r = DVec3::splat(d.min(limit));
+            if grid.in_box(qp - box_r, qp + box_r).any(|&m| {
+                let e = qp.distance(at(m));
+                m.0 == seg.0 && m != q && e < d && e <= limit.min(r_of(m))
+            }) {
+                continue;
+            }
             if seg.0 != q.0 && d > tight.max(4.0 * nearest.get(&q).copied().unwrap_or(0.0)) {
                 continue;
             }
@@ -376,6 +387,23 @@ mod outlines {
             if clash {
                 return;
             }
+            self.merge(x, y);
+        }
+
+        /// Joins the lone node `a` to the cluster of `b`, its neighbour a
+        /// segment away, if every node of their face there is within `tight` of it.
+        fn absorb(&mut self, a: u32, b: u32) -> bool {
+            let (x, y) = (self.find(a), self.find(b));
+            let Some(&(f, p, _)) = self.members[x as usize].first() else { return false };
+            if x == y || self.members[y as usize].iter().any(|&(g, q, _)| g == f && p.distance(q) > self.tight) {
+                return false;
+            }
+            self.merge(x, y);
+            true
+        }
+
+        /// Merges the clusters with roots `x` and `y`.
+        fn merge(&mut self, x: u32, y: u32) {
             let (small, big) =
                 if self.members[x as usize].len() < self.members[y as usize].len() { (x, y) } else { (y, x) };
             let moved = core::mem::take(&mut self.members[small as usize]);
@@ -385,7 +413,8 @@ mod outlines {
     }
 
     /// Gives nodes within both their reaches of each other one id (within
-    /// `tight` inside one face), new nodes the id of the node they stand for.
+    /// `tight` inside one face), new nodes the id of the node they stand for,
+    /// and a lone node one short segment from a shared one that id.
     fn name_nodes(
         faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>],
         bodies: &[u32],
@@ -462,6 +491,41 @@ mod outlines {
             pairs.sort_by(|x, y| x.0.total_cmp(&y.0));
             for (_, a, b) in pairs {
                 cl.union(a, b);
+            }
+            // A node no other face took, one segment shorter than `tight` from
+            // a node shared with a face within `sew` of it, is that node: there
+            // the other border has one node for this one's tiny jog. Only nodes
+            // shared before this take others in, so it does not run along a border.
+            let shared_before: Vec<bool> = (0..flat.len() as u32)
+                .map(|a| {
+                    let r = cl.find(a);
+                    cl.members[r as usize].len() > 1
+                })
+                .collect();
+            for (fi, item) in faces.iter().enumerate() {
+                let Some((_, o)) = item else { continue };
+                for (k, poly) in o.loops.polys.iter().enumerate() {
+                    let n = poly.uv.len();
+                    for i in 0..n {
+                        let a = index[fi][k][i];
+                        if shared_before[a as usize] {
+                            continue;
+                        }
+                        let p = flat[a as usize].1;
+                        for j in [(i + n - 1) % n, (i + 1) % n] {
+                            let b = index[fi][k][j];
+                            if b == a || !shared_before[b as usize] || flat[b as usize].1.distance(p) > tight {
+                                continue;
+                            }
+                            let rb = cl.find(b);
+                            let shared =
+                                cl.members[rb as usize].iter().any(|&(g, q, _)| g != fi as u32 && q.distance(p) <= sew);
+                            if shared && cl.absorb(a, b) {
+                                break;
+                            }
+                        }
+                    }
+                }
             }
         }
         // Compact ids.
