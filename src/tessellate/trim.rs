@@ -219,6 +219,7 @@ pub(crate) fn prepare_loops<'a>(
                 .collect();
         }
     }
+    split_crossings(&mut out);
     check_crossings(face, &out, &order)?;
     for k in 1..out.polys.len() {
         let probe = out.polys[k].uv[0];
@@ -307,9 +308,70 @@ fn segments_meet(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
     on(c, d, a, d1) || on(c, d, b, d2) || on(a, b, c, d3) || on(a, b, d, d4)
 }
 
+/// Two loop segments that cross or touch: (loop, segment) of each, and
+/// whether they are neighbours folding back onto each other.
+struct Crossing {
+    a: (usize, usize),
+    b: (usize, usize),
+    folds: bool,
+}
+
+/// Most rounds of splitting crossing chords (see [`split_crossings`]).
+const MAX_CROSSING_SPLITS: usize = 64;
+
+/// Splits chords that cross although their curves need not: two sides of a
+/// strip narrower than the tolerance, discretized within the tolerance, can
+/// cross as chords. Each round halves both chords of one crossing on their
+/// curves; a crossing that survives [`MAX_CROSSING_SPLITS`] rounds (curves
+/// that really cross) is left for [`check_crossings`] to report.
+fn split_crossings(loops: &mut Loops<'_>) {
+    for _ in 0..MAX_CROSSING_SPLITS {
+        let Some(x) = first_crossing(loops) else { return };
+        if x.folds {
+            return;
+        }
+        // The later segment first, so the earlier index stays valid.
+        let (first, second) = if x.a >= x.b { (x.a, x.b) } else { (x.b, x.a) };
+        for (k, i) in [first, second] {
+            if !split_chord(loops, k, i) {
+                return;
+            }
+        }
+    }
+}
+
+/// Halves segment `i` of loop `k` at the middle of its curve parameters;
+/// false when that segment is too short in parameter to halve.
+fn split_chord(loops: &mut Loops<'_>, k: usize, i: usize) -> bool {
+    let Some(&(c, ta, tb)) = loops.polys.get(k).and_then(|p| p.seg.get(i)) else { return false };
+    let Some(curve) = loops.curves.get(c as usize) else { return false };
+    let tm = 0.5 * (ta + tb);
+    if !(tm != ta && tm != tb && tm.is_finite()) {
+        return false;
+    }
+    let q = curve.point(tm).truncate();
+    let poly = &mut loops.polys[k];
+    poly.seg[i] = (c, ta, tm);
+    poly.seg.insert(i + 1, (c, tm, tb));
+    poly.uv.insert(i + 1, q);
+    poly.at.insert(i + 1, CurveRef { curve: c, t: tm });
+    true
+}
+
+/// Fails on a pair of loop segments that cross or touch (see [`first_crossing`]).
+fn check_crossings(face: usize, loops: &Loops<'_>, order: &[usize]) -> Result<(), Error> {
+    let Some(x) = first_crossing(loops) else { return Ok(()) };
+    let message = if x.a.0 == x.b.0 {
+        format!("loop {} crosses itself", order[x.a.0])
+    } else {
+        format!("loop {} crosses loop {}", order[x.a.0.min(x.b.0)], order[x.a.0.max(x.b.0)])
+    };
+    Err(Error::Mesh { face, message })
+}
+
 /// Finds a pair of loop segments that cross or touch (other than neighbours
 /// sharing their common node), bucketed on a uniform grid.
-fn check_crossings(face: usize, loops: &Loops<'_>, order: &[usize]) -> Result<(), Error> {
+fn first_crossing(loops: &Loops<'_>) -> Option<Crossing> {
     struct Seg {
         a: DVec2,
         b: DVec2,
@@ -353,21 +415,83 @@ fn check_crossings(face: usize, loops: &Loops<'_>, order: &[usize]) -> Result<()
                         let (shared, p, q) = if (s.idx + 1) % n == t.idx { (s.b, s.a, t.b) } else { (s.a, s.b, t.a) };
                         let folds = orient(shared, p, q) == 0.0 && (p - shared).dot(q - shared) > 0.0;
                         if folds && n > 2 {
-                            return Err(Error::Mesh { face, message: format!("loop {} crosses itself", order[s.lp]) });
+                            return Some(Crossing { a: (s.lp, s.idx), b: (t.lp, t.idx), folds: true });
                         }
                         continue;
                     }
                 }
                 if segments_meet(s.a, s.b, t.a, t.b) {
-                    let message = if s.lp == t.lp {
-                        format!("loop {} crosses itself", order[s.lp])
-                    } else {
-                        format!("loop {} crosses loop {}", order[s.lp.min(t.lp)], order[s.lp.max(t.lp)])
-                    };
-                    return Err(Error::Mesh { face, message });
+                    return Some(Crossing { a: (s.lp, s.idx), b: (t.lp, t.idx), folds: false });
                 }
             }
         }
     }
-    Ok(())
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::NurbsCurve;
+
+    /// A quadratic Bézier in (u,v) from `a` over control `c` to `b`.
+    fn bezier(a: DVec2, c: DVec2, b: DVec2) -> NurbsCurve {
+        let pts = [a, c, b].iter().map(|p| p.extend(0.0)).collect();
+        NurbsCurve::try_new(2, alloc::vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0], pts, None).unwrap()
+    }
+
+    /// A lens between two arcs 0.02 apart at the top: coarse chords of the
+    /// lower arc cross the upper arc's, though the arcs never meet between
+    /// their shared ends. Splitting resolves it, every node staying on its curve.
+    #[test]
+    fn crossing_chords_of_a_thin_lens_are_split_apart() {
+        let (p, q) = (DVec2::new(0.0, 0.0), DVec2::new(1.0, 0.0));
+        let upper = bezier(p, DVec2::new(0.5, 0.4), q);
+        let lower = bezier(q, DVec2::new(0.5, 0.36), p);
+        let nodes = [(0u32, 0.0), (0, 0.5), (1, 0.0), (1, 0.25), (1, 0.75)];
+        let curves = [&upper, &lower];
+        let mut poly = Polyline::default();
+        for &(c, t) in &nodes {
+            poly.uv.push(curves[c as usize].point(t).truncate());
+            poly.at.push(CurveRef { curve: c, t });
+        }
+        poly.seg = alloc::vec![(0, 0.0, 0.5), (0, 0.5, 1.0), (1, 0.0, 0.25), (1, 0.25, 0.75), (1, 0.75, 1.0)];
+        let mut loops = Loops { polys: alloc::vec![poly], curves: curves.to_vec() };
+        assert!(first_crossing(&loops).is_some(), "the test's chords must cross");
+        split_crossings(&mut loops);
+        assert!(first_crossing(&loops).is_none());
+        let poly = &loops.polys[0];
+        assert!(poly.uv.len() > nodes.len());
+        assert_eq!(poly.uv.len(), poly.seg.len());
+        for (q, at) in poly.uv.iter().zip(&poly.at) {
+            assert!(q.distance(curves[at.curve as usize].point(at.t).truncate()) < 1e-12);
+        }
+        // Each segment starts at its node's parameter on the same curve.
+        for (s, at) in poly.seg.iter().zip(&poly.at) {
+            assert_eq!((s.0, s.1), (at.curve, at.t));
+        }
+    }
+
+    /// Arcs that really cross are left crossing (and reported), within the split limit.
+    #[test]
+    fn crossing_curves_stay_crossing() {
+        let (p, q) = (DVec2::new(0.0, 0.0), DVec2::new(1.0, 0.0));
+        let a = bezier(p, DVec2::new(0.5, 0.4), q);
+        let b = bezier(q, DVec2::new(0.5, 0.2), DVec2::new(0.0, 0.3));
+        let c = bezier(DVec2::new(0.0, 0.3), DVec2::new(-0.1, 0.1), p);
+        let curves = [&a, &b, &c];
+        let mut poly = Polyline::default();
+        for (k, cv) in curves.iter().enumerate() {
+            for t in [0.0, 0.5] {
+                poly.uv.push(cv.point(t).truncate());
+                poly.at.push(CurveRef { curve: k as u32, t });
+                poly.seg.push((k as u32, t, t + 0.5));
+            }
+        }
+        let mut loops = Loops { polys: alloc::vec![poly], curves: curves.to_vec() };
+        split_crossings(&mut loops);
+        assert!(first_crossing(&loops).is_some());
+        assert!(check_crossings(3, &loops, &[0]).is_err());
+        assert!(loops.polys[0].uv.len() <= 6 + 2 * MAX_CROSSING_SPLITS);
+    }
 }
