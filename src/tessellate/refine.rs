@@ -681,7 +681,7 @@ impl WorkMesh {
         self.retriangulate(t, u, [tv, uv_], [t1, t2], [w1, w2]);
         let good = [t, u].iter().all(|&x| {
             let (m, turn) = self.measure(surface, x as usize, c);
-            !self.inverted(surface, x as usize) && m.max <= c.tol && turn <= c.angle
+            !self.inverted(surface, x as usize) && m.max <= c.tol && self.turn_ok(c, &m, turn, x)
         });
         if !good {
             self.retriangulate(t, u, [t1, t2], [old.0, old.2], [old.1, old.3]);
@@ -743,7 +743,7 @@ impl WorkMesh {
             area(self.uvs[t as usize]) * sense > 0.0
                 && !self.inverted(surface, t as usize)
                 && m.max <= c.tol
-                && turn <= c.angle
+                && self.turn_ok(c, &m, turn, t)
         });
         if good {
             Some(ring)
@@ -751,6 +751,13 @@ impl WorkMesh {
             set(self, old_uv, old_p, old_n);
             None
         }
+    }
+
+    /// Whether triangle `t`'s normal turn passes: within the angle limit, or
+    /// too short to split for it ([`Criteria::short_for_angle`]), so a repair
+    /// that unfolds such a triangle is not refused for a turn refinement keeps too.
+    fn turn_ok(&self, c: &Criteria, m: &TriMeasure, turn: f64, t: u32) -> bool {
+        turn <= c.angle || c.short_for_angle(m, turn, self.longest_edge(t as usize).2)
     }
 
     /// Replaces triangles `t` and `u` (vertices `from`) by `to` with corner (u,v)s `uvs`.
