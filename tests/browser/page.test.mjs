@@ -173,6 +173,23 @@ test('a file dropped on the view is meshed', async () => {
   assert.equal(await stat('stat-faces'), 50);
 });
 
+test('re-parameterizing a crowded surface: the page names the rebuilt face', async () => {
+  const crowded = readFileSync(join(root, 'tests', 'data', 'crowded_uv.json'));
+  const state = await settle(() =>
+    page.setInputFiles('#file-input', { name: 'crowded_uv.json', mimeType: 'application/json', buffer: crowded }),
+  );
+  assert.equal(state, 'ready');
+  assert.equal(await page.textContent('#stat-reparam'), 'none', 'off: nothing flagged');
+  const off = await stat('stat-triangles');
+  assert.equal(await settle(() => page.selectOption('#reparam', 'auto')), 'ready');
+  assert.equal(await page.textContent('#stat-reparam'), '1 of 1 flagged (face 0)');
+  assert.ok((await stat('stat-triangles')) < off, 'the rebuilt face takes fewer triangles');
+  assert.match(await page.textContent('#stat-max-deviation'), /✓/);
+  await shot(page, '05-reparam-auto');
+  assert.equal(await settle(() => page.selectOption('#reparam', 'off')), 'ready');
+  assert.equal(await stat('stat-triangles'), off);
+});
+
 test('IGES and STEP files go to the module, which meshes them or says why not', async () => {
   for (const name of ['part.igs', 'part.step']) {
     const bytes = Buffer.from(name.endsWith('.igs') ? 'not an IGES file\n' : 'ISO-10303-21;\nEND-ISO-10303-21;\n');

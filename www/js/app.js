@@ -117,6 +117,7 @@ function showStats(report, quality) {
   setStat('stat-free-edges', count(report.free_edges), report.free_edges === 0 ? 'ok' : 'bad');
   setStat('stat-open-edges', count(report.boundary_edges));
   setStat('stat-nonmanifold', count(report.nonmanifold_edges), report.nonmanifold_edges === 0 ? '' : 'bad');
+  setStat('stat-reparam', rebuiltFaces(report.reparameterized ?? []));
   const workers = report.shares > 1 ? ` · ${report.shares} workers` : '';
   setStat('stat-time', `${report.parse_ms.toFixed(1)} / ${report.time_ms.toFixed(1)} ms${workers}`);
   const badge = $('quality');
@@ -137,6 +138,16 @@ function showStats(report, quality) {
     list.append(li);
   }
   $('warning-count').textContent = report.warnings.length ? String(report.warnings.length) : '';
+}
+
+/** Which faces the ratio test flagged and which of them were rebuilt (paper 001). */
+function rebuiltFaces(flagged) {
+  if (flagged.length === 0) return 'none';
+  const rebuilt = flagged.filter((f) => f.rebuilt).map((f) => f.face).sort((a, b) => a - b);
+  const named = rebuilt.length
+    ? ` (face${rebuilt.length > 1 ? 's' : ''} ${rebuilt.slice(0, 8).join(', ')}${rebuilt.length > 8 ? ', …' : ''})`
+    : '';
+  return `${rebuilt.length} of ${flagged.length} flagged${named}`;
 }
 
 function clearStats() {
@@ -175,6 +186,8 @@ function readOptions() {
   if (angle !== '' && angle !== DEFAULT_ANGLE_DEG) options.angle = (Number(angle) * Math.PI) / 180;
   const maxEdge = $('max-edge').value.trim();
   if (maxEdge !== '') options.maxEdge = Number(maxEdge);
+  const reparam = $('reparam').value;
+  if (reparam !== 'off' && meshMode() !== 'quality') options.reparam = reparam;
   return options;
 }
 
@@ -401,11 +414,12 @@ $('tol-slider').addEventListener('input', () => {
   sliderToValue();
   remeshSoon();
 });
-for (const id of ['angle', 'max-edge', 'size-value']) $(id).addEventListener('change', () => remesh());
+for (const id of ['angle', 'max-edge', 'size-value', 'reparam']) $(id).addEventListener('change', () => remesh());
 for (const radio of document.querySelectorAll('input[name="mode"]')) {
   radio.addEventListener('change', () => {
     const quality = meshMode() === 'quality';
     $('size-field').hidden = !quality;
+    $('reparam-field').hidden = quality;
     $('mode-hint').textContent = quality
       ? 'Near-equilateral triangles of size H for analysis (paper 003); faces meet node to node.'
       : 'Fewest triangles within the tolerance.';
