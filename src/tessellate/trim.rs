@@ -238,7 +238,8 @@ pub(crate) fn prepare_loops<'a>(
 /// Drops a node that lies within `eps` of the next one in model space and
 /// next to it in (u,v) too (a trim curve a few nanometres long that bridges
 /// two others in a file): such a segment would only make slivers. The later
-/// node stays, so the segment before it follows the curve that goes on.
+/// node stays, so the segment before it follows the curve that goes on; a
+/// run of such nodes longer than `eps` keeps its curves' corners.
 /// Nodes along a pole stay, far apart in (u,v) though one point in space.
 fn merge_close(p: &mut Polyline, surface: &dyn Surface, eps: f64) {
     let [lo, hi] = surface.domain();
@@ -248,12 +249,31 @@ fn merge_close(p: &mut Polyline, surface: &dyn Surface, eps: f64) {
         return;
     }
     let pts: Vec<DVec3> = p.uv.iter().map(|&q| surface.point(q)).collect();
-    let keep: Vec<bool> = (0..n)
+    let mut keep: Vec<bool> = (0..n)
         .map(|i| {
             let j = (i + 1) % n;
             !(pts[i].distance(pts[j]) < eps && p.uv[i].distance(p.uv[j]) < near_uv)
         })
         .collect();
+    // A run of dropped nodes reaching `eps` or more from the node that stays
+    // is a finely split curve, not a tiny one: its corners stay where the neighbours have them.
+    let Some(start) = (0..n).find(|&i| keep[i]) else { return };
+    let mut kept = start;
+    let mut far = false;
+    for step in 1..=n {
+        let i = (start + n - step) % n;
+        if keep[i] {
+            kept = i;
+            far = false;
+        } else {
+            far |= pts[i].distance(pts[kept]) >= eps;
+            if far && keep[(i + n - 1) % n] {
+                for k in (i..i + n).map(|k| k % n).take_while(|&k| k != kept) {
+                    keep[k] = p.at[k].curve != p.at[(k + n - 1) % n].curve;
+                }
+            }
+        }
+    }
     if keep.iter().filter(|&&k| k).count() < 3 {
         return;
     }
