@@ -521,24 +521,19 @@ fn split_at_corners(surface: &FaceSurface, lp: &TrimLoop) -> TrimLoop {
     let mut curves = Vec::with_capacity(lp.curves.len());
     for c in &lp.curves {
         let (a, b) = c.domain();
-        let deg = c.degree();
-        let knots = c.knots().knots();
-        let mut cuts: Vec<f64> = Vec::new();
-        let mut i = deg + 1;
-        while i + deg < knots.len() {
-            let t = knots[i];
-            let mult = knots[i..].iter().take_while(|&&k| k == t).count();
-            if t > a && t < b && mult >= deg {
-                let h = 1e-4 * (b - a);
-                let at = |x: f64| surface.point(c.point(x.clamp(a, b)).truncate());
+        let knots = c.knots();
+        let h = 1e-4 * (b - a);
+        let at = |x: f64| surface.point(c.point(x.clamp(a, b)).truncate());
+        let cuts: Vec<f64> = knots
+            .breakpoints()
+            .into_iter()
+            .filter(|&t| t > a && t < b && knots.multiplicity(t) >= c.degree())
+            .filter(|&t| {
                 let (p0, p1, p2) = (at(t - h), at(t), at(t + h));
                 let turn = crate::math::angle_between(p1 - p0, p2 - p1);
-                if turn > CORNER && (p1 - p0).length() > 0.0 && (p2 - p1).length() > 0.0 {
-                    cuts.push(t);
-                }
-            }
-            i += mult.max(1);
-        }
+                turn > CORNER && (p1 - p0).length() > 0.0 && (p2 - p1).length() > 0.0
+            })
+            .collect();
         let mut from = a;
         let mut pieces = Vec::with_capacity(cuts.len() + 1);
         for &t in cuts.iter().chain(core::iter::once(&b)) {
@@ -582,10 +577,9 @@ fn rebuild_loop(
     // projection alone would push a curve running just inside the border
     // onto it, over the loop's own stretch along the border.
     let inside = |x: f64, hint: f64| {
-        let cell = BORDER_BAND;
-        if hint > 1.0 - cell {
+        if hint > 1.0 - BORDER_BAND {
             x.min(hint)
-        } else if hint < cell {
+        } else if hint < BORDER_BAND {
             x.max(hint)
         } else {
             x

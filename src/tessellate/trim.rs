@@ -219,8 +219,9 @@ pub(crate) fn prepare_loops<'a>(
                 .collect();
         }
     }
-    split_crossings(&mut out);
-    check_crossings(face, &out, &order)?;
+    if let Some(x) = split_crossings(&mut out) {
+        return Err(crossing_error(face, &x, &order));
+    }
     for k in 1..out.polys.len() {
         let probe = out.polys[k].uv[0];
         let mut only_outer = Loops { polys: Vec::new(), curves: Vec::new() };
@@ -342,22 +343,24 @@ const MAX_CROSSING_SPLITS: usize = 64;
 /// Splits chords that cross although their curves need not: two sides of a
 /// strip narrower than the tolerance, discretized within the tolerance, can
 /// cross as chords. Each round halves both chords of one crossing on their
-/// curves; a crossing that survives [`MAX_CROSSING_SPLITS`] rounds (curves
-/// that really cross) is left for [`check_crossings`] to report.
-fn split_crossings(loops: &mut Loops<'_>) {
+/// curves. Returns the crossing left (a fold, chords too short to halve, or
+/// curves that really cross after [`MAX_CROSSING_SPLITS`] rounds), if any.
+fn split_crossings(loops: &mut Loops<'_>) -> Option<Crossing> {
     for _ in 0..MAX_CROSSING_SPLITS {
-        let Some(x) = first_crossing(loops) else { return };
+        let x = first_crossing(loops)?;
         if x.folds {
-            return;
+            return Some(x);
         }
         // The later segment first, so the earlier index stays valid.
         let (first, second) = if x.a >= x.b { (x.a, x.b) } else { (x.b, x.a) };
         for (k, i) in [first, second] {
             if !split_chord(loops, k, i) {
-                return;
+                // The other chord may have been halved: look again.
+                return first_crossing(loops);
             }
         }
     }
+    first_crossing(loops)
 }
 
 /// Halves segment `i` of loop `k` at the middle of its curve parameters;
@@ -378,15 +381,14 @@ fn split_chord(loops: &mut Loops<'_>, k: usize, i: usize) -> bool {
     true
 }
 
-/// Fails on a pair of loop segments that cross or touch (see [`first_crossing`]).
-fn check_crossings(face: usize, loops: &Loops<'_>, order: &[usize]) -> Result<(), Error> {
-    let Some(x) = first_crossing(loops) else { return Ok(()) };
+/// The error for crossing `x` of face `face`, naming the loops as the file orders them.
+fn crossing_error(face: usize, x: &Crossing, order: &[usize]) -> Error {
     let message = if x.a.0 == x.b.0 {
         format!("loop {} crosses itself", order[x.a.0])
     } else {
         format!("loop {} crosses loop {}", order[x.a.0.min(x.b.0)], order[x.a.0.max(x.b.0)])
     };
-    Err(Error::Mesh { face, message })
+    Error::Mesh { face, message }
 }
 
 /// Finds a pair of loop segments that cross or touch (other than neighbours
@@ -478,7 +480,7 @@ mod tests {
         poly.seg = alloc::vec![(0, 0.0, 0.5), (0, 0.5, 1.0), (1, 0.0, 0.25), (1, 0.25, 0.75), (1, 0.75, 1.0)];
         let mut loops = Loops { polys: alloc::vec![poly], curves: curves.to_vec() };
         assert!(first_crossing(&loops).is_some(), "the test's chords must cross");
-        split_crossings(&mut loops);
+        assert!(split_crossings(&mut loops).is_none());
         assert!(first_crossing(&loops).is_none());
         let poly = &loops.polys[0];
         assert!(poly.uv.len() > nodes.len());
@@ -509,9 +511,10 @@ mod tests {
             }
         }
         let mut loops = Loops { polys: alloc::vec![poly], curves: curves.to_vec() };
-        split_crossings(&mut loops);
+        let left = split_crossings(&mut loops).expect("curves that cross stay crossing");
         assert!(first_crossing(&loops).is_some());
-        assert!(check_crossings(3, &loops, &[0]).is_err());
+        let message = alloc::format!("{}", crossing_error(3, &left, &[0]));
+        assert!(message.contains("loop 0 crosses itself"), "{message}");
         assert!(loops.polys[0].uv.len() <= 6 + 2 * MAX_CROSSING_SPLITS);
     }
 }
