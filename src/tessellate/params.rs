@@ -94,6 +94,73 @@ pub(crate) fn subdivide(evals: &[&dyn Fn(f64) -> (DVec3, DVec3)], breaks: &[f64]
     subdivide_probes(&probes, breaks, lim)
 }
 
+/// Most fine intervals one coarse interval of [`coarsen`] may span.
+const COARSEN_SPAN: usize = 64;
+
+/// Drops nodes of an accepted subdivision `ts` that the limits do not need:
+/// the knot breaks [`subdivide`] starts from force a node per break group
+/// even where the curve is straight (a 3 mm cubic with 27 knot spans took 16
+/// segments at a 0.18 tolerance). A run of fine intervals becomes one when
+/// its chord passes the same tests, on the fine nodes and the quarter points
+/// of every fine interval: the samples the fine intervals were accepted on.
+#[cfg(feature = "std")]
+pub(crate) fn coarsen(
+    evals: &[&dyn Fn(f64) -> (DVec3, DVec3)],
+    straight: &dyn Fn(f64, f64) -> bool,
+    ts: &[f64],
+    lim: &Limits,
+) -> Vec<f64> {
+    let n = ts.len();
+    if n < 3 || evals.is_empty() {
+        return ts.to_vec();
+    }
+    // Samples: node i at 4i, the quarter points of interval i at 4i+1..4i+3.
+    let params: Vec<f64> = (0..4 * (n - 1) + 1)
+        .map(|s| {
+            let (i, q) = (s / 4, s % 4);
+            if q == 0 {
+                ts[i]
+            } else {
+                ts[i] + (ts[i + 1] - ts[i]) * q as f64 * 0.25
+            }
+        })
+        .collect();
+    let samples: Vec<Vec<(DVec3, DVec3)>> = evals.iter().map(|e| params.iter().map(|&t| e(t)).collect()).collect();
+    let passes = |i: usize, k: usize| -> bool {
+        let (pa, pb) = (samples[0][4 * i].0, samples[0][4 * k].0);
+        let len = pa.distance(pb);
+        if len <= lim.min_edge {
+            return true;
+        }
+        if len > lim.max_edge {
+            return false;
+        }
+        straight(ts[i], ts[k])
+            && samples.iter().all(|sm| {
+                let (na, nb) = (sm[4 * i].1, sm[4 * k].1);
+                crate::math::angle_between(na, nb) <= lim.angle
+                    && sm[4 * i + 1..4 * k].iter().all(|&(p, d)| {
+                        dist_to_segment(p, pa, pb) <= lim.tol
+                            && crate::math::angle_between(na, d) <= lim.angle
+                            && crate::math::angle_between(d, nb) <= lim.angle
+                    })
+            })
+    };
+    // From the first node, each run reaches as far as its chord passes.
+    let mut out = Vec::with_capacity(n);
+    out.push(ts[0]);
+    let mut i = 0;
+    while i + 1 < n {
+        let mut k = i + 1;
+        while k + 1 < n && k + 1 - i <= COARSEN_SPAN && passes(i, k + 1) {
+            k += 1;
+        }
+        out.push(ts[k]);
+        i = k;
+    }
+    out
+}
+
 /// As [`subdivide`], each curve tested only on the parts of an interval where it matters.
 pub(crate) fn subdivide_probes(probes: &[Probe<'_>], breaks: &[f64], lim: &Limits) -> (Vec<f64>, f64) {
     let mut out: Vec<f64> = Vec::new();
@@ -255,5 +322,45 @@ mod tests {
         assert_eq!(b, [-1.02, 5.8e-15]);
         let b = initial_breaks(&[0.0, 0.25, 0.25 + 1e-12, 0.5, 1.0], 0.0, 1.0, 16);
         assert_eq!(b, [0.0, 0.25, 0.5, 1.0]);
+    }
+
+    fn lim(tol: f64) -> Limits {
+        Limits { tol, angle: 0.5, max_edge: f64::INFINITY, min_edge: tol * 1e-3 }
+    }
+
+    /// A straight line split at 16 knot groups is one chord after coarsening;
+    /// an arc keeps as many nodes as its sag and turn need, and every chord
+    /// left stays within the tolerance of the arc.
+    #[test]
+    fn coarsening_keeps_only_the_nodes_the_limits_need() {
+        let line = |t: f64| (DVec3::new(3.0 * t, 1.0, 0.0), DVec3::X);
+        let breaks: Vec<f64> = (0..=16).map(|k| k as f64 / 16.0).collect();
+        let (ts, _) = subdivide(&[&line], &breaks, &lim(0.01));
+        assert_eq!(ts.len(), 17);
+        let all = |_: f64, _: f64| true;
+        assert_eq!(coarsen(&[&line], &all, &ts, &lim(0.01)), [0.0, 1.0]);
+
+        let r = 5.0;
+        let arc = |t: f64| (DVec3::new(r * t.cos(), r * t.sin(), 0.0), DVec3::new(-t.sin(), t.cos(), 0.0));
+        let breaks: Vec<f64> = (0..=16).map(|k| k as f64 * core::f64::consts::PI / 16.0).collect();
+        let tol = 0.2;
+        let (ts, _) = subdivide(&[&arc], &breaks, &lim(tol));
+        let coarse = coarsen(&[&arc], &all, &ts, &lim(tol));
+        assert!(coarse.len() < ts.len(), "{} of {}", coarse.len(), ts.len());
+        // sag of a chord over angle a on radius r: r (1 - cos(a/2)).
+        let need = (core::f64::consts::PI / (2.0 * (1.0 - tol / r).acos())).ceil() as usize;
+        assert!(coarse.len() > need, "{} chords, {need} needed", coarse.len() - 1);
+        for w in coarse.windows(2) {
+            let sag = r * (1.0 - (0.5 * (w[1] - w[0])).cos());
+            assert!(sag <= tol, "chord {w:?} sags {sag}");
+            assert!(w[1] - w[0] <= 0.5 + 1e-12, "chord {w:?} turns too far");
+        }
+        // A chord the caller rejects (a straight (u,v) segment off the surface) is not taken.
+        let none = |_: f64, _: f64| false;
+        assert_eq!(coarsen(&[&line], &none, &ts_line(), &lim(0.01)).len(), 17);
+    }
+
+    fn ts_line() -> Vec<f64> {
+        (0..=16).map(|k| k as f64 / 16.0).collect()
     }
 }

@@ -155,9 +155,11 @@ fn reparam_trimmed_crowded_face_keeps_its_hole() {
 
 /// A loop given as one polyline (as many IGES writers give a face's
 /// boundary): its corners are C0 knots and three of its sides run along the
-/// domain's border. Rebuilt, each side is interpolated on its own and the
-/// border sides stay on the border, so no slivers form between the loop's
-/// own nodes: the rebuild is kept, with fewer triangles and a higher angle.
+/// domain's border. Its straight sides are one chord each however many knot
+/// spans they hold, so the original meshes without slivers between the
+/// loop's own nodes; auto keeps whichever of the original and the rebuild
+/// takes fewer triangles, and a rebuild kept must also have the higher
+/// angle, the same area, and be within the tolerance of the original.
 #[test]
 fn reparam_polyline_loop_along_the_border_keeps_its_corners() {
     let corners = [(0.3, 0.0), (1.0, 0.0), (1.0, 1.0), (0.3, 1.0), (0.3, 0.0)];
@@ -168,9 +170,13 @@ fn reparam_polyline_loop_along_the_border_keeps_its_corners() {
     for rel in [1e-2, 1e-3] {
         let (off, auto) = auto_against_off(&m, rel);
         let (o, a) = (&off.report, &auto.report);
-        assert!(a.reparameterized[0].rebuilt, "rel {rel}: {:?}", a.warnings);
+        assert!(o.p1_angle_deg > 1.0, "rel {rel}: off p1 {}", o.p1_angle_deg);
         assert!(a.triangles <= o.triangles, "rel {rel}: {} > {} triangles", a.triangles, o.triangles);
-        assert!(a.p1_angle_deg > o.p1_angle_deg, "rel {rel}: p1 {} <= {}", a.p1_angle_deg, o.p1_angle_deg);
+        if a.reparameterized[0].rebuilt {
+            assert!(a.p1_angle_deg > o.p1_angle_deg, "rel {rel}: p1 {} <= {}", a.p1_angle_deg, o.p1_angle_deg);
+        } else {
+            assert!(a.warnings.iter().any(|w| w.contains("meshed the original")), "rel {rel}: {:?}", a.warnings);
+        }
         let (x, y) = (area(&off), area(&auto));
         assert!((x - y).abs() < 2e-3 * x, "rel {rel}: areas differ: off {x}, auto {y}");
     }
