@@ -94,9 +94,6 @@ pub(crate) fn subdivide(evals: &[&dyn Fn(f64) -> (DVec3, DVec3)], breaks: &[f64]
     subdivide_probes(&probes, breaks, lim)
 }
 
-/// Most fine intervals one coarse interval of [`coarsen`] may span.
-const COARSEN_SPAN: usize = 64;
-
 /// Drops nodes of an accepted subdivision `ts` that the limits do not need:
 /// the knot breaks [`subdivide`] starts from force a node per break group
 /// even where the curve is straight (a 3 mm cubic with 27 knot spans took 16
@@ -146,14 +143,24 @@ pub(crate) fn coarsen(
                     })
             })
     };
-    // From the first node, each run reaches as far as its chord passes.
+    // From the first node, each run reaches as far as its chord passes:
+    // steps double while they pass, then halve back to the last that does,
+    // so a straight run of L intervals costs O(L log L) samples, not O(L²).
     let mut out = Vec::with_capacity(n);
     out.push(ts[0]);
     let mut i = 0;
     while i + 1 < n {
         let mut k = i + 1;
-        while k + 1 < n && k + 1 - i <= COARSEN_SPAN && passes(i, k + 1) {
-            k += 1;
+        let mut step = 1;
+        while k + step < n && passes(i, k + step) {
+            k += step;
+            step *= 2;
+        }
+        while step > 1 {
+            step /= 2;
+            if k + step < n && passes(i, k + step) {
+                k += step;
+            }
         }
         out.push(ts[k]);
         i = k;

@@ -177,17 +177,6 @@ pub(crate) fn prepare_loops<'a>(
                 })
             };
             let ts = super::params::coarsen(&evals, &straight, &ts, lim);
-            // A coarse edge is a straight (u,v) segment in the mesh: its
-            // image must stay as close to its chord as the curve does.
-            let straight = |ta: f64, tb: f64| {
-                let (ua, ub) = (c.point(ta).truncate(), c.point(tb).truncate());
-                let (pa, pb) = (surface.point(ua), surface.point(ub));
-                (1..8).all(|k| {
-                    let p = surface.point(ua.lerp(ub, k as f64 / 8.0));
-                    super::params::dist_to_segment(p, pa, pb) <= lim.tol
-                })
-            };
-            let ts = super::params::coarsen(&evals, &straight, &ts, lim);
             // The last node of each curve is the first of the next: drop it.
             for &t in &ts[..ts.len().saturating_sub(1)] {
                 poly.uv.push(c.point(t).truncate());
