@@ -63,6 +63,34 @@ fn golden(dist: &dyn Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
     }
 }
 
+/// The fraction in `[0, 1]` nearest by `dist`, starting from the chord's
+/// fraction `s0`: a segment's curve parameter need not follow its chord, so
+/// a coarse scan of the whole span brackets the minimum when the window
+/// about `s0` ends at its edge.
+fn nearest_fraction(dist: &dyn Fn(f64) -> f64, s0: f64) -> (f64, f64) {
+    let (lo, hi) = ((s0 - 0.25).max(0.0), (s0 + 0.25).min(1.0));
+    let (s, d) = golden(dist, lo, hi);
+    let at_edge = (s - lo < 1e-6 && lo > 0.0) || (hi - s < 1e-6 && hi < 1.0);
+    if !at_edge {
+        return (s, d);
+    }
+    const SCAN: usize = 16;
+    let mut best = (0usize, f64::INFINITY);
+    for i in 0..=SCAN {
+        let v = dist(i as f64 / SCAN as f64);
+        if v < best.1 {
+            best = (i, v);
+        }
+    }
+    let (a, b) = (best.0.saturating_sub(1) as f64 / SCAN as f64, (best.0 + 1).min(SCAN) as f64 / SCAN as f64);
+    let (s2, d2) = golden(dist, a, b);
+    if d2 < d {
+        (s2, d2)
+    } else {
+        (s, d)
+    }
+}
+
 /// Sewing of face outlines before they are triangulated.
 #[cfg(feature = "std")]
 mod outlines {
@@ -70,7 +98,7 @@ mod outlines {
     use alloc::vec::Vec;
     use glam::DVec3;
 
-    use super::golden;
+    use super::nearest_fraction;
     use crate::nurbs::Surface;
     use crate::tessellate::face::Outline;
     use crate::tessellate::trim::Polyline;
@@ -236,8 +264,7 @@ mod outlines {
                         if !parallel {
                             continue;
                         }
-                        let (s, d) =
-                            golden(&|s: f64| on_curve(s).distance(q), (s0 - 0.25).max(0.0), (s0 + 0.25).min(1.0));
+                        let (s, d) = nearest_fraction(&|s: f64| on_curve(s).distance(q), s0);
                         if d <= limit && s > 1e-9 && s < 1.0 - 1e-9 {
                             cands.push((na, s, ta + (tb - ta) * s, d, qn));
                         } else if q.distance(pa).min(q.distance(pb)) <= limit {
@@ -576,7 +603,7 @@ fn nearest_on_border(f: &FaceWork<'_>, a: u32, b: u32, q: DVec3) -> f64 {
     let s0 = ((q - pa).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
     let dist =
         |s: f64| f.mesh.boundary_point(f.surface, &f.curves, a, b, s).map_or(f64::INFINITY, |(_, p)| p.distance(q));
-    golden(&dist, (s0 - 0.25).max(0.0), (s0 + 0.25).min(1.0)).0
+    nearest_fraction(&dist, s0).0
 }
 
 /// Refines every face until its triangles pass (or its budget or the minimum
