@@ -776,6 +776,15 @@ impl WorkMesh {
         }
     }
 
+    /// Whether triangle `t` folds against the surface with a facet worth
+    /// judging: corners within `negligible` of each other are one point (a
+    /// pole's nodes a rounding error apart), the facet's normal then noise.
+    pub fn folded_beyond(&self, surface: &dyn Surface, t: usize, negligible: f64) -> bool {
+        let v = self.tris[t];
+        let p = [self.pos[v[0] as usize], self.pos[v[1] as usize], self.pos[v[2] as usize]];
+        (0..3).all(|k| p[k].distance(p[(k + 1) % 3]) > negligible) && self.inverted(surface, t)
+    }
+
     /// Whether the facet normal opposes the surface normal at the centroid's (u,v).
     pub fn inverted(&self, surface: &dyn Surface, t: usize) -> bool {
         let v = self.tris[t];

@@ -926,4 +926,29 @@ mod tests {
         assert_eq!(faces[0].mesh.pos[1], corner(1.0, 0.0));
         assert_eq!(faces[1].mesh.pos[0], corner(1.0, 0.0));
     }
+    /// A triangle clockwise on the plane folds; the same with two corners a
+    /// rounding error apart (a pole's nodes) has no facet to judge, while one
+    /// whose short edge is still well above `negligible` does.
+    #[test]
+    fn corners_within_negligible_distance_fold_nothing() {
+        let corner = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        let plane = bilinear(
+            [[corner(-10.0, -10.0), corner(-10.0, 10.0)], [corner(10.0, -10.0), corner(10.0, 10.0)]],
+            [-10.0, 10.0],
+            [-10.0, 10.0],
+        )
+        .unwrap();
+        let sliver = |gap: f64| {
+            let mut m = WorkMesh::default();
+            let c = [(0.0, 0.0), (0.0, gap), (1.0, 0.0)];
+            for (x, y) in c {
+                m.add_vertex(corner(x, y), DVec3::Z);
+            }
+            m.add_triangle([0, 1, 2], c.map(|(x, y)| DVec2::new(x, y)));
+            m
+        };
+        assert!(sliver(1e-9).inverted(&plane, 0));
+        assert!(!sliver(1e-9).folded_beyond(&plane, 0, 1e-7));
+        assert!(sliver(1e-3).folded_beyond(&plane, 0, 1e-7));
+    }
 }
