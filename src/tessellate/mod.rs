@@ -227,7 +227,7 @@ pub fn mesh_model_with_progress(
     }
     // Refinement keeps shared borders shared: a split of a shared edge is
     // made on every side; then every node takes one position.
-    let budget_hit = sew::refine_all(&mut works, ids, options.max_triangles, progress)?;
+    let budget_hit = sew::refine_all(&mut works, ids, sew_tol, options.max_triangles, progress)?;
     let (settled, places) = sew::settle_nodes(&mut works, 1e-6 * tol);
     for (w, moved) in works.iter_mut().zip(&settled) {
         w.mesh.forget(moved);

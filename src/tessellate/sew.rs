@@ -595,6 +595,96 @@ fn border_uses(faces: &[FaceWork<'_>]) -> Uses {
     uses
 }
 
+/// Border nodes of another face that run between the two nodes of a border
+/// edge no other face shares are added to that edge: its end nodes, shared
+/// with that face, show the two borders are one, though their gap there was
+/// wider than the nodes' reach when the outlines were sewn (a T-junction).
+/// Paper 000 §3.3: both sides of a shared edge carry the same nodes.
+fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) {
+    /// Border nodes walked from one end towards the other, at most.
+    const STEPS: usize = 16;
+    let uses = border_uses(faces);
+    // Per (face, node id): the border neighbours' ids; per node id: (face, vertex).
+    let mut around: HashMap<(u32, u32), Vec<u32>> = HashMap::default();
+    let mut holders: HashMap<u32, Vec<(u32, u32)>> = HashMap::default();
+    for (fi, f) in faces.iter().enumerate() {
+        for (a, b) in f.mesh.boundary_edges() {
+            let (ga, gb) = (f.mesh.gid[a as usize], f.mesh.gid[b as usize]);
+            if ga == NONE || gb == NONE || ga == gb {
+                continue;
+            }
+            for (g, h, v) in [(ga, gb, a), (gb, ga, b)] {
+                let list = around.entry((fi as u32, g)).or_default();
+                if list.is_empty() {
+                    holders.entry(g).or_default().push((fi as u32, v));
+                }
+                list.push(h);
+            }
+        }
+    }
+    let place = |g: u32, face: u32| holders.get(&g)?.iter().find(|h| h.0 == face).map(|h| h.1);
+    // (face, a, b, the gap at its ends, the other face's nodes from a's end: id and position).
+    type Plan = (usize, u32, u32, f64, Vec<(u32, DVec3)>);
+    let mut plans: Vec<Plan> = Vec::new();
+    let mut lonely: Vec<(u32, u32, u32)> = uses.values().filter(|l| l.len() == 1).map(|l| l[0]).collect();
+    lonely.sort_unstable();
+    for (fa, a, b) in lonely {
+        let f = &faces[fa as usize];
+        let (ga, gb) = (f.mesh.gid[a as usize], f.mesh.gid[b as usize]);
+        let Some(others) = holders.get(&ga) else { continue };
+        'faces: for &(fb, _) in others {
+            if fb == fa || !around.contains_key(&(fb, gb)) {
+                continue;
+            }
+            for &first in around.get(&(fb, ga)).map_or(&[][..], |v| &v[..]) {
+                let (mut prev, mut cur) = (ga, first);
+                let mut path = Vec::new();
+                let mut reached = false;
+                for _ in 0..STEPS {
+                    if cur == gb {
+                        reached = true;
+                        break;
+                    }
+                    path.push(cur);
+                    let Some(nb) = around.get(&(fb, cur)).filter(|nb| nb.len() == 2) else { break };
+                    let next = if nb[0] == prev { nb[1] } else { nb[0] };
+                    (prev, cur) = (cur, next);
+                }
+                // Nodes this face's border has elsewhere are not along this edge.
+                if !reached || path.is_empty() || path.iter().any(|&g| around.contains_key(&(fa, g))) {
+                    continue;
+                }
+                let g = &faces[fb as usize];
+                let nodes = path.iter().filter_map(|&x| Some((x, g.mesh.pos[place(x, fb)? as usize]))).collect();
+                let gap = |v: u32, id: u32| {
+                    place(id, fb).map_or(0.0, |w| f.mesh.pos[v as usize].distance(g.mesh.pos[w as usize]))
+                };
+                plans.push((fa as usize, a, b, gap(a, ga).max(gap(b, gb)), nodes));
+                break 'faces;
+            }
+        }
+    }
+    for (fa, a, b, gap, nodes) in plans {
+        let f = &mut faces[fa];
+        let (pa, pb) = (f.mesh.pos[a as usize], f.mesh.pos[b as usize]);
+        // The other border runs about as far off as the shared end nodes are.
+        let limit = (0.1 * pa.distance(pb)).max(2.0 * gap).min(sew);
+        let mut c = a;
+        for (g, p) in nodes {
+            let frac = nearest_on_border(f, c, b, p).clamp(1e-6, 1.0 - 1e-6);
+            let Some((_, q)) = f.mesh.boundary_point(f.surface, &f.curves, c, b, frac) else { break };
+            if q.distance(p) > limit {
+                break;
+            }
+            let mut changed = Vec::new();
+            let Some(n) = f.mesh.split_edge_at(f.surface, &f.curves, c, b, frac, None, &mut changed) else { break };
+            f.mesh.gid[n as usize] = g;
+            f.mesh.forget(&changed);
+            c = n;
+        }
+    }
+}
+
 /// The fraction from `a` of the point of the exact border under edge `a-b`
 /// of face `f` nearest `q`.
 fn nearest_on_border(f: &FaceWork<'_>, a: u32, b: u32, q: DVec3) -> f64 {
@@ -608,18 +698,22 @@ fn nearest_on_border(f: &FaceWork<'_>, a: u32, b: u32, q: DVec3) -> f64 {
 
 /// Refines every face until its triangles pass (or its budget or the minimum
 /// edge stops it), making each split of a shared border edge in every face
-/// that shares it and refining again what that split changed there. Node ids
-/// continue from `ids`. `progress(done, total)` is called as each face's first
-/// refinement ends; `false` cancels. Returns whether the budget stopped a face.
+/// that shares it and refining again what that split changed there. First
+/// closes the T-junctions the outline sewing left, within `sew`. Node ids
+/// continue from `ids`. `progress(done, total)` is called as each face's
+/// first refinement ends; `false` cancels. Returns whether the budget
+/// stopped a face.
 ///
 /// # Errors
 /// [`Error::Cancelled`] when `progress` says so.
 pub(crate) fn refine_all(
     faces: &mut [FaceWork<'_>],
     mut ids: u32,
+    sew: f64,
     budget: usize,
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<bool, Error> {
+    close_t_junctions(faces, sew);
     let mut uses = border_uses(faces);
     for list in uses.values().filter(|l| l.len() > 1) {
         for &(fi, a, b) in list {
