@@ -595,15 +595,16 @@ fn border_uses(faces: &[FaceWork<'_>]) -> Uses {
     uses
 }
 
-/// Border nodes of another face that run between the two nodes of a border
-/// edge no other face shares are added to that edge: its end nodes, shared
-/// with that face, show the two borders are one, though their gap there was
-/// wider than the nodes' reach when the outlines were sewn (a T-junction).
-/// Paper 000 §3.3: both sides of a shared edge carry the same nodes.
+/// Where two faces share two border nodes but their borders between them
+/// carry different nodes (their gap there was wider than the nodes' reach
+/// when the outlines were sewn: T-junctions), each face takes the other's
+/// nodes in between, within the sewing distance `sew`. Paper 000 §3.3:
+/// both sides of a shared edge carry the same nodes.
 fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) {
-    /// Border nodes walked from one end towards the other, at most.
-    const STEPS: usize = 16;
+    /// Border nodes walked from one shared node towards the next, at most.
+    const STEPS: usize = 24;
     let uses = border_uses(faces);
+    let lonely = |ga: u32, gb: u32| uses.get(&node_key(ga, gb)).is_some_and(|l| l.len() == 1);
     // Per (face, node id): the border neighbours' ids; per node id: (face, vertex).
     let mut around: HashMap<(u32, u32), Vec<u32>> = HashMap::default();
     let mut holders: HashMap<u32, Vec<(u32, u32)>> = HashMap::default();
@@ -623,64 +624,102 @@ fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) {
         }
     }
     let place = |g: u32, face: u32| holders.get(&g)?.iter().find(|h| h.0 == face).map(|h| h.1);
-    // (face, a, b, the gap at its ends, the other face's nodes from a's end: id and position).
-    type Plan = (usize, u32, u32, f64, Vec<(u32, DVec3)>);
+    // Face `f`'s border from `from` by `first`, over edges no other face
+    // shares, to the first node `other` holds: the nodes passed and that node.
+    let walk = |f: u32, other: u32, from: u32, first: u32| -> Option<(Vec<u32>, u32)> {
+        let (mut prev, mut cur) = (from, first);
+        let mut path = Vec::new();
+        for _ in 0..STEPS {
+            if !lonely(prev, cur) {
+                return None;
+            }
+            if around.contains_key(&(other, cur)) {
+                return Some((path, cur));
+            }
+            path.push(cur);
+            let nb = around.get(&(f, cur)).filter(|nb| nb.len() == 2)?;
+            let next = if nb[0] == prev { nb[1] } else { nb[0] };
+            (prev, cur) = (cur, next);
+        }
+        None
+    };
+    // (face, its border's vertices from one shared node to the next, the
+    // gap at those two, the other face's nodes between: id and position).
+    type Plan = (usize, Vec<u32>, f64, Vec<(u32, DVec3)>);
     let mut plans: Vec<Plan> = Vec::new();
-    let mut lonely: Vec<(u32, u32, u32)> = uses.values().filter(|l| l.len() == 1).map(|l| l[0]).collect();
-    lonely.sort_unstable();
-    for (fa, a, b) in lonely {
-        let f = &faces[fa as usize];
-        let (ga, gb) = (f.mesh.gid[a as usize], f.mesh.gid[b as usize]);
+    let mut seen = crate::collections::HashSet::default();
+    let mut starts: Vec<(u32, u32)> = around.keys().copied().collect();
+    starts.sort_unstable();
+    for (fa, ga) in starts {
         let Some(others) = holders.get(&ga) else { continue };
-        'faces: for &(fb, _) in others {
-            if fb == fa || !around.contains_key(&(fb, gb)) {
+        for &(fb, _) in others {
+            if fb == fa {
                 continue;
             }
-            for &first in around.get(&(fb, ga)).map_or(&[][..], |v| &v[..]) {
-                let (mut prev, mut cur) = (ga, first);
-                let mut path = Vec::new();
-                let mut reached = false;
-                for _ in 0..STEPS {
-                    if cur == gb {
-                        reached = true;
-                        break;
-                    }
-                    path.push(cur);
-                    let Some(nb) = around.get(&(fb, cur)).filter(|nb| nb.len() == 2) else { break };
-                    let next = if nb[0] == prev { nb[1] } else { nb[0] };
-                    (prev, cur) = (cur, next);
-                }
-                // Nodes this face's border has elsewhere are not along this edge.
-                if !reached || path.is_empty() || path.iter().any(|&g| around.contains_key(&(fa, g))) {
+            for &first in around.get(&(fa, ga)).map_or(&[][..], |v| &v[..]) {
+                let Some((mine, gb)) = walk(fa, fb, ga, first) else { continue };
+                if gb == ga || !seen.insert((fa, fb, node_key(ga, gb))) {
                     continue;
                 }
-                let g = &faces[fb as usize];
-                let nodes = path.iter().filter_map(|&x| Some((x, g.mesh.pos[place(x, fb)? as usize]))).collect();
-                let gap = |v: u32, id: u32| {
-                    place(id, fb).map_or(0.0, |w| f.mesh.pos[v as usize].distance(g.mesh.pos[w as usize]))
-                };
-                plans.push((fa as usize, a, b, gap(a, ga).max(gap(b, gb)), nodes));
-                break 'faces;
+                let theirs =
+                    around.get(&(fb, ga)).map_or(&[][..], |v| &v[..]).iter().find_map(|&t| {
+                        walk(fb, fa, ga, t).filter(|(p, end)| *end == gb && !p.is_empty()).map(|(p, _)| p)
+                    });
+                let Some(theirs) = theirs else { continue };
+                let (f, g) = (&faces[fa as usize], &faces[fb as usize]);
+                let run: Option<Vec<u32>> =
+                    core::iter::once(ga).chain(mine.iter().copied()).chain([gb]).map(|x| place(x, fa)).collect();
+                let nodes: Option<Vec<(u32, DVec3)>> =
+                    theirs.iter().map(|&x| Some((x, g.mesh.pos[place(x, fb)? as usize]))).collect();
+                let gap =
+                    |id: u32| Some(f.mesh.pos[place(id, fa)? as usize].distance(g.mesh.pos[place(id, fb)? as usize]));
+                if let (Some(run), Some(nodes), Some(g0), Some(g1)) = (run, nodes, gap(ga), gap(gb)) {
+                    plans.push((fa as usize, run, g0.max(g1), nodes));
+                }
             }
         }
     }
-    for (fa, a, b, gap, nodes) in plans {
+    for (fa, mut run, gap, nodes) in plans {
         let f = &mut faces[fa];
-        let (pa, pb) = (f.mesh.pos[a as usize], f.mesh.pos[b as usize]);
-        // The other border runs about as far off as the shared end nodes are.
-        let limit = (0.1 * pa.distance(pb)).max(2.0 * gap).min(sew);
-        let mut c = a;
+        // All the other border's nodes run along this one, or none is taken:
+        // a stretch where they part is not one border.
+        let along = |f: &FaceWork<'_>, p: DVec3| {
+            (0..run.len() - 1).any(|i| {
+                let (c, d) = (run[i], run[i + 1]);
+                let frac = nearest_on_border(f, c, d, p).clamp(1e-6, 1.0 - 1e-6);
+                let limit = (0.1 * f.mesh.pos[c as usize].distance(f.mesh.pos[d as usize])).max(2.0 * gap).min(sew);
+                f.mesh.boundary_point(f.surface, &f.curves, c, d, frac).is_some_and(|(_, q)| q.distance(p) <= limit)
+            })
+        };
+        if !nodes.iter().all(|&(_, p)| along(f, p)) {
+            continue;
+        }
+        let mut from = 0;
         for (g, p) in nodes {
-            let frac = nearest_on_border(f, c, b, p).clamp(1e-6, 1.0 - 1e-6);
-            let Some((_, q)) = f.mesh.boundary_point(f.surface, &f.curves, c, b, frac) else { break };
-            if q.distance(p) > limit {
-                break;
+            // The nearest of the run's edges from the last node added on.
+            let mut best: Option<(usize, f64, f64)> = None;
+            for i in from..run.len() - 1 {
+                let (c, d) = (run[i], run[i + 1]);
+                let frac = nearest_on_border(f, c, d, p).clamp(1e-6, 1.0 - 1e-6);
+                let Some((_, q)) = f.mesh.boundary_point(f.surface, &f.curves, c, d, frac) else { continue };
+                let e = q.distance(p);
+                if best.is_none_or(|b| e < b.2) {
+                    best = Some((i, frac, e));
+                }
+            }
+            let Some((i, frac, e)) = best else { break };
+            let (c, d) = (run[i], run[i + 1]);
+            // The other border runs about as far off as the shared end nodes are.
+            let limit = (0.1 * f.mesh.pos[c as usize].distance(f.mesh.pos[d as usize])).max(2.0 * gap).min(sew);
+            if e > limit {
+                continue;
             }
             let mut changed = Vec::new();
-            let Some(n) = f.mesh.split_edge_at(f.surface, &f.curves, c, b, frac, None, &mut changed) else { break };
+            let Some(n) = f.mesh.split_edge_at(f.surface, &f.curves, c, d, frac, None, &mut changed) else { continue };
             f.mesh.gid[n as usize] = g;
             f.mesh.forget(&changed);
-            c = n;
+            run.insert(i + 1, n);
+            from = i + 1;
         }
     }
 }
