@@ -1084,4 +1084,58 @@ mod tests {
         assert!(!sliver(1e-9).folded_beyond(&plane, 0, 1e-7));
         assert!(sliver(1e-3).folded_beyond(&plane, 0, 1e-7));
     }
+    /// Face A's border runs straight from node 1 to node 2; face B's, 0.02
+    /// beside it, passes node 3 on the way. Within the sewing distance A
+    /// takes node 3 in, its edge 1-2 becoming 1-3-2; with a sewing distance
+    /// under the gap it does not.
+    #[test]
+    fn a_node_of_the_neighbours_border_closes_the_t_junction() {
+        let corner = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        let plane = bilinear(
+            [[corner(-10.0, -10.0), corner(-10.0, 10.0)], [corner(10.0, -10.0), corner(10.0, 10.0)]],
+            [-10.0, 10.0],
+            [-10.0, 10.0],
+        )
+        .unwrap();
+        let crit = Criteria { tol: 0.1, angle: 0.5, max_edge: f64::INFINITY, min_edge: 0.0, steps: 4 };
+        let mesh = |pts: &[(f64, f64, u32)], tris: &[[u32; 3]]| {
+            let mut m = WorkMesh::default();
+            for &(x, y, g) in pts {
+                let v = m.add_vertex(corner(x, y), DVec3::Z);
+                if g != 0 {
+                    m.gid[v as usize] = g;
+                }
+            }
+            for t in tris {
+                m.add_triangle(*t, t.map(|v| DVec2::new(pts[v as usize].0, pts[v as usize].1)));
+            }
+            m
+        };
+        let gids = |f: &FaceWork<'_>| -> Vec<(u32, u32)> {
+            let mut e: Vec<(u32, u32)> = f
+                .mesh
+                .boundary_edges()
+                .into_iter()
+                .map(|(a, b)| node_key(f.mesh.gid[a as usize], f.mesh.gid[b as usize]))
+                .filter(|&(a, b)| a != NONE && b != NONE)
+                .collect();
+            e.sort_unstable();
+            e
+        };
+        for (sew, closed) in [(0.1, true), (0.01, false)] {
+            let a = mesh(&[(0.0, 0.0, 0), (1.0, 0.0, 1), (1.0, 1.0, 2), (0.0, 1.0, 0)], &[[0, 1, 2], [0, 2, 3]]);
+            let b = mesh(
+                &[(1.0, 0.0, 1), (2.0, 0.0, 0), (2.0, 1.0, 0), (1.0, 1.0, 2), (1.02, 0.5, 3)],
+                &[[0, 1, 4], [1, 2, 4], [2, 3, 4]],
+            );
+            let mut faces = alloc::vec![
+                FaceWork { surface: &plane, curves: Vec::new(), mesh: a, crit },
+                FaceWork { surface: &plane, curves: Vec::new(), mesh: b, crit },
+            ];
+            close_t_junctions(&mut faces, sew);
+            let want = if closed { alloc::vec![(1, 3), (2, 3)] } else { alloc::vec![(1, 2)] };
+            assert_eq!(gids(&faces[0]), want, "sew {sew}");
+            assert_eq!(gids(&faces[1]), [(1, 3), (2, 3)], "sew {sew}");
+        }
+    }
 }
