@@ -605,22 +605,21 @@ fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) {
     const STEPS: usize = 24;
     let uses = border_uses(faces);
     let lonely = |ga: u32, gb: u32| uses.get(&node_key(ga, gb)).is_some_and(|l| l.len() == 1);
-    // Per (face, node id): the border neighbours' ids; per node id: (face, vertex).
+    // Per (face, node id): the border neighbours' ids; per node id: (face,
+    // vertex). From the border uses, in face and edge order.
+    let mut edges: Vec<(u32, u32, u32)> = uses.values().flatten().copied().collect();
+    edges.sort_unstable();
     let mut around: HashMap<(u32, u32), Vec<u32>> = HashMap::default();
     let mut holders: HashMap<u32, Vec<(u32, u32)>> = HashMap::default();
-    for (fi, f) in faces.iter().enumerate() {
-        for (a, b) in f.mesh.boundary_edges() {
-            let (ga, gb) = (f.mesh.gid[a as usize], f.mesh.gid[b as usize]);
-            if ga == NONE || gb == NONE || ga == gb {
-                continue;
+    for (fi, a, b) in edges {
+        let f = &faces[fi as usize];
+        let (ga, gb) = (f.mesh.gid[a as usize], f.mesh.gid[b as usize]);
+        for (g, h, v) in [(ga, gb, a), (gb, ga, b)] {
+            let list = around.entry((fi, g)).or_default();
+            if list.is_empty() {
+                holders.entry(g).or_default().push((fi, v));
             }
-            for (g, h, v) in [(ga, gb, a), (gb, ga, b)] {
-                let list = around.entry((fi as u32, g)).or_default();
-                if list.is_empty() {
-                    holders.entry(g).or_default().push((fi as u32, v));
-                }
-                list.push(h);
-            }
+            list.push(h);
         }
     }
     let place = |g: u32, face: u32| holders.get(&g)?.iter().find(|h| h.0 == face).map(|h| h.1);
@@ -681,40 +680,37 @@ fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) {
     }
     for (fa, mut run, gap, nodes) in plans {
         let f = &mut faces[fa];
+        // Per edge of the run from `from` on: its index, the fraction of its
+        // border point nearest `p`, that point's distance and the distance
+        // allowed (about as far off as the shared end nodes are).
+        let near = |f: &FaceWork<'_>, run: &[u32], from: usize, p: DVec3| {
+            (from..run.len() - 1)
+                .filter_map(|i| {
+                    let (c, d) = (run[i], run[i + 1]);
+                    let frac = nearest_on_border(f, c, d, p).clamp(1e-6, 1.0 - 1e-6);
+                    let (_, q) = f.mesh.boundary_point(f.surface, &f.curves, c, d, frac)?;
+                    let limit = (0.1 * f.mesh.pos[c as usize].distance(f.mesh.pos[d as usize])).max(2.0 * gap).min(sew);
+                    Some((i, frac, q.distance(p), limit))
+                })
+                .collect::<Vec<_>>()
+        };
         // All the other border's nodes run along this one, or none is taken:
         // a stretch where they part is not one border.
-        let along = |f: &FaceWork<'_>, p: DVec3| {
-            (0..run.len() - 1).any(|i| {
-                let (c, d) = (run[i], run[i + 1]);
-                let frac = nearest_on_border(f, c, d, p).clamp(1e-6, 1.0 - 1e-6);
-                let limit = (0.1 * f.mesh.pos[c as usize].distance(f.mesh.pos[d as usize])).max(2.0 * gap).min(sew);
-                f.mesh.boundary_point(f.surface, &f.curves, c, d, frac).is_some_and(|(_, q)| q.distance(p) <= limit)
-            })
-        };
-        if !nodes.iter().all(|&(_, p)| along(f, p)) {
+        if !nodes.iter().all(|&(_, p)| near(f, &run, 0, p).iter().any(|e| e.2 <= e.3)) {
             continue;
         }
         let mut from = 0;
         for (g, p) in nodes {
             // The nearest of the run's edges from the last node added on.
-            let mut best: Option<(usize, f64, f64)> = None;
-            for i in from..run.len() - 1 {
-                let (c, d) = (run[i], run[i + 1]);
-                let frac = nearest_on_border(f, c, d, p).clamp(1e-6, 1.0 - 1e-6);
-                let Some((_, q)) = f.mesh.boundary_point(f.surface, &f.curves, c, d, frac) else { continue };
-                let e = q.distance(p);
-                if best.is_none_or(|b| e < b.2) {
-                    best = Some((i, frac, e));
-                }
-            }
-            let Some((i, frac, e)) = best else { break };
-            let (c, d) = (run[i], run[i + 1]);
-            // The other border runs about as far off as the shared end nodes are.
-            let limit = (0.1 * f.mesh.pos[c as usize].distance(f.mesh.pos[d as usize])).max(2.0 * gap).min(sew);
+            let Some((i, frac, e, limit)) = near(f, &run, from, p).into_iter().min_by(|x, y| x.2.total_cmp(&y.2))
+            else {
+                break;
+            };
             if e > limit {
                 continue;
             }
             let mut changed = Vec::new();
+            let (c, d) = (run[i], run[i + 1]);
             let Some(n) = f.mesh.split_edge_at(f.surface, &f.curves, c, d, frac, None, &mut changed) else { continue };
             f.mesh.gid[n as usize] = g;
             f.mesh.forget(&changed);
@@ -1020,6 +1016,20 @@ mod tests {
     use crate::nurbs::analytic::bilinear;
     use glam::DVec2;
 
+    /// The plane z = 0 over [-10, 10]², u = x and v = y.
+    fn plane() -> crate::nurbs::NurbsSurface {
+        let corner = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        bilinear(
+            [[corner(-10.0, -10.0), corner(-10.0, 10.0)], [corner(10.0, -10.0), corner(10.0, 10.0)]],
+            [-10.0, 10.0],
+            [-10.0, 10.0],
+        )
+        .unwrap()
+    }
+
+    /// The limits the test faces are held to.
+    const CRIT: Criteria = Criteria { tol: 0.1, angle: 0.5, max_edge: f64::INFINITY, min_edge: 0.0, steps: 4 };
+
     /// One triangle on the plane z = 0 (u = x, v = y), its vertex `node` the model node 7.
     fn face(corners: [(f64, f64); 3], node: usize) -> WorkMesh {
         let mut m = WorkMesh::default();
@@ -1037,13 +1047,8 @@ mod tests {
     #[test]
     fn a_node_settled_into_a_fold_moves_to_a_place_that_folds_nothing() {
         let corner = |x: f64, y: f64| DVec3::new(x, y, 0.0);
-        let plane = bilinear(
-            [[corner(-10.0, -10.0), corner(-10.0, 10.0)], [corner(10.0, -10.0), corner(10.0, 10.0)]],
-            [-10.0, 10.0],
-            [-10.0, 10.0],
-        )
-        .unwrap();
-        let crit = Criteria { tol: 0.1, angle: 0.5, max_edge: f64::INFINITY, min_edge: 0.0, steps: 4 };
+        let plane = plane();
+        let crit = CRIT;
         let work = |mesh| FaceWork { surface: &plane, curves: Vec::new(), mesh, crit };
         let mut faces = alloc::vec![
             work(face([(0.0, 0.0), (1.0, 0.0), (0.5, 0.01)], 1)),
@@ -1059,18 +1064,14 @@ mod tests {
         assert_eq!(faces[0].mesh.pos[1], corner(1.0, 0.0));
         assert_eq!(faces[1].mesh.pos[0], corner(1.0, 0.0));
     }
+
     /// A triangle clockwise on the plane folds; the same with two corners a
     /// rounding error apart (a pole's nodes) has no facet to judge, while one
     /// whose short edge is still well above `negligible` does.
     #[test]
     fn corners_within_negligible_distance_fold_nothing() {
         let corner = |x: f64, y: f64| DVec3::new(x, y, 0.0);
-        let plane = bilinear(
-            [[corner(-10.0, -10.0), corner(-10.0, 10.0)], [corner(10.0, -10.0), corner(10.0, 10.0)]],
-            [-10.0, 10.0],
-            [-10.0, 10.0],
-        )
-        .unwrap();
+        let plane = plane();
         let sliver = |gap: f64| {
             let mut m = WorkMesh::default();
             let c = [(0.0, 0.0), (0.0, gap), (1.0, 0.0)];
@@ -1084,6 +1085,7 @@ mod tests {
         assert!(!sliver(1e-9).folded_beyond(&plane, 0, 1e-7));
         assert!(sliver(1e-3).folded_beyond(&plane, 0, 1e-7));
     }
+
     /// Face A's border runs straight from node 1 to node 2; face B's, 0.02
     /// beside it, passes node 3 on the way. Within the sewing distance A
     /// takes node 3 in, its edge 1-2 becoming 1-3-2; with a sewing distance
@@ -1091,13 +1093,8 @@ mod tests {
     #[test]
     fn a_node_of_the_neighbours_border_closes_the_t_junction() {
         let corner = |x: f64, y: f64| DVec3::new(x, y, 0.0);
-        let plane = bilinear(
-            [[corner(-10.0, -10.0), corner(-10.0, 10.0)], [corner(10.0, -10.0), corner(10.0, 10.0)]],
-            [-10.0, 10.0],
-            [-10.0, 10.0],
-        )
-        .unwrap();
-        let crit = Criteria { tol: 0.1, angle: 0.5, max_edge: f64::INFINITY, min_edge: 0.0, steps: 4 };
+        let plane = plane();
+        let crit = CRIT;
         let mesh = |pts: &[(f64, f64, u32)], tris: &[[u32; 3]]| {
             let mut m = WorkMesh::default();
             for &(x, y, g) in pts {
