@@ -558,19 +558,35 @@ impl Band {
     /// triangle on both sides (a seam) is an inner edge, not a trim edge.
     pub fn build(&self, surface: &dyn Surface, tris: &[[u32; 3]], wm: &mut WorkMesh, gids: Option<&[Vec<u32>]>) {
         let flat: Vec<u32> = gids.map(|g| g.iter().flatten().copied().collect()).unwrap_or_default();
+        let points: Vec<DVec3> = self.nodes.iter().map(|&q| surface.point(q)).collect();
+        // The two ends of a loop segment that are one node but not one point
+        // (a side collapsed to a hair, not to a pole) stay two vertices: one
+        // vertex would stand for both ends of a segment the surface spans.
+        let mut apart = alloc::vec![false; self.nodes.len()];
+        for &(a, b, ..) in &self.segs {
+            let (ga, gb) = (flat.get(a).copied(), flat.get(b).copied());
+            let (pa, pb) = (points[a], points[b]);
+            let rounding = 1e-12 * pa.abs().max(pb.abs()).max_element().max(1.0);
+            if ga.is_some() && ga == gb && ga != Some(u32::MAX) && pa.distance(pb) > rounding {
+                apart[a] = true;
+                apart[b] = true;
+            }
+        }
         let mut by_gid: crate::collections::HashMap<u32, u32> = crate::collections::HashMap::default();
         let mut vid = Vec::with_capacity(self.nodes.len());
         for (k, &q) in self.nodes.iter().enumerate() {
             let g = flat.get(k).copied().unwrap_or(u32::MAX);
-            if g != u32::MAX {
+            if g != u32::MAX && !apart[k] {
                 if let Some(&v) = by_gid.get(&g) {
                     vid.push(v);
                     continue;
                 }
             }
-            let v = wm.add_vertex(surface.point(q), surface.normal(q));
+            let v = wm.add_vertex(points[k], surface.normal(q));
             if g != u32::MAX {
-                by_gid.insert(g, v);
+                if !apart[k] {
+                    by_gid.insert(g, v);
+                }
                 wm.gid[v as usize] = g;
             }
             vid.push(v);

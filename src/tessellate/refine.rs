@@ -777,12 +777,16 @@ impl WorkMesh {
     }
 
     /// Whether triangle `t` folds against the surface with a facet worth
-    /// judging: corners within `negligible` of each other are one point (a
-    /// pole's nodes a rounding error apart), the facet's normal then noise.
+    /// judging: a triangle whose smallest height is within `negligible` is
+    /// flat (two corners one point, as a pole's nodes a rounding error apart,
+    /// or three in a line where a side of the surface is collapsed to a
+    /// hair), its facet's normal then noise.
     pub fn folded_beyond(&self, surface: &dyn Surface, t: usize, negligible: f64) -> bool {
         let v = self.tris[t];
         let p = [self.pos[v[0] as usize], self.pos[v[1] as usize], self.pos[v[2] as usize]];
-        (0..3).all(|k| p[k].distance(p[(k + 1) % 3]) > negligible) && self.inverted(surface, t)
+        let longest = (0..3).map(|k| p[k].distance(p[(k + 1) % 3])).fold(0.0, f64::max);
+        let height = (p[1] - p[0]).cross(p[2] - p[0]).length() / longest.max(f64::MIN_POSITIVE);
+        height > negligible && self.inverted(surface, t)
     }
 
     /// Whether the facet normal opposes the surface normal at the centroid's (u,v).

@@ -156,7 +156,7 @@ mod outlines {
             sew_used = used;
             twins = insert(faces, &adds);
         }
-        name_nodes(faces, bodies, &radii(&pos, sew_used), &twins, sew_used, tight)
+        name_nodes(faces, bodies, &radii(&pos, sew_used, tight), &twins, sew_used, tight)
     }
 
     /// Each outline node's point on its face's surface.
@@ -171,9 +171,10 @@ mod outlines {
             .collect()
     }
 
-    /// Each node's reach: `sew`, at most 0.3 of its shortest loop segment
-    /// (zero-length segments along a pole aside).
-    fn radii(pos: &PerNode<DVec3>, sew: f64) -> PerNode<f64> {
+    /// Each node's reach: `sew`, at most 0.3 of its shortest loop segment.
+    /// Segments along a pole, and those shorter than a thousandth of `tight`
+    /// (a trim edge far below any weld: its ends are one point), do not count.
+    fn radii(pos: &PerNode<DVec3>, sew: f64, tight: f64) -> PerNode<f64> {
         pos.iter()
             .map(|f| {
                 f.iter()
@@ -182,7 +183,7 @@ mod outlines {
                         let scale = p.iter().fold(0.0f64, |m, q| m.max(q.abs().max_element())).max(1e-300);
                         let length = |i: usize| {
                             let l = p[i].distance(p[(i + 1) % n]);
-                            if l <= 1e-12 * scale {
+                            if l <= (1e-12 * scale).max(1e-3 * tight) {
                                 f64::INFINITY
                             } else {
                                 l
@@ -216,7 +217,7 @@ mod outlines {
         reach: f64,
         mean_segment: f64,
     ) -> (Additions, f64) {
-        let radius = radii(pos, sew);
+        let radius = radii(pos, sew, tight);
         // Nodes hashed on a grid about one loop segment long.
         let mut grid = CellGrid::new(1.0 / mean_segment.max(reach).max(1e-300));
         for (fi, f) in pos.iter().enumerate() {
@@ -295,7 +296,7 @@ mod outlines {
         gaps.sort_by(f64::total_cmp);
         let q90 = gaps.get((gaps.len() * 9) / 10).copied().unwrap_or(0.0);
         let sew = (4.0 * q90).clamp(tight, sew.max(tight));
-        let radius = radii(pos, sew);
+        let radius = radii(pos, sew, tight);
         let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
         let mut adds: Additions =
             pos.iter().map(|f| f.iter().map(|p| alloc::vec![Vec::new(); p.len()]).collect()).collect();
@@ -1066,24 +1067,31 @@ mod tests {
     }
 
     /// A triangle clockwise on the plane folds; the same with two corners a
-    /// rounding error apart (a pole's nodes) has no facet to judge, while one
-    /// whose short edge is still well above `negligible` does.
+    /// rounding error apart (a pole's nodes), or with its three corners in a
+    /// line within `negligible`, has no facet to judge, while one whose
+    /// height is still well above `negligible` does.
     #[test]
-    fn corners_within_negligible_distance_fold_nothing() {
+    fn triangles_flat_within_negligible_distance_fold_nothing() {
         let corner = |x: f64, y: f64| DVec3::new(x, y, 0.0);
         let plane = plane();
-        let sliver = |gap: f64| {
+        let triangle = |c: [(f64, f64); 3]| {
             let mut m = WorkMesh::default();
-            let c = [(0.0, 0.0), (0.0, gap), (1.0, 0.0)];
             for (x, y) in c {
                 m.add_vertex(corner(x, y), DVec3::Z);
             }
             m.add_triangle([0, 1, 2], c.map(|(x, y)| DVec2::new(x, y)));
             m
         };
+        // Two corners a rounding apart.
+        let sliver = |gap: f64| triangle([(0.0, 0.0), (0.0, gap), (1.0, 0.0)]);
         assert!(sliver(1e-9).inverted(&plane, 0));
         assert!(!sliver(1e-9).folded_beyond(&plane, 0, 1e-7));
         assert!(sliver(1e-3).folded_beyond(&plane, 0, 1e-7));
+        // Three corners in a line, every edge long: flat, not folded.
+        let flat = |off: f64| triangle([(0.0, 0.0), (0.5, off), (1.0, 0.0)]);
+        assert!(flat(1e-9).inverted(&plane, 0));
+        assert!(!flat(1e-9).folded_beyond(&plane, 0, 1e-7));
+        assert!(flat(1e-3).folded_beyond(&plane, 0, 1e-7));
     }
 
     /// Face A's border runs straight from node 1 to node 2; face B's, 0.02
