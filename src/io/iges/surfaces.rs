@@ -246,9 +246,24 @@ impl Revolution {
         let r = radial.length();
         let scale = self.origin.length() + w.length() + 1e-300;
         let on_axis = r <= 1e-10 * scale;
-        let theta = if on_axis { hint.map_or(0.0, |q| q.y) } else { libm::atan2(radial.dot(y), radial.dot(x)) };
+        let mut theta = if on_axis { hint.map_or(0.0, |q| q.y) } else { libm::atan2(radial.dot(y), radial.dot(x)) };
         let t = match &self.profile {
-            Profile::Line { p0, d } => (DVec2::new(r, h) - *p0).dot(*d) / d.length_squared().max(1e-300),
+            Profile::Line { p0, d } => {
+                // A cone is both its nappes: past the apex the profile's
+                // radius is negative, the point half a turn round.
+                let foot = |q: DVec2| {
+                    let t = (q - *p0).dot(*d) / d.length_squared().max(1e-300);
+                    (t, q.distance(*p0 + *d * t))
+                };
+                let (t, e) = foot(DVec2::new(r, h));
+                let (t2, e2) = foot(DVec2::new(-r, h));
+                if e2 < e && !on_axis {
+                    theta += if theta > 0.0 { -core::f64::consts::PI } else { core::f64::consts::PI };
+                    t2
+                } else {
+                    t
+                }
+            }
             Profile::Circle { c, .. } => libm::atan2(h - c.y, r - c.x),
             Profile::Curve(curve) => {
                 let q = self.origin + self.axis * h + x * r;
@@ -703,5 +718,30 @@ mod tests {
         // Beside the pole both coordinates are fixed.
         let n = wedge(3e-8).invert(DVec3::new(0.04, 0.0, 0.0), None, &mut true);
         assert_eq!(n.free, [false, false]);
+    }
+
+    /// A cone's face may lie past its apex (a STEP cone is both nappes):
+    /// there the profile's radius is negative, and the point found must be
+    /// the one given, not its mirror on the near nappe.
+    #[test]
+    fn a_point_past_the_cone_apex_inverts_to_itself() {
+        let cone = Revolution {
+            origin: DVec3::new(1.0, 2.0, 3.0),
+            axis: DVec3::Z,
+            xref: DVec3::X,
+            profile: Profile::Line { p0: DVec2::new(10.0, 0.0), d: DVec2::new(1.0, 1.0) },
+            angles: None,
+        };
+        let at = |t: f64, theta: f64| {
+            let radius = 10.0 + t;
+            cone.origin + (DVec3::X * libm::cos(theta) + DVec3::Y * libm::sin(theta)) * radius + DVec3::Z * t
+        };
+        // Before the apex (t = -10) and past it, on both sides of the seam.
+        for (t, theta) in [(5.0, 0.3), (-4.0, 2.0), (-20.0, 0.3), (-35.0, -2.5), (-12.0, 3.0)] {
+            let p = at(t, theta);
+            let n = cone.invert(p, None);
+            assert!(at(n.q.x, n.q.y).distance(p) < 1e-9, "t {t} theta {theta}: {:?}", n.q);
+            assert!((n.q.x - t).abs() < 1e-9, "t {t}: {:?}", n.q);
+        }
     }
 }
