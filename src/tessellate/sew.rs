@@ -207,7 +207,9 @@ mod outlines {
     /// nearest border of another face beside them, between `tight` and
     /// `sew`. A file whose faces meet exactly is sewn tightly, so a face
     /// pinched narrower than `sew` is not sewn across its neck; a patchwork
-    /// with gaps gets the distance its gaps take.
+    /// with gaps gets the distance its gaps take. Gaps below an eighth of
+    /// `sew` are always sewn, also where most of the model meets exactly:
+    /// each side moves by half the gap, by default a fortieth of the tolerance.
     fn insertions(
         faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
         bodies: &[u32],
@@ -295,7 +297,7 @@ mod outlines {
         let mut gaps: Vec<f64> = nearest.values().copied().collect();
         gaps.sort_by(f64::total_cmp);
         let q90 = gaps.get((gaps.len() * 9) / 10).copied().unwrap_or(0.0);
-        let sew = (4.0 * q90).clamp(tight, sew.max(tight));
+        let sew = (4.0 * q90).max(0.125 * sew).clamp(tight, sew.max(tight));
         let radius = radii(pos, sew, tight);
         let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
         let mut adds: Additions =
