@@ -21,6 +21,10 @@ use crate::nurbs::{NurbsCurve, Surface};
 use crate::Error;
 
 const NONE: u32 = u32::MAX;
+/// Marks a candidate beyond the other border's segment, at its end.
+const BEYOND: f64 = -2.0;
+/// Nodes a pair of faces needs before its own gaps set its sewing distance.
+const PAIR_MIN: usize = 3;
 
 /// One face while the model is sewn.
 pub(crate) struct FaceWork<'a> {
@@ -150,13 +154,14 @@ mod outlines {
             return 0;
         }
         let mut twins: Vec<(NodeRef, NodeRef)> = Vec::new();
-        let mut sew_used = tight;
+        let (mut sew_used, mut radius) = (tight, None);
         if sew > 0.0 && reach.is_finite() {
-            let (adds, used) = insertions(faces, bodies, &pos, sew, tight, reach, total / count as f64);
-            sew_used = used;
+            let (adds, r, used) = insertions(faces, bodies, &pos, sew, tight, reach, total / count as f64);
+            (sew_used, radius) = (used, Some(r));
             twins = insert(faces, &adds);
         }
-        name_nodes(faces, bodies, &radii(&pos, sew_used, tight), &twins, sew_used, tight)
+        let radius = radius.unwrap_or_else(|| radii(&pos, tight, tight));
+        name_nodes(faces, bodies, &radius, &twins, sew_used, tight)
     }
 
     /// Each outline node's point on its face's surface.
@@ -175,10 +180,17 @@ mod outlines {
     /// Segments along a pole, and those shorter than a thousandth of `tight`
     /// (a trim edge far below any weld: its ends are one point), do not count.
     fn radii(pos: &PerNode<DVec3>, sew: f64, tight: f64) -> PerNode<f64> {
+        radii_each(pos, &|_| sew, tight)
+    }
+
+    /// [`radii`] with each node's own sewing distance.
+    fn radii_each(pos: &PerNode<DVec3>, sew_of: &dyn Fn(NodeRef) -> f64, tight: f64) -> PerNode<f64> {
         pos.iter()
-            .map(|f| {
+            .enumerate()
+            .map(|(fi, f)| {
                 f.iter()
-                    .map(|p| {
+                    .enumerate()
+                    .map(|(k, p)| {
                         let n = p.len();
                         let scale = p.iter().fold(0.0f64, |m, q| m.max(q.abs().max_element())).max(1e-300);
                         let length = |i: usize| {
@@ -190,7 +202,10 @@ mod outlines {
                             }
                         };
                         (0..n)
-                            .map(|i| sew.min(0.3 * length(i).min(length((i + n - 1) % n))).max(1e-12 * scale))
+                            .map(|i| {
+                                let sew = sew_of((fi as u32, k as u32, i as u32));
+                                sew.min(0.3 * length(i).min(length((i + n - 1) % n))).max(1e-12 * scale)
+                            })
                             .collect()
                     })
                     .collect()
@@ -210,6 +225,12 @@ mod outlines {
     /// with gaps gets the distance its gaps take. Gaps below an eighth of
     /// `sew` are always sewn, also where most of the model meets exactly:
     /// each side moves by half the gap, by default a fortieth of the tolerance.
+    /// Two faces side by side with gaps of their own (a panel cut in a model
+    /// that otherwise meets exactly) take four times the 90th percentile of
+    /// theirs, counted at the nodes whose nearest other face is the other one
+    /// and apart from it (a node both borders have is no gap, and one beside
+    /// a thin face between them is nearer that face). Returns the additions,
+    /// each node's reach, and the largest sewing distance used.
     fn insertions(
         faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
         bodies: &[u32],
@@ -218,7 +239,7 @@ mod outlines {
         tight: f64,
         reach: f64,
         mean_segment: f64,
-    ) -> (Additions, f64) {
+    ) -> (Additions, PerNode<f64>, f64) {
         let radius = radii(pos, sew, tight);
         // Nodes hashed on a grid about one loop segment long.
         let mut grid = CellGrid::new(1.0 / mean_segment.max(reach).max(1e-300));
@@ -255,7 +276,16 @@ mod outlines {
                         let q = at(qn);
                         let limit = if g == fi { tight.min(r_of(qn)) } else { r_of(qn) };
                         let s0 = ((q - pa).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
-                        if s0 <= 0.0 || s0 >= 1.0 || q.distance(pa + ab * s0) > reach {
+                        if s0 <= 0.0 || s0 >= 1.0 {
+                            // Beyond an end, at most as far as the end: a
+                            // node the other border has too (a gap of nothing).
+                            let e = q.distance(pa).min(q.distance(pb));
+                            if e <= limit {
+                                cands.push((na, super::BEYOND, 0.0, e, qn));
+                            }
+                            continue;
+                        }
+                        if q.distance(pa + ab * s0) > reach {
                             continue;
                         }
                         // The other border must run along this
@@ -284,8 +314,18 @@ mod outlines {
         // another as near within `tight`, the other side of a seam): a face
         // pinched narrower than `sew` is not sewn across its neck.
         let mut nearest: HashMap<NodeRef, f64> = HashMap::default();
+        let mut nearest_face: HashMap<NodeRef, (u32, f64)> = HashMap::default();
         let mut nearest_in: HashMap<(NodeRef, u32), f64> = HashMap::default();
-        for &(seg, _, _, d, q) in &cands {
+        for &(seg, s, _, d, q) in &cands {
+            if seg.0 != q.0 {
+                let e = nearest_face.entry(q).or_insert((super::NONE, f64::INFINITY));
+                if d < e.1 {
+                    *e = (seg.0, d);
+                }
+            }
+            if s == super::BEYOND {
+                continue;
+            }
             if seg.0 != q.0 {
                 let e = nearest.entry(q).or_insert(f64::INFINITY);
                 *e = e.min(d);
@@ -293,12 +333,37 @@ mod outlines {
             let e = nearest_in.entry((q, seg.0)).or_insert(f64::INFINITY);
             *e = e.min(d);
         }
-        // The gaps the model has.
+        // The gaps the model has, and those of each pair of faces side by
+        // side (counted at the nodes whose nearest other face is the other).
+        let q90 = |gaps: &mut Vec<f64>| {
+            gaps.sort_by(f64::total_cmp);
+            gaps.get((gaps.len() * 9) / 10).copied().unwrap_or(0.0)
+        };
         let mut gaps: Vec<f64> = nearest.values().copied().collect();
-        gaps.sort_by(f64::total_cmp);
-        let q90 = gaps.get((gaps.len() * 9) / 10).copied().unwrap_or(0.0);
-        let sew = (4.0 * q90).max(0.125 * sew).clamp(tight, sew.max(tight));
-        let radius = radii(pos, sew, tight);
+        let mut pair_gaps: HashMap<(u32, u32), Vec<f64>> = HashMap::default();
+        for (&q, &(g, d)) in &nearest_face {
+            if d > tight {
+                pair_gaps.entry((q.0.min(g), q.0.max(g))).or_default().push(d);
+            }
+        }
+        let ceiling = sew.max(tight);
+        let model_sew = (4.0 * q90(&mut gaps)).max(0.125 * sew).clamp(tight, ceiling);
+        let pair_sew: HashMap<(u32, u32), f64> = pair_gaps
+            .into_iter()
+            .map(|(key, mut g)| {
+                let s = if g.len() >= super::PAIR_MIN { 4.0 * q90(&mut g) } else { 0.0 };
+                (key, s.clamp(model_sew, ceiling))
+            })
+            .collect();
+        let sew_of = |q: NodeRef| {
+            nearest_face
+                .get(&q)
+                .and_then(|&(g, _)| pair_sew.get(&(q.0.min(g), q.0.max(g))))
+                .copied()
+                .unwrap_or(model_sew)
+        };
+        let radius = radii_each(pos, &sew_of, tight);
+        let sew = pair_sew.values().fold(model_sew, |m, &s| m.max(s));
         let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
         let mut adds: Additions =
             pos.iter().map(|f| f.iter().map(|p| alloc::vec![Vec::new(); p.len()]).collect()).collect();
@@ -341,7 +406,7 @@ mod outlines {
         for list in adds.iter_mut().flatten().flatten() {
             list.sort_by(|x, y| x.0.total_cmp(&y.0));
         }
-        (adds, sew)
+        (adds, radius, sew)
     }
 
     /// Adds the nodes to the outlines; returns each new node with the node

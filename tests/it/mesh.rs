@@ -459,3 +459,36 @@ fn mesh_split_surface_halves_reproduce_the_original() {
     }
     assert!(s.split(true, 0.0).is_none() && s.split(false, 1.0).is_none());
 }
+
+/// A row of patches that meet exactly, every other one wavy inside (so the
+/// two sides of a border take different nodes), and one more at its end
+/// `gap` apart.
+fn row_with_one_gap(gap: f64) -> Model {
+    let patch = |x0: f64, wavy: bool| {
+        height_patch(x0, x0 + 10.0, move |x, t| {
+            let inside = x > x0 + 1.0 && x < x0 + 9.0;
+            (0.3 * x).sin() * (t * 5.0).sin() + if wavy && inside { 6.0 * (t * 9.0).sin() } else { 0.0 }
+        })
+    };
+    let face = |s| Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] };
+    let mut faces: Vec<Face> = (0..30).map(|i| face(patch(10.0 * i as f64, i % 2 == 1))).collect();
+    faces.push(face(patch(300.0 + gap, false)));
+    Model { units: "mm".into(), faces, warnings: vec![], tolerance: None, bodies: vec![] }
+}
+
+#[test]
+fn mesh_sews_one_gapped_border_in_a_model_that_otherwise_meets_exactly() {
+    // Nearly every border node lies on its neighbour's border, so the model's
+    // gaps are nothing; the last pair's own gap (0.3 of the tolerance, within
+    // the sewing distance) still gets sewn.
+    // (A tolerance of a hundredth of the diagonal: far above the seam weld.)
+    let tol = 1.0;
+    let opts = MeshOptions::default().with_tolerance(tol);
+    let r = mesh_model(&row_with_one_gap(0.3 * tol), &opts).expect("meshes");
+    let rep = &r.report;
+    assert!(rep.max_deviation <= tol, "deviation {} above tolerance {tol}", rep.max_deviation);
+    assert_eq!((rep.free_edges, rep.nonmanifold_edges, rep.inverted_triangles), (0, 0, 0));
+    // The row's outer border stays open; wider than the sewing distance, the gap does too.
+    let open = |gap: f64| mesh_model(&row_with_one_gap(gap), &opts).expect("meshes").report.boundary_edges;
+    assert!(open(1.5 * tol) > r.report.boundary_edges, "a gap of 1.5 tolerances was sewn");
+}
