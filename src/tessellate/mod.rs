@@ -188,12 +188,16 @@ pub fn mesh_model_with_progress(
         None => (0.4 * tol, auto_tight),
     };
     let ids = unify_outlines(&mut chosen, &model.bodies, sew_tol, tight, aim + sew_tol);
-    // Every face's first mesh (grid and trim band) on those nodes.
+    // Every face's first mesh (grid and trim band) on those nodes; each
+    // outline is freed once its mesh is built (only whether it is pinched
+    // is asked later).
     let mut works: Vec<sew::FaceWork<'_>> = Vec::with_capacity(model.faces.len());
     let mut fit_errors: Vec<f64> = Vec::with_capacity(model.faces.len());
+    let mut pinched: Vec<bool> = Vec::with_capacity(model.faces.len());
     let mut used = 0usize;
-    for (index, c) in chosen.iter().enumerate() {
+    for (index, c) in chosen.into_iter().enumerate() {
         let f = &model.faces[index];
+        pinched.push(c.as_ref().is_some_and(Chosen::pinched));
         let Some(c) = c else {
             works.push(empty_work(f, crit));
             fit_errors.push(0.0);
@@ -272,8 +276,7 @@ pub fn mesh_model_with_progress(
                 report.faces_skipped += 1;
                 // A loop that passes one node twice: a strip narrower than
                 // the sewing distance, its two sides sewn into one border.
-                let pinched = chosen.get(index).and_then(Option::as_ref).is_some_and(Chosen::pinched);
-                report.warnings.push(if pinched {
+                report.warnings.push(if pinched[index] {
                     format!(
                         "face {index}: produced no triangles: a strip narrower than the sewing distance, \
                          its sides sewn into one border by its neighbours"
@@ -300,6 +303,9 @@ pub fn mesh_model_with_progress(
     // The model's mesh, each face's working mesh freed once it is copied:
     // wasm memory never shrinks, so the peak is what a page keeps.
     drop((places, folded, settled));
+    for w in &mut works {
+        w.mesh.keep_only_triangles();
+    }
     let (nv, nt) = works.iter().fold((0, 0), |(v, t), w| (v + w.mesh.pos.len(), t + w.mesh.tris.len()));
     let mut mesh = Mesh {
         positions: Vec::with_capacity(nv),
@@ -318,7 +324,6 @@ pub fn mesh_model_with_progress(
         }
         mesh.face_ranges.push(FaceRange { first, count: wm.tris.len() as u32 });
     }
-    drop(chosen);
     report.mean_deviation = if dev_count > 0 { dev_sum / dev_count as f64 } else { 0.0 };
     report.triangles = mesh.triangle_count();
     report.vertices = mesh.positions.len();

@@ -112,6 +112,18 @@ impl WorkMesh {
         room(&mut self.uvs, tris);
     }
 
+    /// Frees all but the vertices, normals and triangles, once nothing more
+    /// is refined or repaired: the model's mesh is copied from those alone.
+    pub fn keep_only_triangles(&mut self) {
+        self.uvs = Vec::new();
+        self.edges = HashMap::default();
+        self.trim = HashMap::default();
+        self.gid = Vec::new();
+        self.shared = Default::default();
+        self.events = Vec::new();
+        self.measures = Vec::new();
+    }
+
     /// A slot in the measure cache per triangle.
     fn measure_slots(&mut self) {
         let missing = self.tris.len().saturating_sub(self.measures.len());
