@@ -96,9 +96,11 @@ pub(crate) struct Outcome {
 /// Makes room for `extra` more elements, growing by a quarter: every face's
 /// mesh is held until the model is assembled, and wasm memory never shrinks,
 /// so the slack of doubling (up to half of each buffer) would stay with the page.
+/// The least step is small: most faces of a large model have a few dozen
+/// triangles, and a step of 64 left their buffers mostly empty.
 fn room<T>(v: &mut Vec<T>, extra: usize) {
     if v.capacity() - v.len() < extra {
-        v.reserve_exact(v.len() / 4 + extra.max(64));
+        v.reserve_exact(v.len() / 4 + extra.max(8));
     }
 }
 
