@@ -70,7 +70,10 @@ pub(super) struct Graph {
     pub name_ids: HashMap<String, u32>,
     pub parts: Vec<Part>,
     pub instances: Vec<Instance>,
-    pub index: HashMap<u64, u32>,
+    /// Where each `#id` is in `instances`, built only once the numbers stop
+    /// increasing: while they increase (as writers number them) a binary
+    /// search of `instances` finds one, and the map's memory is saved.
+    index: Option<HashMap<u64, u32>>,
     /// Header entities (`FILE_NAME`, `FILE_SCHEMA`, …), as parts.
     pub header: Vec<Part>,
 }
@@ -87,6 +90,42 @@ impl Graph {
         i
     }
 
+    /// Adds an instance; `false` (and nothing added) when its `#id` is
+    /// already defined.
+    pub fn add_instance(&mut self, inst: Instance) -> bool {
+        if self.index.is_none() && self.instances.last().is_some_and(|l| l.id >= inst.id) {
+            let mut m = HashMap::default();
+            m.reserve(self.instances.len() + 1);
+            for (i, x) in self.instances.iter().enumerate() {
+                m.insert(x.id, i as u32);
+            }
+            self.index = Some(m);
+        }
+        if let Some(m) = &mut self.index {
+            if m.insert(inst.id, self.instances.len() as u32).is_some() {
+                return false;
+            }
+        }
+        self.instances.push(inst);
+        true
+    }
+
+    /// Frees the slack the arenas grew with, once the file is read.
+    pub fn shrink(&mut self) {
+        self.values.shrink_to_fit();
+        self.text.shrink_to_fit();
+        self.parts.shrink_to_fit();
+        self.instances.shrink_to_fit();
+    }
+
+    /// Position of instance `#id` in `instances`.
+    fn slot(&self, id: u64) -> Option<u32> {
+        match &self.index {
+            Some(m) => m.get(&id).copied(),
+            None => self.instances.binary_search_by_key(&id, |i| i.id).ok().map(|i| i as u32),
+        }
+    }
+
     /// The interned keyword `i`.
     pub fn name(&self, i: u32) -> &str {
         self.names.get(i as usize).map_or("", String::as_str)
@@ -97,8 +136,8 @@ impl Graph {
     /// # Errors
     /// No such instance.
     pub fn get(&self, id: u64, from: u64) -> Result<Ent<'_>, Error> {
-        match self.index.get(&id) {
-            Some(&idx) => Ok(Ent { g: self, idx }),
+        match self.slot(id) {
+            Some(idx) => Ok(Ent { g: self, idx }),
             None if from == 0 => Err(step_error(id, 0, "is referenced but not defined")),
             None => Err(step_error(from, self.line_of(from), format!("references #{id}, which is not defined"))),
         }
@@ -106,7 +145,7 @@ impl Graph {
 
     /// The instance `#id`, if any.
     pub fn find(&self, id: u64) -> Option<Ent<'_>> {
-        self.index.get(&id).map(|&idx| Ent { g: self, idx })
+        self.slot(id).map(|idx| Ent { g: self, idx })
     }
 
     /// Every instance, in file order.

@@ -393,6 +393,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Graph, Error> {
     if !seen_data {
         return Err(step_error(0, lx.line, "no DATA section"));
     }
+    g.shrink();
     Ok(g)
 }
 
@@ -487,11 +488,9 @@ fn instance(lx: &mut Lexer<'_>, g: &mut Graph, scratch: &mut Vec<Value>, id: u64
         return Err(step_error(id, line, "complex instance without entities"));
     }
     expect(lx, g, id, &Tok::Semicolon, "';' at the end of the instance")?;
-    let idx = g.instances.len() as u32;
-    if g.index.insert(id, idx).is_some() {
+    if !g.add_instance(Instance { id, first, count, line: u32::try_from(line).unwrap_or(u32::MAX) }) {
         return Err(step_error(id, line, "instance number defined twice"));
     }
-    g.instances.push(Instance { id, first, count, line: u32::try_from(line).unwrap_or(u32::MAX) });
     Ok(())
 }
 
@@ -689,6 +688,20 @@ mod tests {
         assert!(m.contains("#4") && m.contains("value is missing"), "{m}");
         let m = message(file("#4 = A(1").as_bytes());
         assert!(m.contains("#4"), "{m}");
+    }
+
+    #[test]
+    fn instances_numbered_out_of_order_are_found_and_duplicates_refused() {
+        let g = parse(file("#5 = A(#9);\n#7 = A(2);\n#2 = A(#5);\n#9 = A(3);").as_bytes()).unwrap();
+        for id in [2, 5, 7, 9] {
+            assert_eq!(g.get(id, 0).unwrap().id(), id);
+        }
+        assert!(g.find(3).is_none() && g.find(10).is_none());
+        assert_eq!(g.get(2, 0).unwrap().attrs().ent(0).unwrap().attrs().ent(0).unwrap().id(), 9);
+        let m = message(file("#5 = A(1);\n#2 = A(1);\n#5 = A(2);").as_bytes());
+        assert!(m.contains("#5") && m.contains("defined twice"), "{m}");
+        let m = message(file("#1 = A(1);\n#2 = A(1);\n#3 = A(1);\n#2 = A(2);").as_bytes());
+        assert!(m.contains("#2") && m.contains("defined twice"), "{m}");
     }
 
     #[test]
