@@ -83,14 +83,29 @@ pub(super) fn read_shapes(g: &Graph, plan: &Plan, warnings: &mut Vec<String>) ->
     let styles = colours(g);
     let mut out =
         Shapes { faces: Vec::new(), placement: Vec::new(), colours: Vec::new(), shells: Vec::new(), first_error: None };
+    let key_of = |p: &Placed| (p.item, p.angle.to_bits(), p.uncertainty.to_bits());
+    // How many placements of each item are still ahead: the last one takes
+    // the item's faces instead of copying them, so that a part placed once
+    // is not held twice while the rest is read.
+    let mut ahead: HashMap<(u64, u64, u64), usize> = HashMap::default();
+    for p in &plan.placed {
+        *ahead.entry(key_of(p)).or_default() += 1;
+    }
     for (pi, p) in plan.placed.iter().enumerate() {
-        let key = (p.item, p.angle.to_bits(), p.uncertainty.to_bits());
+        let key = key_of(p);
         if !cache.contains_key(&key) {
             let f = r.item(p);
             cache.insert(key, f);
         }
-        let Some(item) = cache.get(&key) else { continue };
-        if out.faces.len() + item.faces.len() > MAX_FACES {
+        let last = ahead.get_mut(&key).is_none_or(|n| {
+            *n = n.saturating_sub(1);
+            *n == 0
+        });
+        let mut owned = if last { cache.remove(&key) } else { None };
+        let taken: Vec<Face> = owned.as_mut().map(|i| core::mem::take(&mut i.faces)).unwrap_or_default();
+        let Some(item) = owned.as_ref().or_else(|| cache.get(&key)) else { continue };
+        let count = if owned.is_some() { taken.len() } else { item.faces.len() };
+        if out.faces.len() + count > MAX_FACES {
             return Err(step_error(
                 p.item,
                 g.line_of(p.item),
@@ -98,8 +113,17 @@ pub(super) fn read_shapes(g: &Graph, plan: &Plan, warnings: &mut Vec<String>) ->
             ));
         }
         let base = out.faces.len();
-        for (k, (f, id)) in item.faces.iter().zip(&item.ids).enumerate() {
-            match place_face(f, &p.m) {
+        let mut taken = taken.into_iter();
+        for (k, id) in item.ids.iter().enumerate().take(count) {
+            let placed = match taken.next() {
+                Some(f) if p.m == DAffine3::IDENTITY => Ok(f),
+                Some(f) => place_face(&f, &p.m),
+                None => match item.faces.get(k) {
+                    Some(f) => place_face(f, &p.m),
+                    None => continue,
+                },
+            };
+            match placed {
                 Ok(f) => {
                     out.faces.push(f);
                     out.placement.push(pi);
