@@ -55,14 +55,19 @@ fn main() {
         mb(PEAK.load(Relaxed) - base),
         mb(after_parse - base)
     );
+    let parse_peak = PEAK.load(Relaxed) - base;
     PEAK.store(after_parse, Relaxed);
     let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(rel)).expect("mesh");
-    let out = r.mesh.positions.len() * 12 + r.mesh.indices.len() * 4;
+    let out = r.mesh.positions.len() * 24 + r.mesh.indices.len() * 4;
+    let mesh_peak = PEAK.load(Relaxed) - base;
     println!(
         "mesh peak {:.2} MB over the model ({:.2} MB over the input); {} tris, output (f32 pos + normals + u32 idx) {:.2} MB",
-        mb(PEAK.load(Relaxed) - after_parse),
-        mb(PEAK.load(Relaxed) - base),
+        mb(mesh_peak - (after_parse - base)),
+        mb(mesh_peak),
         r.report.triangles,
-        mb(out + r.mesh.positions.len() * 12)
+        mb(out)
     );
+    // The wasm binding holds the input bytes through the whole call.
+    let total = bytes.len() + parse_peak.max(mesh_peak);
+    println!("total peak {:.2} MB = {:.1} x the output", mb(total), total as f64 / out.max(1) as f64);
 }
