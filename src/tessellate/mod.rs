@@ -3,6 +3,8 @@
 #[cfg(feature = "std")]
 mod cdt;
 mod face;
+#[cfg(feature = "std")]
+mod fill;
 pub(crate) mod measure;
 mod options;
 mod params;
@@ -257,6 +259,9 @@ pub fn mesh_model_with_progress(
             }
         }
     }
+    // Three faces' corners that sewing left apart: a sliver between them.
+    #[cfg(feature = "std")]
+    fill::close_slivers(&mut works, tol);
     let (mut dev_sum, mut dev_count) = (0.0, 0u64);
     for (index, (w, fit_error)) in works.iter_mut().zip(&fit_errors).enumerate() {
         let out = w.mesh.outcome(w.surface, &w.crit);

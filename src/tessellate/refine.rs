@@ -810,6 +810,54 @@ impl WorkMesh {
         height > negligible && self.inverted(surface, t)
     }
 
+    /// Closes a small hole beside border edge `a-b` (run a→b by its one
+    /// triangle) with the triangle `b, a, x`, `x` at `p` (another face's
+    /// node `gid`, placed on this surface at its nearest point), if that
+    /// triangle faces the surface's way and passes the limits; otherwise
+    /// leaves the mesh as it was. Returns whether it closed it.
+    #[cfg(feature = "std")]
+    pub fn close_beside(&mut self, surface: &dyn Surface, c: &Criteria, a: u32, b: u32, p: DVec3, gid: u32) -> bool {
+        let Some(t) = self.edges.get(&key(a, b)).filter(|e| e[1] == NONE).map(|e| e[0] as usize) else {
+            return false;
+        };
+        let Some(k) = (0..3).find(|&k| self.tris[t][k] == a && self.tris[t][(k + 1) % 3] == b) else {
+            return false;
+        };
+        let (uv_a, uv_b) = (self.uvs[t][k], self.uvs[t][(k + 1) % 3]);
+        let hint = (uv_a + uv_b) * 0.5;
+        let uv = project_to_surface(surface, p, Some(hint), &Default::default()).uv;
+        // Far from the edge in (u,v): across a seam, not beside it.
+        if !uv.is_finite() || uv.distance(hint) > 2.0 * uv_a.distance(uv_b).max(1e-300) {
+            return false;
+        }
+        let old_v = self.pos.len();
+        let n = surface.normal(uv);
+        if !n.is_finite() {
+            return false;
+        }
+        let x = self.add_vertex(p, n);
+        self.gid[x as usize] = gid;
+        self.add_triangle([b, a, x], [uv_b, uv_a, uv]);
+        self.measure_slots();
+        let nt = self.tris.len() - 1;
+        let (m, turn) = self.cached_measure(surface, nt, c);
+        let (_, _, len) = self.longest_edge(nt);
+        let fits = m.max <= c.tol && (turn <= c.angle || c.short_for_angle(&m, turn, len));
+        if fits && !self.inverted(surface, nt) {
+            return true;
+        }
+        for k in 0..3 {
+            self.detach(self.tris[nt][k], self.tris[nt][(k + 1) % 3], nt as u32);
+        }
+        self.tris.pop();
+        self.uvs.pop();
+        self.measures.truncate(self.tris.len());
+        self.pos.truncate(old_v);
+        self.normal.truncate(old_v);
+        self.gid.truncate(old_v);
+        false
+    }
+
     /// Whether the facet normal opposes the surface normal at the centroid's (u,v).
     pub fn inverted(&self, surface: &dyn Surface, t: usize) -> bool {
         let v = self.tris[t];

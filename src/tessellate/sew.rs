@@ -21,10 +21,6 @@ use crate::nurbs::{NurbsCurve, Surface};
 use crate::Error;
 
 const NONE: u32 = u32::MAX;
-/// Marks a candidate beyond the other border's segment, at its end.
-const BEYOND: f64 = -2.0;
-/// Nodes a pair of faces needs before its own gaps set its sewing distance.
-const PAIR_MIN: usize = 3;
 
 /// One face while the model is sewn.
 pub(crate) struct FaceWork<'a> {
@@ -106,6 +102,11 @@ mod outlines {
     use crate::nurbs::Surface;
     use crate::tessellate::face::Outline;
     use crate::tessellate::trim::Polyline;
+
+    /// Marks a candidate beyond the other border's segment, at its end.
+    const BEYOND: f64 = -2.0;
+    /// Nodes a pair of faces needs before its own gaps set its sewing distance.
+    const PAIR_MIN: usize = 3;
 
     /// A node of some face's outline: face, loop, index.
     type NodeRef = (u32, u32, u32);
@@ -281,7 +282,7 @@ mod outlines {
                             // node the other border has too (a gap of nothing).
                             let e = q.distance(pa).min(q.distance(pb));
                             if e <= limit {
-                                cands.push((na, super::BEYOND, 0.0, e, qn));
+                                cands.push((na, BEYOND, 0.0, e, qn));
                             }
                             continue;
                         }
@@ -323,7 +324,7 @@ mod outlines {
                     *e = (seg.0, d);
                 }
             }
-            if s == super::BEYOND {
+            if s == BEYOND {
                 continue;
             }
             if seg.0 != q.0 {
@@ -351,7 +352,7 @@ mod outlines {
         let pair_sew: HashMap<(u32, u32), f64> = pair_gaps
             .into_iter()
             .map(|(key, mut g)| {
-                let s = if g.len() >= super::PAIR_MIN { 4.0 * q90(&mut g) } else { 0.0 };
+                let s = if g.len() >= PAIR_MIN { 4.0 * q90(&mut g) } else { 0.0 };
                 (key, s.clamp(model_sew, ceiling))
             })
             .collect();

@@ -492,3 +492,35 @@ fn mesh_sews_one_gapped_border_in_a_model_that_otherwise_meets_exactly() {
     let open = |gap: f64| mesh_model(&row_with_one_gap(gap), &opts).expect("meshes").report.boundary_edges;
     assert!(open(1.5 * tol) > r.report.boundary_edges, "a gap of 1.5 tolerances was sewn");
 }
+
+/// Three flat faces round a corner that misses: the right face's corner
+/// stops `miss` short of the others', leaving a sliver between its top
+/// border and the face above.
+fn missed_corner(miss: f64) -> Model {
+    let quad = |p: [[f64; 2]; 4]| {
+        format!(
+            r#"{{"surface":{{"degree":[1,1],"knots":[[0,0,1,1],[0,0,1,1]],
+            "points":[[[{},{},0],[{},{},0]],[[{},{},0],[{},{},0]]]}}}}"#,
+            p[0][0], p[0][1], p[1][0], p[1][1], p[2][0], p[2][1], p[3][0], p[3][1]
+        )
+    };
+    let faces = [
+        quad([[0.0, 0.0], [0.0, 10.0], [10.0, 0.0], [10.0, 10.0]]),
+        quad([[10.0, 0.0], [10.0, 10.0 - miss], [20.0, 0.0], [20.0, 10.0]]),
+        quad([[0.0, 10.0], [0.0, 20.0], [20.0, 10.0], [20.0, 20.0]]),
+    ];
+    surfmesh::read_json(format!(r#"{{"faces":[{}]}}"#, faces.join(",")).as_bytes()).expect("reads")
+}
+
+#[test]
+fn mesh_closes_the_sliver_where_three_corners_miss() {
+    // The miss is beyond the sewing distance (0.4 of the tolerance) but
+    // within the tolerance: the sliver is closed by one triangle.
+    let tol = 0.1;
+    let r = mesh_model(&missed_corner(0.7 * tol), &MeshOptions::default().with_tolerance(tol)).expect("meshes");
+    check_common("missed corner", &r, tol);
+    // A miss far beyond the tolerance stays open.
+    let outer = r.report.boundary_edges;
+    let wide = mesh_model(&missed_corner(3.0 * tol), &MeshOptions::default().with_tolerance(tol)).expect("meshes");
+    assert!(wide.report.boundary_edges > outer, "a miss of 3 tolerances was closed");
+}
