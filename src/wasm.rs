@@ -212,7 +212,7 @@ pub fn memory_bytes() -> f64 {
 /// a bad option, a parse error with its line, or the face/loop/curve and field
 /// that is invalid.
 #[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
-pub fn mesh(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsError> {
+pub fn mesh(bytes: Vec<u8>, format: &str, options: JsValue) -> Result<JsValue, JsError> {
     let options = read_options(&options).map_err(|e| JsError::new(&e))?;
     run(bytes, format, &options, &mut |_, _| true).map_err(|e| JsError::new(&one_line(&e.to_string())))
 }
@@ -227,7 +227,7 @@ pub fn mesh(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsE
 #[cfg_attr(not(test), wasm_bindgen(js_name = meshWithProgress, skip_typescript))]
 #[cfg_attr(test, allow(dead_code))]
 pub fn mesh_with_progress(
-    bytes: &[u8],
+    bytes: Vec<u8>,
     format: &str,
     options: JsValue,
     progress: &Function,
@@ -257,24 +257,26 @@ fn one_line(message: &str) -> String {
 }
 
 /// Parses, meshes (reporting each face to `progress`) and converts, timing
-/// the two stages with the host clock.
+/// the two stages with the host clock. The input is freed once read: wasm
+/// memory never shrinks, so the file need not sit beside the mesh at its peak.
 fn run(
-    bytes: &[u8],
+    bytes: Vec<u8>,
     format: &str,
     options: &MeshOptions,
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<JsValue, Error> {
     options.validate()?;
-    let format = pick_format(bytes, format)?;
+    let format = pick_format(&bytes, format)?;
     let t0 = now_ms();
     let (model, parts) = if format == Format::Step {
-        let s = read_step_parts(bytes)?;
+        let s = read_step_parts(&bytes)?;
         (s.model, Parts { names: s.parts, faces: s.face_parts, colours: s.face_colours })
     } else {
-        let model = read_model(bytes, format)?;
+        let model = read_model(&bytes, format)?;
         let n = model.faces.len();
         (model, Parts { names: alloc::vec![String::new()], faces: alloc::vec![0; n], colours: alloc::vec![None; n] })
     };
+    drop(bytes);
     let t1 = now_ms();
     let mut result = mesh_model_with_progress(&model, options, progress)?;
     let t2 = now_ms();

@@ -91,7 +91,7 @@ fn num(x: f64) -> JsValue {
 
 /// Calls the binding; on failure checks that what it throws is a JS `Error` and returns its message.
 fn call(bytes: &[u8], format: &str, opts: JsValue) -> Result<Output, String> {
-    match binding::mesh(bytes, format, opts) {
+    match binding::mesh(bytes.to_vec(), format, opts) {
         Ok(v) => {
             let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
             Ok(Output {
@@ -420,7 +420,7 @@ fn mesh_with_progress_js(bytes: &[u8], body: &str) -> (Result<JsValue, JsValue>,
     Reflect::set(&js_sys::global(), &"__surfmeshCalls".into(), &calls).expect("set global");
     let source = format!("globalThis.__surfmeshCalls.push([done, total]); {body}");
     let progress = js_sys::Function::new_with_args("done, total", &source);
-    let result = binding::mesh_with_progress(bytes, "json", JsValue::UNDEFINED, &progress);
+    let result = binding::mesh_with_progress(bytes.to_vec(), "json", JsValue::UNDEFINED, &progress);
     let seen = calls
         .iter()
         .map(|c| {
@@ -616,7 +616,7 @@ fn fit_errors_are_js_errors_with_the_cli_message() {
 #[wasm_bindgen_test]
 fn step_assembly_parts_and_colours_reach_js() {
     let bytes = include_bytes!("data/step_assembly.stp");
-    let v = binding::mesh(bytes, "step", options(&[("toleranceRel", num(1e-3))]))
+    let v = binding::mesh(bytes.to_vec(), "step", options(&[("toleranceRel", num(1e-3))]))
         .unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
     let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
     let parts: Vec<String> =
@@ -631,7 +631,8 @@ fn step_assembly_parts_and_colours_reach_js() {
     assert_eq!(&colours[3..6], &[0.0, 0.0, 1.0]);
     assert_eq!(&colours[21..24], &[0.0, 0.0, 1.0]);
 
-    let v = binding::mesh(FREEFORM, "json", JsValue::UNDEFINED).unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+    let v = binding::mesh(FREEFORM.to_vec(), "json", JsValue::UNDEFINED)
+        .unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
     let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
     assert_eq!(get("parts").dyn_into::<Array>().expect("parts").length(), 1);
     let colours = get("faceColors").dyn_into::<Float32Array>().expect("faceColors").to_vec();
