@@ -17,6 +17,8 @@ use glam::DVec3;
 use super::sew::FaceWork;
 
 const NONE: u32 = u32::MAX;
+/// The most sides a hole closed here may have.
+const MAX_SIDES: usize = 8;
 
 /// One border edge of a face: face, local ends (run a→b by its triangle),
 /// and their model node ids.
@@ -29,12 +31,31 @@ struct Side {
     gb: u32,
 }
 
-/// Closes every triangular hole between faces narrower than `width`;
-/// returns how many it closed.
+/// Closes every hole of three to [`MAX_SIDES`] sides between faces
+/// narrower than `width`; returns how many triangles it added. A hole of
+/// more sides takes one triangle on its longest side per pass.
 pub(crate) fn close_slivers(faces: &mut [FaceWork<'_>], width: f64) -> usize {
     if width.is_nan() || width <= 0.0 {
         return 0;
     }
+    let mut added = 0;
+    for _ in 0..2 * MAX_SIDES {
+        let (open, at_node) = open_sides(faces);
+        // Quads only on sides the triangles left as they were.
+        let mut n = close_triangles(faces, &open, &at_node, width);
+        if n == 0 {
+            n = close_polygons(faces, &open, &at_node, width);
+        }
+        added += n;
+        if n == 0 {
+            break;
+        }
+    }
+    added
+}
+
+/// Border edges used once in the whole model, and the edges at each node.
+fn open_sides(faces: &[FaceWork<'_>]) -> (Vec<Side>, HashMap<u32, Vec<usize>>) {
     // Border edges whose ends are model nodes, and how often each pair of
     // nodes is a border edge anywhere (twice: two faces meet there).
     let mut sides: Vec<Side> = Vec::new();
@@ -62,10 +83,31 @@ pub(crate) fn close_slivers(faces: &mut [FaceWork<'_>], width: f64) -> usize {
         at_node.entry(s.ga).or_default().push(i);
         at_node.entry(s.gb).or_default().push(i);
     }
-    let other = |s: &Side, g: u32| if s.ga == g { s.gb } else { s.ga };
-    let pos_of = |faces: &[FaceWork<'_>], s: &Side, g: u32| -> DVec3 {
-        faces[s.face as usize].mesh.pos[(if s.ga == g { s.a } else { s.b }) as usize]
-    };
+    (open, at_node)
+}
+
+/// The node at the other end of `s` from `g`.
+fn other(s: &Side, g: u32) -> u32 {
+    if s.ga == g {
+        s.gb
+    } else {
+        s.ga
+    }
+}
+
+/// Where `s`'s face has node `g` (one of its ends).
+fn pos_of(faces: &[FaceWork<'_>], s: &Side, g: u32) -> DVec3 {
+    faces[s.face as usize].mesh.pos[(if s.ga == g { s.a } else { s.b }) as usize]
+}
+
+/// Twice the area over the longest side: how wide a triangle is.
+fn width_of(p: [DVec3; 3]) -> f64 {
+    let longest = (0..3).map(|k| p[k].distance(p[(k + 1) % 3])).fold(0.0, f64::max);
+    (p[1] - p[0]).cross(p[2] - p[0]).length() / longest.max(f64::MIN_POSITIVE)
+}
+
+/// Three-sided holes.
+fn close_triangles(faces: &mut [FaceWork<'_>], open: &[Side], at_node: &HashMap<u32, Vec<usize>>, width: f64) -> usize {
     let mut used = alloc::vec![false; open.len()];
     let mut closed = 0;
     for i in 0..open.len() {
@@ -90,9 +132,7 @@ pub(crate) fn close_slivers(faces: &mut [FaceWork<'_>], width: f64) -> usize {
             }
             let p = [pos_of(faces, &s1, n1), pos_of(faces, &s2, n2), pos_of(faces, &s3, n3)];
             let len = [p[0].distance(p[1]), p[1].distance(p[2]), p[2].distance(p[0])];
-            let longest = len.iter().copied().fold(0.0, f64::max);
-            let area2 = (p[1] - p[0]).cross(p[2] - p[0]).length();
-            if area2 / longest.max(f64::MIN_POSITIVE) > width {
+            if width_of(p) > width {
                 continue;
             }
             // Into the face along whose border it lies longest, else the next.
@@ -109,4 +149,70 @@ pub(crate) fn close_slivers(faces: &mut [FaceWork<'_>], width: f64) -> usize {
         }
     }
     closed
+}
+
+/// Holes of four to [`MAX_SIDES`] sides, each node on two of them: one
+/// triangle on the longest side, to the nearer of the two corners beside
+/// it (the shorter diagonal), if every triangle that clipping it so would
+/// take is narrower than `width`; the rest is a hole of one side fewer.
+fn close_polygons(faces: &mut [FaceWork<'_>], open: &[Side], at_node: &HashMap<u32, Vec<usize>>, width: f64) -> usize {
+    let mut used = alloc::vec![false; open.len()];
+    let mut closed = 0;
+    for i in 0..open.len() {
+        if used[i] {
+            continue;
+        }
+        // Walk the loop from side i, through nodes on exactly two sides.
+        let (start, mut node) = (open[i].ga, open[i].gb);
+        let (mut sides, mut nodes) = (alloc::vec![i], alloc::vec![start]);
+        let mut prev = i;
+        while node != start && sides.len() <= MAX_SIDES {
+            let Some(at) = at_node.get(&node).filter(|l| l.len() == 2) else { break };
+            let next = if at[0] == prev { at[1] } else { at[0] };
+            nodes.push(node);
+            sides.push(next);
+            node = other(&open[next], node);
+            prev = next;
+        }
+        let n = sides.len();
+        if node != start || !(4..=MAX_SIDES).contains(&n) || sides.iter().any(|&k| used[k]) {
+            continue;
+        }
+        if sides.iter().all(|&k| open[k].face == open[i].face) {
+            continue;
+        }
+        // Side m runs from corner m to corner m + 1.
+        let p: Vec<DVec3> = (0..n).map(|m| pos_of(faces, &open[sides[m]], nodes[m])).collect();
+        let Some((m, far)) = ear(&p, &(0..n).collect::<Vec<_>>(), width) else { continue };
+        let s = open[sides[m]];
+        let f = &mut faces[s.face as usize];
+        if f.mesh.close_beside(f.surface, &f.crit, s.a, s.b, p[far], nodes[far]) {
+            closed += 1;
+            for &k in &sides {
+                used[k] = true;
+            }
+        }
+    }
+    closed
+}
+
+/// The ear to clip from polygon `ring` (indices into `p`): its longest
+/// side's first corner and the far corner, if that ear and every later one
+/// clipped the same way are narrower than `width`.
+fn ear(p: &[DVec3], ring: &[usize], width: f64) -> Option<(usize, usize)> {
+    let mut ring: Vec<usize> = ring.to_vec();
+    let mut first = None;
+    while ring.len() >= 3 {
+        let n = ring.len();
+        let side = |m: usize| p[ring[m]].distance(p[ring[(m + 1) % n]]);
+        let m = (0..n).max_by(|&x, &y| side(x).total_cmp(&side(y)))?;
+        let (x, y, z, w) = (ring[m], ring[(m + 1) % n], ring[(m + 2) % n], ring[(m + n - 1) % n]);
+        let (far, drop) = if n == 3 || p[x].distance(p[z]) <= p[y].distance(p[w]) { (z, (m + 1) % n) } else { (w, m) };
+        if width_of([p[x], p[y], p[far]]) > width {
+            return None;
+        }
+        first.get_or_insert((x, far));
+        ring.remove(drop);
+    }
+    first
 }

@@ -521,6 +521,11 @@ fn mesh_closes_the_sliver_where_three_corners_miss() {
     check_common("missed corner", &r, tol);
     // A miss far beyond the tolerance stays open.
     let outer = r.report.boundary_edges;
+    // Edges at most 3 long: the sliver's sides take more nodes, and what
+    // sewing leaves of it has four sides.
+    let short = MeshOptions::default().with_tolerance(tol).with_max_edge(Some(3.0));
+    let r = mesh_model(&missed_corner(0.7 * tol), &short).expect("meshes");
+    check_common("missed corner, short edges", &r, tol);
     let wide = mesh_model(&missed_corner(3.0 * tol), &MeshOptions::default().with_tolerance(tol)).expect("meshes");
     assert!(wide.report.boundary_edges > outer, "a miss of 3 tolerances was closed");
 }
