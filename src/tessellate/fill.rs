@@ -183,36 +183,43 @@ fn close_polygons(faces: &mut [FaceWork<'_>], open: &[Side], at_node: &HashMap<u
         }
         // Side m runs from corner m to corner m + 1.
         let p: Vec<DVec3> = (0..n).map(|m| pos_of(faces, &open[sides[m]], nodes[m])).collect();
-        let Some((m, far)) = ear(&p, &(0..n).collect::<Vec<_>>(), width) else { continue };
-        let s = open[sides[m]];
-        let f = &mut faces[s.face as usize];
-        if f.mesh.close_beside(f.surface, &f.crit, s.a, s.b, p[far], nodes[far]) {
-            closed += 1;
-            for &k in &sides {
-                used[k] = true;
+        // Longest side first; where its face refuses the ear, the next.
+        let mut by_length: Vec<usize> = (0..n).collect();
+        by_length.sort_by(|&x, &y| p[y].distance(p[(y + 1) % n]).total_cmp(&p[x].distance(p[(x + 1) % n])));
+        for m in by_length {
+            let Some(far) = ear(&p, m, width) else { continue };
+            let s = open[sides[m]];
+            let f = &mut faces[s.face as usize];
+            if f.mesh.close_beside(f.surface, &f.crit, s.a, s.b, p[far], nodes[far]) {
+                closed += 1;
+                for &k in &sides {
+                    used[k] = true;
+                }
+                break;
             }
         }
     }
     closed
 }
 
-/// The ear to clip from polygon `ring` (indices into `p`): its longest
-/// side's first corner and the far corner, if that ear and every later one
-/// clipped the same way are narrower than `width`.
-fn ear(p: &[DVec3], ring: &[usize], width: f64) -> Option<(usize, usize)> {
-    let mut ring: Vec<usize> = ring.to_vec();
-    let mut first = None;
+/// The far corner of the ear on side `first` of polygon `p` (side m runs
+/// from corner m to m + 1), if that ear and every later one, each on the
+/// longest side left, are narrower than `width`; an ear goes to the nearer
+/// of the two corners beside its side (the shorter diagonal).
+fn ear(p: &[DVec3], first: usize, width: f64) -> Option<usize> {
+    let mut ring: Vec<usize> = (0..p.len()).collect();
+    let mut chosen = None;
     while ring.len() >= 3 {
         let n = ring.len();
         let side = |m: usize| p[ring[m]].distance(p[ring[(m + 1) % n]]);
-        let m = (0..n).max_by(|&x, &y| side(x).total_cmp(&side(y)))?;
+        let m = if chosen.is_none() { first } else { (0..n).max_by(|&x, &y| side(x).total_cmp(&side(y)))? };
         let (x, y, z, w) = (ring[m], ring[(m + 1) % n], ring[(m + 2) % n], ring[(m + n - 1) % n]);
         let (far, drop) = if n == 3 || p[x].distance(p[z]) <= p[y].distance(p[w]) { (z, (m + 1) % n) } else { (w, m) };
         if width_of([p[x], p[y], p[far]]) > width {
             return None;
         }
-        first.get_or_insert((x, far));
+        chosen.get_or_insert(far);
         ring.remove(drop);
     }
-    first
+    chosen
 }
