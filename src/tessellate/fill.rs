@@ -1,14 +1,15 @@
-//! Closing the slivers sewing leaves where three faces almost meet.
+//! Closing the slivers sewing leaves where faces' corners miss.
 //!
-//! Three faces whose corners miss one another by less than the sewing
-//! distance can leave a thin triangular hole between them: each pair of
-//! borders is sewn along its length, but the corners are nodes of
-//! different faces, too far apart within one face to be one. The hole is
-//! three border edges, each used once in the whole model, that close a
-//! loop (faces need not agree on their orientation). It is closed by one triangle in the face along whose
-//! border it lies longest, if that triangle passes that face's limits
+//! Three faces whose corners miss one another by more than the sewing
+//! distance can leave a thin hole between them: each pair of borders is
+//! sewn along its length, but the corners are nodes of different faces,
+//! too far apart within one face to be one. The hole is a loop of three to
+//! [`MAX_SIDES`] border edges, each used once in the whole model, through
+//! at least two faces (which need not agree on their orientation). It is
+//! closed by triangles in the faces along whose borders it lies, each kept
+//! only if it faces the surface's way and passes that face's limits
 //! (paper 000 §3.3: both sides of a shared border use the same nodes; here
-//! the third node joins the face that lacks it).
+//! a node joins the face that lacks it).
 
 use crate::collections::HashMap;
 use alloc::vec::Vec;
@@ -41,7 +42,7 @@ pub(crate) fn close_slivers(faces: &mut [FaceWork<'_>], width: f64) -> usize {
     let mut added = 0;
     for _ in 0..2 * MAX_SIDES {
         let (open, at_node) = open_sides(faces);
-        // Quads only on sides the triangles left as they were.
+        // Longer loops only on sides the triangles left as they were.
         let mut n = close_triangles(faces, &open, &at_node, width);
         if n == 0 {
             n = close_polygons(faces, &open, &at_node, width);
