@@ -39,6 +39,7 @@ pub(crate) fn close_slivers(faces: &mut [FaceWork<'_>], width: f64) -> usize {
     if width.is_nan() || width <= 0.0 {
         return 0;
     }
+    remove_flaps(faces, width);
     let mut added = 0;
     for _ in 0..2 * MAX_SIDES {
         let (open, at_node) = open_sides(faces);
@@ -53,6 +54,69 @@ pub(crate) fn close_slivers(faces: &mut [FaceWork<'_>], width: f64) -> usize {
         }
     }
     added
+}
+
+/// Removes narrow flaps: a triangle with one side inside its face and two
+/// on its border, one of those used by no other face and the other by two
+/// others already, whose corner between them no other triangle of its face
+/// has. Such a triangle reaches past where its neighbours meet (a strip
+/// narrower than the sewing distance was sewn shut beside it); without it
+/// its inner side is the border, and what is left open beside that is a
+/// hole the passes after close. Returns how many it removed.
+fn remove_flaps(faces: &mut [FaceWork<'_>], width: f64) -> usize {
+    let mut uses: HashMap<(u32, u32), u32> = HashMap::default();
+    for f in faces.iter() {
+        let m = &f.mesh;
+        for t in &m.tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let (ga, gb) = (m.gid[a as usize], m.gid[b as usize]);
+                if ga != NONE && gb != NONE && ga != gb && m.edge_triangles(a, b) == 1 {
+                    *uses.entry((ga.min(gb), ga.max(gb))).or_default() += 1;
+                }
+            }
+        }
+    }
+    let used = |m: &super::refine::WorkMesh, a: u32, b: u32| {
+        let (ga, gb) = (m.gid[a as usize], m.gid[b as usize]);
+        if ga == NONE || gb == NONE || ga == gb {
+            return 0;
+        }
+        uses.get(&(ga.min(gb), ga.max(gb))).copied().unwrap_or(0)
+    };
+    let mut removed = 0;
+    for f in faces.iter_mut() {
+        let m = &f.mesh;
+        let mut flaps: Vec<usize> = Vec::new();
+        for (t, v) in m.tris.iter().enumerate() {
+            // Corner k is the apex: sides k-1→k and k→k+1 on the border.
+            for k in 0..3 {
+                let (prev, apex, next) = (v[(k + 2) % 3], v[k], v[(k + 1) % 3]);
+                if m.edge_triangles(prev, next) != 2
+                    || m.edge_triangles(prev, apex) != 1
+                    || m.edge_triangles(apex, next) != 1
+                {
+                    continue;
+                }
+                let (u1, u2) = (used(m, prev, apex), used(m, apex, next));
+                if !((u1 == 1 && u2 >= 3) || (u1 >= 3 && u2 == 1)) {
+                    continue;
+                }
+                let p = v.map(|x| m.pos[x as usize]);
+                if width_of(p) > width || m.tris.iter().filter(|w| w.contains(&apex)).count() != 1 {
+                    continue;
+                }
+                flaps.push(t);
+                break;
+            }
+        }
+        // Highest first: removing one moves only the last triangle.
+        for &t in flaps.iter().rev() {
+            f.mesh.remove_triangle(t);
+            removed += 1;
+        }
+    }
+    removed
 }
 
 /// Border edges used once in the whole model, and the edges at each node.
@@ -147,6 +211,15 @@ fn close_triangles(faces: &mut [FaceWork<'_>], open: &[Side], at_node: &HashMap<
                     break 'hole;
                 }
             }
+            // No face takes the triangle the right way up: the corner across
+            // the longest side pokes over it (the two other sides overlap
+            // that side's face), so that side takes the corner as its node.
+            let (_, s, q, g) = order[0];
+            let f = &mut faces[s.face as usize];
+            if f.mesh.split_border_at(f.surface, &f.crit, s.a, s.b, q, g) {
+                closed += 1;
+                (used[i], used[j], used[k]) = (true, true, true);
+            }
         }
     }
     closed
@@ -223,4 +296,125 @@ fn ear(p: &[DVec3], first: usize, width: f64) -> Option<usize> {
         ring.remove(drop);
     }
     chosen
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nurbs::analytic::bilinear;
+    use crate::tessellate::refine::{Criteria, WorkMesh};
+    use glam::DVec2;
+
+    /// The plane z = 0 over [-20, 20]², u = x and v = y.
+    fn plane() -> crate::nurbs::NurbsSurface {
+        let c = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        bilinear([[c(-20.0, -20.0), c(-20.0, 20.0)], [c(20.0, -20.0), c(20.0, 20.0)]], [-20.0, 20.0], [-20.0, 20.0])
+            .unwrap()
+    }
+
+    const CRIT: Criteria = Criteria { tol: 0.1, angle: 0.5, max_edge: f64::INFINITY, min_edge: 0.0, steps: 4 };
+
+    /// A face on the plane: its points with their model node ids (`NONE`
+    /// inside) and its triangles, counter-clockwise.
+    fn mesh(points: &[(f64, f64, u32)], tris: &[[u32; 3]]) -> WorkMesh {
+        let mut m = WorkMesh::default();
+        for &(x, y, g) in points {
+            let v = m.add_vertex(DVec3::new(x, y, 0.0), DVec3::Z);
+            m.gid[v as usize] = g;
+        }
+        for t in tris {
+            m.add_triangle(*t, t.map(|v| DVec2::new(points[v as usize].0, points[v as usize].1)));
+        }
+        m
+    }
+
+    /// Border edges (one triangle in their face) each pair of nodes is, over all faces.
+    fn border_uses(faces: &[FaceWork<'_>]) -> HashMap<(u32, u32), u32> {
+        let mut uses: HashMap<(u32, u32), u32> = HashMap::default();
+        for f in faces {
+            for t in &f.mesh.tris {
+                for k in 0..3 {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    let (ga, gb) = (f.mesh.gid[a as usize], f.mesh.gid[b as usize]);
+                    if ga != NONE && gb != NONE && f.mesh.edge_triangles(a, b) == 1 {
+                        *uses.entry((ga.min(gb), ga.max(gb))).or_default() += 1;
+                    }
+                }
+            }
+        }
+        uses
+    }
+
+    /// The lower face's border node 3 pokes 0.03 over the upper face's
+    /// border 1-2: no triangle between them faces the plane's way, so the
+    /// upper face's border takes node 3, and no border edge is left unpaired.
+    #[test]
+    fn a_corner_poking_over_a_border_becomes_its_node() {
+        let plane = plane();
+        let upper =
+            mesh(&[(0.0, 0.0, 1), (10.0, 0.0, 2), (10.0, 10.0, NONE), (0.0, 10.0, NONE)], &[[0, 1, 2], [0, 2, 3]]);
+        let lower = mesh(
+            &[(0.0, 0.0, 1), (5.0, 0.03, 3), (10.0, 0.0, 2), (0.0, -10.0, NONE), (10.0, -10.0, NONE)],
+            &[[3, 4, 2], [3, 2, 1], [3, 1, 0]],
+        );
+        let work = |mesh| FaceWork { surface: &plane, curves: Vec::new(), mesh, crit: CRIT };
+        let mut faces = alloc::vec![work(upper), work(lower)];
+        assert_eq!(border_uses(&faces).get(&(1, 2)), Some(&1));
+        assert_eq!(close_slivers(&mut faces, 0.1), 1);
+        let uses = border_uses(&faces);
+        for pair in [(1, 3), (2, 3)] {
+            assert_eq!(uses.get(&pair), Some(&2), "{pair:?} is not shared");
+        }
+        assert!(!uses.contains_key(&(1, 2)));
+        for f in &faces {
+            for t in 0..f.mesh.tris.len() {
+                assert!(!f.mesh.inverted(&plane, t));
+            }
+        }
+        // Poking further over than the width allowed: left as it was.
+        let upper =
+            mesh(&[(0.0, 0.0, 1), (10.0, 0.0, 2), (10.0, 10.0, NONE), (0.0, 10.0, NONE)], &[[0, 1, 2], [0, 2, 3]]);
+        let lower = mesh(
+            &[(0.0, 0.0, 1), (5.0, 0.3, 3), (10.0, 0.0, 2), (0.0, -10.0, NONE), (10.0, -10.0, NONE)],
+            &[[3, 4, 2], [3, 2, 1], [3, 1, 0]],
+        );
+        let mut faces = alloc::vec![work(upper), work(lower)];
+        assert_eq!(close_slivers(&mut faces, 0.1), 0);
+        assert_eq!(faces[0].mesh.tris.len(), 2);
+    }
+
+    /// A narrow triangle reaching past its face's border: one side of it is
+    /// used by no other face, the other by two faces that already meet
+    /// there. It goes; a triangle whose second side only one other face uses
+    /// (a proper shared border) stays.
+    #[test]
+    fn a_flap_over_where_two_faces_meet_is_removed() {
+        let plane = plane();
+        let work = |mesh| FaceWork { surface: &plane, curves: Vec::new(), mesh, crit: CRIT };
+        // Square 0..10 with a flap on its right side: B (10,0) = 1, apex
+        // A (10.03, 5) = 2, D (10, 10) = 3.
+        let square = || {
+            mesh(
+                &[(0.0, 0.0, 4), (10.0, 0.0, 1), (10.03, 5.0, 2), (10.0, 10.0, 3), (0.0, 10.0, 5)],
+                &[[0, 1, 3], [0, 3, 4], [1, 2, 3]],
+            )
+        };
+        let beside = |far: f64| mesh(&[(10.03, 5.0, 2), (far, 5.0, NONE), (10.0, 10.0, 3)], &[[0, 1, 2]]);
+        let mut faces = alloc::vec![
+            work(square()),
+            work(beside(15.0)),
+            work(mesh(&[(10.0, 10.0, 3), (10.0, 15.0, NONE), (10.03, 5.0, 2)], &[[0, 1, 2]]))
+        ];
+        assert_eq!(border_uses(&faces).get(&(2, 3)), Some(&3));
+        assert_eq!(remove_flaps(&mut faces, 0.1), 1);
+        assert_eq!(faces[0].mesh.tris.len(), 2);
+        let uses = border_uses(&faces);
+        assert_eq!(uses.get(&(2, 3)), Some(&2));
+        assert_eq!(uses.get(&(1, 3)), Some(&1));
+        assert!(!uses.contains_key(&(1, 2)));
+        // One other face on A-D: the flap's sides are shared as they should be.
+        let mut faces = alloc::vec![work(square()), work(beside(15.0))];
+        assert_eq!(remove_flaps(&mut faces, 0.1), 0);
+        assert_eq!(faces[0].mesh.tris.len(), 3);
+    }
 }

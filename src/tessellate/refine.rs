@@ -858,6 +858,107 @@ impl WorkMesh {
         false
     }
 
+    /// Splits border edge `a-b` (one triangle) at `p`, another face's node
+    /// `gid` that pokes across it from beside: its triangle becomes two that
+    /// meet there, kept only if neither folds in (u,v), both face the
+    /// surface's way and pass the limits; otherwise the mesh stays as it was.
+    #[cfg(feature = "std")]
+    pub fn split_border_at(&mut self, surface: &dyn Surface, c: &Criteria, a: u32, b: u32, p: DVec3, gid: u32) -> bool {
+        let Some(t) = self.edges.get(&key(a, b)).filter(|e| e[1] == NONE).map(|e| e[0] as usize) else {
+            return false;
+        };
+        let (old_t, old_uv) = (self.tris[t], self.uvs[t]);
+        let Some(k) = (0..3).find(|&k| key(old_t[k], old_t[(k + 1) % 3]) == key(a, b)) else {
+            return false;
+        };
+        let (x0, x1, x2) = (old_t[k], old_t[(k + 1) % 3], old_t[(k + 2) % 3]);
+        let (u0, u1, u2) = (old_uv[k], old_uv[(k + 1) % 3], old_uv[(k + 2) % 3]);
+        let area = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+        let whole = area(u0, u1, u2);
+        let folds = |uv: DVec2| !uv.is_finite() || area(u0, uv, u2) * whole <= 0.0 || area(uv, u1, u2) * whole <= 0.0;
+        // Its nearest point on this surface; where that folds the two (the
+        // node lies past the surface's end), the edge's (u,v) at its chord
+        // fraction, the node keeping its place for the weld.
+        let (pa, pb) = (self.pos[x0 as usize], self.pos[x1 as usize]);
+        let frac = (p - pa).dot(pb - pa) / pa.distance_squared(pb).max(f64::MIN_POSITIVE);
+        let uv = project_to_surface(surface, p, Some(u0.lerp(u1, frac.clamp(0.0, 1.0))), &Default::default()).uv;
+        let uv = if folds(uv) { u0.lerp(u1, frac) } else { uv };
+        if whole == 0.0 || !(1e-3..=1.0 - 1e-3).contains(&frac) || folds(uv) {
+            return false;
+        }
+        let n = surface.normal(uv);
+        if !n.is_finite() {
+            return false;
+        }
+        let old_v = self.pos.len();
+        let m = self.add_vertex(p, n);
+        self.gid[m as usize] = gid;
+        let tu = t as u32;
+        self.detach(x0, x1, tu);
+        self.detach(x1, x2, tu);
+        self.tris[t] = [x0, m, x2];
+        self.uvs[t] = [u0, uv, u2];
+        self.attach(x0, m, tu);
+        self.attach(m, x2, tu);
+        self.add_triangle([m, x1, x2], [uv, u1, u2]);
+        self.measure_slots();
+        self.measures[t] = STALE;
+        let nt = self.tris.len() - 1;
+        let fits = |w: &mut Self, s: usize| {
+            let (mm, turn) = w.cached_measure(surface, s, c);
+            let (_, _, len) = w.longest_edge(s);
+            mm.max <= c.tol && (turn <= c.angle || c.short_for_angle(&mm, turn, len)) && !w.inverted(surface, s)
+        };
+        if fits(self, t) && fits(self, nt) {
+            return true;
+        }
+        for k in 0..3 {
+            self.detach(self.tris[nt][k], self.tris[nt][(k + 1) % 3], nt as u32);
+        }
+        self.tris.pop();
+        self.uvs.pop();
+        self.measures.truncate(self.tris.len());
+        self.detach(x0, m, tu);
+        self.detach(m, x2, tu);
+        self.tris[t] = old_t;
+        self.uvs[t] = old_uv;
+        self.attach(x0, x1, tu);
+        self.attach(x1, x2, tu);
+        self.measures[t] = STALE;
+        self.pos.truncate(old_v);
+        self.normal.truncate(old_v);
+        self.gid.truncate(old_v);
+        false
+    }
+
+    /// Removes triangle `t`; the last triangle takes its index. Its corners
+    /// stay as vertices (one no other triangle uses is simply not drawn).
+    #[cfg(feature = "std")]
+    pub fn remove_triangle(&mut self, t: usize) {
+        if t >= self.tris.len() {
+            return;
+        }
+        let last = self.tris.len() - 1;
+        for k in 0..3 {
+            self.detach(self.tris[t][k], self.tris[t][(k + 1) % 3], t as u32);
+        }
+        if t != last {
+            let v = self.tris[last];
+            for k in 0..3 {
+                self.detach(v[k], v[(k + 1) % 3], last as u32);
+                self.attach(v[k], v[(k + 1) % 3], t as u32);
+            }
+        }
+        if self.measures.len() == self.tris.len() {
+            self.measures.swap_remove(t);
+        } else if let Some(m) = self.measures.get_mut(t) {
+            *m = STALE;
+        }
+        self.tris.swap_remove(t);
+        self.uvs.swap_remove(t);
+        self.measures.truncate(self.tris.len());
+    }
+
     /// Whether the facet normal opposes the surface normal at the centroid's (u,v).
     pub fn inverted(&self, surface: &dyn Surface, t: usize) -> bool {
         let v = self.tris[t];
