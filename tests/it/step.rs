@@ -216,6 +216,11 @@ const MESHED: [&str; 15] = [
     "trj6_pm4-ec-203.stp",
 ];
 
+/// Corpus files held to the same, except that a face may be missing when
+/// the report says why: a strip narrower than the sewing distance, its two
+/// sides sewn into one border by its neighbours (it has no area to mesh).
+const MESHED_BUT_STRIPS: [&str; 1] = ["trj7_b1-ec-214.stp"];
+
 /// In a debug build, larger files are neither read nor meshed (reading
 /// projects every edge onto its surface: all 16 files take over a minute
 /// unoptimized); `cargo test --release` takes them all.
@@ -280,7 +285,8 @@ fn corpus_meshes_within_tolerance_watertight() {
     );
     for path in files {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
-        let must = MESHED.contains(&name.as_str());
+        let strips_allowed = MESHED_BUT_STRIPS.contains(&name.as_str());
+        let must = MESHED.contains(&name.as_str()) || strips_allowed;
         let bytes = std::fs::read(&path).unwrap();
         if cfg!(debug_assertions) && bytes.len() > DEBUG_MAX_BYTES {
             continue;
@@ -334,8 +340,10 @@ fn corpus_meshes_within_tolerance_watertight() {
             continue;
         }
         let mut problems = Vec::new();
-        if meshed != listed || rep.faces_skipped != 0 {
-            problems.push(format!("{meshed} of {listed} faces meshed"));
+        let strips = rep.warnings.iter().filter(|w| w.contains("a strip narrower than the sewing distance")).count();
+        let explained = if strips_allowed { strips } else { 0 };
+        if meshed + explained != listed || rep.faces_skipped != explained {
+            problems.push(format!("{meshed} of {listed} faces meshed, {strips} strips explained"));
         }
         if rep.max_deviation.is_nan() || rep.max_deviation > rep.tolerance {
             problems.push(format!("deviation {} > {}", rep.max_deviation, rep.tolerance));
