@@ -322,10 +322,26 @@ pub fn mesh_model_with_progress(
         let wm = w.mesh;
         let first = mesh.triangle_count() as u32;
         let base = mesh.positions.len() as u32;
-        mesh.positions.extend_from_slice(&wm.pos);
-        mesh.normals.extend_from_slice(&wm.normal);
+        // Vertices no triangle kept (a removed flap's corner, a collapsed
+        // sliver's) are left out: a stray point would still widen the
+        // bounding box a viewer fits its camera to.
+        let mut index = alloc::vec![u32::MAX; wm.pos.len()];
         for t in &wm.tris {
-            mesh.indices.extend(t.iter().map(|&v| v + base));
+            for &v in t {
+                index[v as usize] = 0;
+            }
+        }
+        let mut next = base;
+        for (v, slot) in index.iter_mut().enumerate() {
+            if *slot == 0 {
+                *slot = next;
+                next += 1;
+                mesh.positions.push(wm.pos[v]);
+                mesh.normals.push(wm.normal[v]);
+            }
+        }
+        for t in &wm.tris {
+            mesh.indices.extend(t.iter().map(|&v| index[v as usize]));
         }
         mesh.face_ranges.push(FaceRange { first, count: wm.tris.len() as u32 });
     }

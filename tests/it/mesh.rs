@@ -56,6 +56,11 @@ fn check_common(name: &str, r: &MeshResult, rel: f64) -> usize {
     assert_eq!(r.mesh.indices.len(), 3 * rep.triangles);
     assert_eq!(r.mesh.positions.len(), rep.vertices);
     assert_eq!(r.mesh.normals.len(), rep.vertices);
+    let mut used = vec![false; rep.vertices];
+    for &i in &r.mesh.indices {
+        used[i as usize] = true;
+    }
+    assert!(used.iter().all(|&u| u), "{name}: a vertex no triangle uses");
     for n in &r.mesh.normals {
         assert!((n.length() - 1.0).abs() < 1e-9, "{name}: normal not unit");
     }

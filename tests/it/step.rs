@@ -354,6 +354,13 @@ fn corpus_meshes_within_tolerance_watertight() {
         if rep.free_edges != 0 {
             problems.push(format!("{} free edges", rep.free_edges));
         }
+        let mut used = vec![false; r.mesh.positions.len()];
+        for &i in &r.mesh.indices {
+            used[i as usize] = true;
+        }
+        if let Some(n) = Some(used.iter().filter(|&&u| !u).count()).filter(|&n| n > 0) {
+            problems.push(format!("{n} vertices no triangle uses"));
+        }
         if (shell_boundary, misoriented) != (0, 0) {
             problems.push(format!("closed shells: {shell_boundary} boundary, {misoriented} misoriented edges"));
         }
