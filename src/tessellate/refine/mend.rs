@@ -1,0 +1,410 @@
+//! Mending a refined face: folded triangles unfolded by flips and inner
+//! vertex moves, and the small changes at its border that close what
+//! sewing left open (a triangle beside a hole, a border split at a corner
+//! poking over it, a flap removed).
+
+use alloc::vec::Vec;
+use glam::{DVec2, DVec3};
+
+use super::{key, Criteria, TriMeasure, WorkMesh, NONE};
+use crate::nurbs::Surface;
+#[cfg(feature = "std")]
+use {super::STALE, crate::nurbs::project_to_surface};
+
+impl WorkMesh {
+    /// Repairs folded triangles by edge flips: for each inverted triangle,
+    /// its interior edges (not trim edges) are tried in turn, and a flip is
+    /// kept when both new triangles face the surface's way, keep the (u,v)
+    /// orientation (or, where sewing moved nodes, face the surface's way in
+    /// space) and pass the deviation and angle limits. Borders are not
+    /// touched, so a sewn border stays conforming. Returns the triangles
+    /// changed.
+    ///
+    /// Also returns the triangles still folded.
+    pub fn repair_inverted(&mut self, surface: &dyn Surface, c: &Criteria) -> (Vec<u32>, Vec<u32>) {
+        let mut changed = Vec::new();
+        let mut todo: Vec<u32> = self.folded(surface);
+        if todo.is_empty() {
+            return (changed, todo);
+        }
+        for _ in 0..8 {
+            let mut next = Vec::new();
+            let mut flipped = false;
+            for t in todo {
+                if !self.inverted(surface, t as usize) {
+                    continue;
+                }
+                let v = self.tris[t as usize];
+                let mut fixed = false;
+                for k in 0..3 {
+                    if let Some(u) = self.try_flip(surface, c, t, v[k], v[(k + 1) % 3]) {
+                        changed.push(t);
+                        changed.push(u);
+                        flipped = true;
+                        fixed = true;
+                        break;
+                    }
+                }
+                if fixed {
+                    continue;
+                }
+                // No flip helps: move an inner vertex of the fold to the
+                // middle of its neighbours (borders stay where sewing put them).
+                for &x in &v {
+                    if let Some(moved) = self.try_smooth(surface, c, x) {
+                        changed.extend(moved.iter().copied());
+                        next.extend(moved);
+                        break;
+                    }
+                }
+            }
+            // A fold of several triangles (a fan on a border) unfolds one
+            // flip at a time: after a round with flips, the rest are tried again.
+            if flipped {
+                next.extend((0..self.tris.len() as u32).filter(|&t| self.inverted(surface, t as usize)));
+                next.sort_unstable();
+                next.dedup();
+            }
+            if next.is_empty() {
+                break;
+            }
+            todo = next;
+        }
+        changed.sort_unstable();
+        changed.dedup();
+        let left = self.folded(surface);
+        (changed, left)
+    }
+
+    /// Of triangles `ts`, how many fold against the surface or exceed the
+    /// deviation limit (judging a node's place, see [`super::sew::resettle_folds`]).
+    pub fn failing(&self, surface: &dyn Surface, c: &Criteria, ts: &[u32]) -> usize {
+        ts.iter()
+            .filter(|&&t| self.inverted(surface, t as usize) || self.measure(surface, t as usize, c).0.max > c.tol)
+            .count()
+    }
+
+    /// The triangles still folded against the surface.
+    pub fn folded(&self, surface: &dyn Surface) -> Vec<u32> {
+        (0..self.tris.len() as u32).filter(|&t| self.inverted(surface, t as usize)).collect()
+    }
+
+    /// Flips edge `a-b` of triangle `t` (where `t` runs a→b) if the result is better; see [`Self::repair_inverted`].
+    fn try_flip(&mut self, surface: &dyn Surface, c: &Criteria, t: u32, a: u32, b: u32) -> Option<u32> {
+        if self.trim.contains_key(&key(a, b)) {
+            return None;
+        }
+        let &adj = self.edges.get(&key(a, b))?;
+        let u = if adj[0] == t { adj[1] } else { adj[0] };
+        if u == NONE || adj[0] != t && adj[1] != t {
+            return None;
+        }
+        let (tv, tuv) = (self.tris[t as usize], self.uvs[t as usize]);
+        let (uv_, uuv) = (self.tris[u as usize], self.uvs[u as usize]);
+        let i = (0..3).find(|&k| tv[k] == a && tv[(k + 1) % 3] == b)?;
+        let j = (0..3).find(|&k| uv_[k] == b && uv_[(k + 1) % 3] == a)?;
+        let cv = tv[(i + 2) % 3];
+        let d = uv_[(j + 2) % 3];
+        if cv == d || self.edges.contains_key(&key(cv, d)) {
+            return None;
+        }
+        let (qa, qb, qc) = (tuv[i], tuv[(i + 1) % 3], tuv[(i + 2) % 3]);
+        let (qb2, qa2, qd) = (uuv[j], uuv[(j + 1) % 3], uuv[(j + 2) % 3]);
+        // One chart on both sides (not across a seam).
+        let span = (qa - qb).length().max(1e-300);
+        if (qa - qa2).length() > 1e-9 * span || (qb - qb2).length() > 1e-9 * span {
+            return None;
+        }
+        let area = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+        let sense = area(qb2, qa2, qd);
+        let (t1, t2) = ([a, d, cv], [d, b, cv]);
+        let (w1, w2) = ([qa, qd, qc], [qd, qb, qc]);
+        let uv_ok = area(w1[0], w1[1], w1[2]) * sense > 0.0 && area(w2[0], w2[1], w2[2]) * sense > 0.0;
+        // Sewing moves border nodes in space, not in (u,v): where it folded a
+        // triangle, the flip that unfolds it can look folded in the stale
+        // (u,v), so the new pair is judged in space against the surface's
+        // normal there too.
+        let space_ok = || {
+            let n = surface.normal((qa + qb + qc + qd) / 4.0);
+            let p = |v: u32| self.pos[v as usize];
+            let facing = |t: [u32; 3]| (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).dot(n) > 0.0;
+            facing(t1) && facing(t2)
+        };
+        if !uv_ok && !space_ok() {
+            return None;
+        }
+        // Apply, then test; undo when worse.
+        let old = (tv, tuv, uv_, uuv);
+        self.retriangulate(t, u, [tv, uv_], [t1, t2], [w1, w2]);
+        let good = [t, u].iter().all(|&x| {
+            let (m, turn) = self.measure(surface, x as usize, c);
+            !self.inverted(surface, x as usize) && m.max <= c.tol && self.turn_ok(c, &m, turn, x)
+        });
+        if !good {
+            self.retriangulate(t, u, [t1, t2], [old.0, old.2], [old.1, old.3]);
+        }
+        good.then_some(u)
+    }
+
+    /// Moves inner vertex `x` to the (u,v) centroid of its neighbours when
+    /// that leaves every triangle around it facing the surface's way, with
+    /// its (u,v) orientation, and within the limits; returns those triangles.
+    fn try_smooth(&mut self, surface: &dyn Surface, c: &Criteria, x: u32) -> Option<Vec<u32>> {
+        let ring: Vec<u32> = (0..self.tris.len() as u32).filter(|&t| self.tris[t as usize].contains(&x)).collect();
+        if ring.len() < 3 {
+            return None;
+        }
+        let mut centre = DVec2::ZERO;
+        let mut at: Option<DVec2> = None;
+        let mut n = 0.0;
+        for &t in &ring {
+            let (tv, tuv) = (self.tris[t as usize], self.uvs[t as usize]);
+            for k in 0..3 {
+                let (a, b) = (tv[k], tv[(k + 1) % 3]);
+                if (a == x || b == x) && self.edges.get(&key(a, b)).is_none_or(|e| e[1] == NONE) {
+                    return None; // on a border
+                }
+                if tv[k] == x {
+                    // One chart all around (not a seam or pole vertex).
+                    if at.is_some_and(|q| q.distance(tuv[k]) > 0.0) {
+                        return None;
+                    }
+                    at = Some(tuv[k]);
+                } else {
+                    centre += tuv[k];
+                    n += 1.0;
+                }
+            }
+        }
+        let old_uv = at?;
+        let new_uv = centre / n;
+        let area = |w: [DVec2; 3]| (w[1] - w[0]).perp_dot(w[2] - w[0]);
+        let signs: Vec<f64> = ring.iter().map(|&t| area(self.uvs[t as usize])).collect();
+        let sense = signs.iter().sum::<f64>();
+        let (old_p, old_n) = (self.pos[x as usize], self.normal[x as usize]);
+        let set = |m: &mut Self, q: DVec2, p: DVec3, nn: DVec3| {
+            m.pos[x as usize] = p;
+            m.normal[x as usize] = nn;
+            for &t in &ring {
+                let tv = m.tris[t as usize];
+                for k in 0..3 {
+                    if tv[k] == x {
+                        m.uvs[t as usize][k] = q;
+                    }
+                }
+            }
+        };
+        set(self, new_uv, surface.point(new_uv), surface.normal(new_uv));
+        let good = ring.iter().all(|&t| {
+            let (m, turn) = self.measure(surface, t as usize, c);
+            area(self.uvs[t as usize]) * sense > 0.0
+                && !self.inverted(surface, t as usize)
+                && m.max <= c.tol
+                && self.turn_ok(c, &m, turn, t)
+        });
+        if good {
+            Some(ring)
+        } else {
+            set(self, old_uv, old_p, old_n);
+            None
+        }
+    }
+
+    /// Whether triangle `t`'s normal turn passes: within the angle limit, or
+    /// too short to split for it ([`Criteria::short_for_angle`]), so a repair
+    /// that unfolds such a triangle is not refused for a turn refinement keeps too.
+    fn turn_ok(&self, c: &Criteria, m: &TriMeasure, turn: f64, t: u32) -> bool {
+        turn <= c.angle || c.short_for_angle(m, turn, self.longest_edge(t as usize).2)
+    }
+
+    /// Replaces triangles `t` and `u` (vertices `from`) by `to` with corner (u,v)s `uvs`.
+    fn retriangulate(&mut self, t: u32, u: u32, from: [[u32; 3]; 2], to: [[u32; 3]; 2], uvs: [[DVec2; 3]; 2]) {
+        for (x, tri) in [t, u].into_iter().zip(from) {
+            for k in 0..3 {
+                self.detach(tri[k], tri[(k + 1) % 3], x);
+            }
+        }
+        for ((x, tri), w) in [t, u].into_iter().zip(to).zip(uvs) {
+            self.tris[x as usize] = tri;
+            self.uvs[x as usize] = w;
+            for k in 0..3 {
+                self.attach(tri[k], tri[(k + 1) % 3], x);
+            }
+        }
+    }
+
+    /// Whether triangle `t` folds against the surface with a facet worth
+    /// judging: a triangle whose smallest height is within `negligible` is
+    /// flat (two corners one point, as a pole's nodes a rounding error apart,
+    /// or three in a line where a side of the surface is collapsed to a
+    /// hair), its facet's normal then noise.
+    pub fn folded_beyond(&self, surface: &dyn Surface, t: usize, negligible: f64) -> bool {
+        let v = self.tris[t];
+        let p = [self.pos[v[0] as usize], self.pos[v[1] as usize], self.pos[v[2] as usize]];
+        let longest = (0..3).map(|k| p[k].distance(p[(k + 1) % 3])).fold(0.0, f64::max);
+        let height = (p[1] - p[0]).cross(p[2] - p[0]).length() / longest.max(f64::MIN_POSITIVE);
+        height > negligible && self.inverted(surface, t)
+    }
+
+    /// Closes a small hole beside border edge `a-b` (run a→b by its one
+    /// triangle) with the triangle `b, a, x`, `x` at `p` (another face's
+    /// node `gid`, placed on this surface at its nearest point), if that
+    /// triangle faces the surface's way and passes the limits; otherwise
+    /// leaves the mesh as it was. Returns whether it closed it.
+    #[cfg(feature = "std")]
+    pub fn close_beside(&mut self, surface: &dyn Surface, c: &Criteria, a: u32, b: u32, p: DVec3, gid: u32) -> bool {
+        let Some(t) = self.edges.get(&key(a, b)).filter(|e| e[1] == NONE).map(|e| e[0] as usize) else {
+            return false;
+        };
+        let Some(k) = (0..3).find(|&k| self.tris[t][k] == a && self.tris[t][(k + 1) % 3] == b) else {
+            return false;
+        };
+        let (uv_a, uv_b) = (self.uvs[t][k], self.uvs[t][(k + 1) % 3]);
+        let hint = (uv_a + uv_b) * 0.5;
+        let uv = project_to_surface(surface, p, Some(hint), &Default::default()).uv;
+        // Far from the edge in (u,v): across a seam, not beside it.
+        if !uv.is_finite() || uv.distance(hint) > 2.0 * uv_a.distance(uv_b).max(1e-300) {
+            return false;
+        }
+        let old_v = self.pos.len();
+        let n = surface.normal(uv);
+        if !n.is_finite() {
+            return false;
+        }
+        let x = self.add_vertex(p, n);
+        self.gid[x as usize] = gid;
+        self.add_triangle([b, a, x], [uv_b, uv_a, uv]);
+        self.measure_slots();
+        let nt = self.tris.len() - 1;
+        let (m, turn) = self.cached_measure(surface, nt, c);
+        let (_, _, len) = self.longest_edge(nt);
+        let fits = m.max <= c.tol && (turn <= c.angle || c.short_for_angle(&m, turn, len));
+        if fits && !self.inverted(surface, nt) {
+            return true;
+        }
+        for k in 0..3 {
+            self.detach(self.tris[nt][k], self.tris[nt][(k + 1) % 3], nt as u32);
+        }
+        self.tris.pop();
+        self.uvs.pop();
+        self.measures.truncate(self.tris.len());
+        self.pos.truncate(old_v);
+        self.normal.truncate(old_v);
+        self.gid.truncate(old_v);
+        false
+    }
+
+    /// Splits border edge `a-b` (one triangle) at `p`, another face's node
+    /// `gid` that pokes across it from beside: its triangle becomes two that
+    /// meet there, kept only if neither folds in (u,v), both face the
+    /// surface's way and pass the limits; otherwise the mesh stays as it was.
+    #[cfg(feature = "std")]
+    pub fn split_border_at(&mut self, surface: &dyn Surface, c: &Criteria, a: u32, b: u32, p: DVec3, gid: u32) -> bool {
+        let Some(t) = self.edges.get(&key(a, b)).filter(|e| e[1] == NONE).map(|e| e[0] as usize) else {
+            return false;
+        };
+        let (old_t, old_uv) = (self.tris[t], self.uvs[t]);
+        let Some(k) = (0..3).find(|&k| key(old_t[k], old_t[(k + 1) % 3]) == key(a, b)) else {
+            return false;
+        };
+        let (x0, x1, x2) = (old_t[k], old_t[(k + 1) % 3], old_t[(k + 2) % 3]);
+        let (u0, u1, u2) = (old_uv[k], old_uv[(k + 1) % 3], old_uv[(k + 2) % 3]);
+        let area = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+        let whole = area(u0, u1, u2);
+        let folds = |uv: DVec2| !uv.is_finite() || area(u0, uv, u2) * whole <= 0.0 || area(uv, u1, u2) * whole <= 0.0;
+        // Its nearest point on this surface; where that folds the two (the
+        // node lies past the surface's end), the edge's (u,v) at its chord
+        // fraction, the node keeping its place for the weld.
+        let (pa, pb) = (self.pos[x0 as usize], self.pos[x1 as usize]);
+        let frac = (p - pa).dot(pb - pa) / pa.distance_squared(pb).max(f64::MIN_POSITIVE);
+        let uv = project_to_surface(surface, p, Some(u0.lerp(u1, frac.clamp(0.0, 1.0))), &Default::default()).uv;
+        let uv = if folds(uv) { u0.lerp(u1, frac) } else { uv };
+        if whole == 0.0 || !(1e-3..=1.0 - 1e-3).contains(&frac) || folds(uv) {
+            return false;
+        }
+        let n = surface.normal(uv);
+        if !n.is_finite() {
+            return false;
+        }
+        let old_v = self.pos.len();
+        let m = self.add_vertex(p, n);
+        self.gid[m as usize] = gid;
+        let tu = t as u32;
+        self.detach(x0, x1, tu);
+        self.detach(x1, x2, tu);
+        self.tris[t] = [x0, m, x2];
+        self.uvs[t] = [u0, uv, u2];
+        self.attach(x0, m, tu);
+        self.attach(m, x2, tu);
+        self.add_triangle([m, x1, x2], [uv, u1, u2]);
+        self.measure_slots();
+        self.measures[t] = STALE;
+        let nt = self.tris.len() - 1;
+        let fits = |w: &mut Self, s: usize| {
+            let (mm, turn) = w.cached_measure(surface, s, c);
+            let (_, _, len) = w.longest_edge(s);
+            mm.max <= c.tol && (turn <= c.angle || c.short_for_angle(&mm, turn, len)) && !w.inverted(surface, s)
+        };
+        if fits(self, t) && fits(self, nt) {
+            return true;
+        }
+        for k in 0..3 {
+            self.detach(self.tris[nt][k], self.tris[nt][(k + 1) % 3], nt as u32);
+        }
+        self.tris.pop();
+        self.uvs.pop();
+        self.measures.truncate(self.tris.len());
+        self.detach(x0, m, tu);
+        self.detach(m, x2, tu);
+        self.tris[t] = old_t;
+        self.uvs[t] = old_uv;
+        self.attach(x0, x1, tu);
+        self.attach(x1, x2, tu);
+        self.measures[t] = STALE;
+        self.pos.truncate(old_v);
+        self.normal.truncate(old_v);
+        self.gid.truncate(old_v);
+        false
+    }
+
+    /// Removes triangle `t`; the last triangle takes its index. Its corners
+    /// stay as vertices (one no other triangle uses is simply not drawn).
+    #[cfg(feature = "std")]
+    pub fn remove_triangle(&mut self, t: usize) {
+        if t >= self.tris.len() {
+            return;
+        }
+        let last = self.tris.len() - 1;
+        for k in 0..3 {
+            self.detach(self.tris[t][k], self.tris[t][(k + 1) % 3], t as u32);
+        }
+        if t != last {
+            let v = self.tris[last];
+            for k in 0..3 {
+                self.detach(v[k], v[(k + 1) % 3], last as u32);
+                self.attach(v[k], v[(k + 1) % 3], t as u32);
+            }
+        }
+        if self.measures.len() == self.tris.len() {
+            self.measures.swap_remove(t);
+        } else if let Some(m) = self.measures.get_mut(t) {
+            *m = STALE;
+        }
+        self.tris.swap_remove(t);
+        self.uvs.swap_remove(t);
+        self.measures.truncate(self.tris.len());
+    }
+
+    /// Whether the facet normal opposes the surface normal at the centroid's (u,v).
+    pub fn inverted(&self, surface: &dyn Surface, t: usize) -> bool {
+        let v = self.tris[t];
+        let p = [self.pos[v[0] as usize], self.pos[v[1] as usize], self.pos[v[2] as usize]];
+        let facet = (p[1] - p[0]).cross(p[2] - p[0]);
+        if facet.length_squared() == 0.0 {
+            return false;
+        }
+        let uv = self.uvs[t];
+        let n = surface.normal((uv[0] + uv[1] + uv[2]) / 3.0);
+        facet.dot(n) < 0.0
+    }
+}

@@ -1,0 +1,541 @@
+//! Sewing of face outlines before they are triangulated.
+
+use crate::collections::{CellGrid, HashMap};
+use alloc::vec::Vec;
+use glam::DVec3;
+
+use super::nearest_fraction;
+use crate::nurbs::Surface;
+use crate::tessellate::face::Outline;
+use crate::tessellate::trim::Polyline;
+
+/// Marks a candidate beyond the other border's segment, at its end.
+const BEYOND: f64 = -2.0;
+/// Nodes a pair of faces needs before its own gaps set its sewing distance.
+const PAIR_MIN: usize = 3;
+
+/// A node of some face's outline: face, loop, index.
+type NodeRef = (u32, u32, u32);
+
+/// Per face, per loop, per node.
+type PerNode<T> = Vec<Vec<Vec<T>>>;
+
+/// Per segment, the nodes to add to it: (fraction, curve parameter, the node it stands for).
+type Additions = PerNode<Vec<(f64, f64, NodeRef)>>;
+
+/// Makes the outlines of all faces agree and names their nodes.
+///
+/// Each node has a reach: `sew`, but at most 0.3 of its shortest loop
+/// segment (so two nodes of one segment are never one). A node of one
+/// outline that lies on another outline's exact border within its reach,
+/// where the two run side by side and no more than four times as far as
+/// the nearest other face's border, is added to that border at its own
+/// curve's nearest point (unless it is within reach of a node there
+/// already). Then nodes within both reaches of each other get one id in
+/// [`Outline::gids`], and a node left alone one short segment from a
+/// shared node takes its id (a trim curve shorter than the gaps). Within
+/// one face (a seam) `tight` takes the place of `sew`: a face's loops meet
+/// themselves exactly, and a face narrower than `sew` must not be folded
+/// shut. Returns the ids given.
+///
+/// `reach`: how far a node may lie from the other border's chord
+/// (chordal tolerance plus `sew`).
+pub(crate) fn unify(
+    faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>],
+    bodies: &[u32],
+    sew: f64,
+    tight: f64,
+    reach: f64,
+) -> u32 {
+    let tight = tight.min(sew).max(0.0);
+    let sew = if sew.is_finite() { sew.max(0.0) } else { 0.0 };
+    let pos = positions(faces);
+    let (mut total, mut count) = (0.0, 0usize);
+    for p in pos.iter().flatten() {
+        for i in 0..p.len() {
+            total += p[i].distance(p[(i + 1) % p.len()]);
+            count += 1;
+        }
+    }
+    if count == 0 {
+        return 0;
+    }
+    let mut twins: Vec<(NodeRef, NodeRef)> = Vec::new();
+    let (mut sew_used, mut radius) = (tight, None);
+    if sew > 0.0 && reach.is_finite() {
+        let (adds, r, used) = insertions(faces, bodies, &pos, sew, tight, reach, total / count as f64);
+        (sew_used, radius) = (used, Some(r));
+        twins = insert(faces, &adds);
+    }
+    let radius = radius.unwrap_or_else(|| radii(&pos, tight, tight));
+    name_nodes(faces, bodies, &radius, &twins, sew_used, tight)
+}
+
+/// Each outline node's point on its face's surface.
+fn positions(faces: &[Option<(&dyn Surface, &mut Outline<'_>)>]) -> PerNode<DVec3> {
+    faces
+        .iter()
+        .map(|item| {
+            item.as_ref().map_or_else(Vec::new, |(s, o)| {
+                o.loops.polys.iter().map(|p| p.uv.iter().map(|&q| s.point(q)).collect()).collect()
+            })
+        })
+        .collect()
+}
+
+/// Each node's reach: `sew`, at most 0.3 of its shortest loop segment.
+/// Segments along a pole, and those shorter than a thousandth of `tight`
+/// (a trim edge far below any weld: its ends are one point), do not count.
+fn radii(pos: &PerNode<DVec3>, sew: f64, tight: f64) -> PerNode<f64> {
+    radii_each(pos, &|_| sew, tight)
+}
+
+/// [`radii`] with each node's own sewing distance.
+fn radii_each(pos: &PerNode<DVec3>, sew_of: &dyn Fn(NodeRef) -> f64, tight: f64) -> PerNode<f64> {
+    pos.iter()
+        .enumerate()
+        .map(|(fi, f)| {
+            f.iter()
+                .enumerate()
+                .map(|(k, p)| {
+                    let n = p.len();
+                    let scale = p.iter().fold(0.0f64, |m, q| m.max(q.abs().max_element())).max(1e-300);
+                    let length = |i: usize| {
+                        let l = p[i].distance(p[(i + 1) % n]);
+                        if l <= (1e-12 * scale).max(1e-3 * tight) {
+                            f64::INFINITY
+                        } else {
+                            l
+                        }
+                    };
+                    (0..n)
+                        .map(|i| {
+                            let sew = sew_of((fi as u32, k as u32, i as u32));
+                            sew.min(0.3 * length(i).min(length((i + n - 1) % n))).max(1e-12 * scale)
+                        })
+                        .collect()
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Per segment, the nodes of other borders to add to it: (fraction,
+/// curve parameter, the node it stands for), in order along it; and the
+/// sewing distance used.
+///
+/// The distance is what the model's gaps need, not `sew` blindly: four
+/// times the 90th percentile of the distances from border nodes to the
+/// nearest border of another face beside them, between `tight` and
+/// `sew`. A file whose faces meet exactly is sewn tightly, so a face
+/// pinched narrower than `sew` is not sewn across its neck; a patchwork
+/// with gaps gets the distance its gaps take. Gaps below an eighth of
+/// `sew` are always sewn, also where most of the model meets exactly:
+/// each side moves by half the gap, by default a fortieth of the tolerance.
+/// Two faces side by side with gaps of their own (a panel cut in a model
+/// that otherwise meets exactly) take four times the 90th percentile of
+/// theirs, counted at the nodes whose nearest other face is the other one
+/// and apart from it (a node both borders have is no gap, and one beside
+/// a thin face between them is nearer that face). Returns the additions,
+/// each node's reach, and the largest sewing distance used.
+fn insertions(
+    faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
+    bodies: &[u32],
+    pos: &PerNode<DVec3>,
+    sew: f64,
+    tight: f64,
+    reach: f64,
+    mean_segment: f64,
+) -> (Additions, PerNode<f64>, f64) {
+    let radius = radii(pos, sew, tight);
+    // Nodes hashed on a grid about one loop segment long.
+    let mut grid = CellGrid::new(1.0 / mean_segment.max(reach).max(1e-300));
+    for (fi, f) in pos.iter().enumerate() {
+        for (k, p) in f.iter().enumerate() {
+            for (i, &q) in p.iter().enumerate() {
+                grid.insert(q, (fi as u32, k as u32, i as u32));
+            }
+        }
+    }
+    let at = |n: NodeRef| pos[n.0 as usize][n.1 as usize][n.2 as usize];
+    let body = |f: usize| crate::model::body_of(bodies, f);
+    let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
+    // Every node on some other segment: (segment, fraction, curve parameter, distance, node).
+    let mut cands: Vec<(NodeRef, f64, f64, f64, NodeRef)> = Vec::new();
+    for (fi, item) in faces.iter().enumerate() {
+        let Some((surface, o)) = item else { continue };
+        for (k, poly) in o.loops.polys.iter().enumerate() {
+            let n = poly.uv.len();
+            for i in 0..n {
+                let j = (i + 1) % n;
+                let (na, nb) = ((fi as u32, k as u32, i as u32), (fi as u32, k as u32, j as u32));
+                let (pa, pb) = (at(na), at(nb));
+                let ab = pb - pa;
+                let dir = ab.normalize_or_zero();
+                let (curve, ta, tb) = poly.seg[i];
+                let Some(c) = o.loops.curves.get(curve as usize) else { continue };
+                let on_curve = |s: f64| surface.point(c.point(ta + (tb - ta) * s).truncate());
+                for &qn in grid.in_box(pa.min(pb) - DVec3::splat(reach), pa.max(pb) + DVec3::splat(reach)) {
+                    let (g, kk, jj) = (qn.0 as usize, qn.1 as usize, qn.2 as usize);
+                    if qn == na || qn == nb || body(g) != body(fi) {
+                        continue;
+                    }
+                    let q = at(qn);
+                    let limit = if g == fi { tight.min(r_of(qn)) } else { r_of(qn) };
+                    let s0 = ((q - pa).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
+                    if s0 <= 0.0 || s0 >= 1.0 {
+                        // Beyond an end, at most as far as the end: a
+                        // node the other border has too (a gap of nothing).
+                        let e = q.distance(pa).min(q.distance(pb));
+                        if e <= limit {
+                            cands.push((na, BEYOND, 0.0, e, qn));
+                        }
+                        continue;
+                    }
+                    if q.distance(pa + ab * s0) > reach {
+                        continue;
+                    }
+                    // The other border must run along this
+                    // one at q, not merely pass near it.
+                    let m = pos[g][kk].len();
+                    let parallel = [(jj + m - 1) % m, (jj + 1) % m]
+                        .iter()
+                        .any(|&nb| (pos[g][kk][nb] - q).normalize_or_zero().dot(dir).abs() >= 0.8);
+                    if !parallel {
+                        continue;
+                    }
+                    let (s, d) = nearest_fraction(&|s: f64| on_curve(s).distance(q), s0);
+                    if d <= limit && s > 1e-9 && s < 1.0 - 1e-9 {
+                        cands.push((na, s, ta + (tb - ta) * s, d, qn));
+                    } else if q.distance(pa).min(q.distance(pb)) <= limit {
+                        // At an end: recorded for the gap estimate only.
+                        cands.push((na, -1.0, 0.0, q.distance(pa).min(q.distance(pb)), qn));
+                    }
+                }
+            }
+        }
+    }
+    // A node goes only onto borders about as near as the nearest other
+    // face's: a face thinner than `sew` keeps its far border to itself.
+    // Of one face's borders it goes onto the nearest only (and onto
+    // another as near within `tight`, the other side of a seam): a face
+    // pinched narrower than `sew` is not sewn across its neck.
+    let mut nearest: HashMap<NodeRef, f64> = HashMap::default();
+    let mut nearest_face: HashMap<NodeRef, (u32, f64)> = HashMap::default();
+    let mut nearest_in: HashMap<(NodeRef, u32), f64> = HashMap::default();
+    for &(seg, s, _, d, q) in &cands {
+        if seg.0 != q.0 {
+            let e = nearest_face.entry(q).or_insert((super::NONE, f64::INFINITY));
+            if d < e.1 {
+                *e = (seg.0, d);
+            }
+        }
+        if s == BEYOND {
+            continue;
+        }
+        if seg.0 != q.0 {
+            let e = nearest.entry(q).or_insert(f64::INFINITY);
+            *e = e.min(d);
+        }
+        let e = nearest_in.entry((q, seg.0)).or_insert(f64::INFINITY);
+        *e = e.min(d);
+    }
+    // The gaps the model has, and those of each pair of faces side by
+    // side (counted at the nodes whose nearest other face is the other).
+    let q90 = |gaps: &mut Vec<f64>| {
+        gaps.sort_by(f64::total_cmp);
+        gaps.get((gaps.len() * 9) / 10).copied().unwrap_or(0.0)
+    };
+    let mut gaps: Vec<f64> = nearest.values().copied().collect();
+    let mut pair_gaps: HashMap<(u32, u32), Vec<f64>> = HashMap::default();
+    for (&q, &(g, d)) in &nearest_face {
+        if d > tight {
+            pair_gaps.entry((q.0.min(g), q.0.max(g))).or_default().push(d);
+        }
+    }
+    let ceiling = sew.max(tight);
+    let model_sew = (4.0 * q90(&mut gaps)).max(0.125 * sew).clamp(tight, ceiling);
+    let pair_sew: HashMap<(u32, u32), f64> = pair_gaps
+        .into_iter()
+        .map(|(key, mut g)| {
+            let s = if g.len() >= PAIR_MIN { 4.0 * q90(&mut g) } else { 0.0 };
+            (key, s.clamp(model_sew, ceiling))
+        })
+        .collect();
+    let sew_of = |q: NodeRef| {
+        nearest_face.get(&q).and_then(|&(g, _)| pair_sew.get(&(q.0.min(g), q.0.max(g)))).copied().unwrap_or(model_sew)
+    };
+    let radius = radii_each(pos, &sew_of, tight);
+    let sew = pair_sew.values().fold(model_sew, |m, &s| m.max(s));
+    let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
+    let mut adds: Additions =
+        pos.iter().map(|f| f.iter().map(|p| alloc::vec![Vec::new(); p.len()]).collect()).collect();
+    cands.sort_by(|x, y| x.3.total_cmp(&y.3));
+    for &(seg, s, t, d, q) in &cands {
+        let (fi, k, i) = (seg.0 as usize, seg.1 as usize, seg.2 as usize);
+        let limit = if seg.0 == q.0 { tight.min(r_of(q)) } else { r_of(q) };
+        let n = pos[fi][k].len();
+        let (na, nb) = (seg, (seg.0, seg.1, ((i + 1) % n) as u32));
+        let qp = at(q);
+        // Beyond reach, or within reach of an end (it will be that node).
+        if s < 0.0
+            || d > limit
+            || qp.distance(at(na)) <= limit.min(r_of(na))
+            || qp.distance(at(nb)) <= limit.min(r_of(nb))
+        {
+            continue;
+        }
+        // Within reach of another node of that face, nearer than this
+        // border: it will be that node, and a copy here would be a second.
+        let box_r = DVec3::splat(d.min(limit));
+        if grid.in_box(qp - box_r, qp + box_r).any(|&m| {
+            let e = qp.distance(at(m));
+            m.0 == seg.0 && m != q && e < d && e <= limit.min(r_of(m))
+        }) {
+            continue;
+        }
+        if seg.0 != q.0 && d > tight.max(4.0 * nearest.get(&q).copied().unwrap_or(0.0)) {
+            continue;
+        }
+        if d > nearest_in.get(&(q, seg.0)).copied().unwrap_or(0.0) + tight {
+            continue;
+        }
+        let list = &mut adds[fi][k][i];
+        // Two nodes within reach of each other will be one: add one.
+        if !list.iter().any(|c| at(c.2).distance(qp) <= r_of(c.2).min(r_of(q))) {
+            list.push((s, t, q));
+        }
+    }
+    for list in adds.iter_mut().flatten().flatten() {
+        list.sort_by(|x, y| x.0.total_cmp(&y.0));
+    }
+    (adds, radius, sew)
+}
+
+/// Adds the nodes to the outlines; returns each new node with the node
+/// it stands for (both by their places in the new outlines).
+fn insert(faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>], adds: &Additions) -> Vec<(NodeRef, NodeRef)> {
+    let mut twins = Vec::new();
+    // Where each old node went.
+    let mut moved: PerNode<u32> =
+        adds.iter().map(|f| f.iter().map(|p| (0..p.len() as u32).collect()).collect()).collect();
+    for (fi, item) in faces.iter_mut().enumerate() {
+        let Some((_, o)) = item else { continue };
+        for (k, add) in adds[fi].iter().enumerate() {
+            if add.iter().all(Vec::is_empty) {
+                continue;
+            }
+            let poly = &mut o.loops.polys[k];
+            let mut out = Polyline::default();
+            // Twins are named by their index in the new loop, fixed below.
+            let mut new_twins = Vec::new();
+            for i in 0..poly.uv.len() {
+                let (curve, ta, tb) = poly.seg[i];
+                moved[fi][k][i] = out.uv.len() as u32;
+                out.uv.push(poly.uv[i]);
+                out.at.push(poly.at[i]);
+                let mut from = ta;
+                for &(_, t, q) in &add[i] {
+                    let Some(c) = o.loops.curves.get(curve as usize) else { break };
+                    new_twins.push((out.uv.len() as u32, q));
+                    out.push_on_curve(curve, &mut from, t, c.point(t).truncate());
+                }
+                out.seg.push((curve, from, tb));
+            }
+            *poly = out;
+            o.gids[k] = alloc::vec![u32::MAX; poly.uv.len()];
+            twins.extend(new_twins.into_iter().map(|(i, q)| ((fi as u32, k as u32, i), q)));
+        }
+    }
+    for (_, q) in &mut twins {
+        q.2 = moved[q.0 as usize][q.1 as usize][q.2 as usize];
+    }
+    twins
+}
+
+/// Union-find over nodes, each cluster with its nodes' faces, points and reaches.
+struct Clusters {
+    parent: Vec<u32>,
+    members: Vec<Vec<(u32, DVec3, f64)>>,
+    tight: f64,
+}
+
+impl Clusters {
+    fn find(&mut self, mut x: u32) -> u32 {
+        while self.parent[x as usize] != x {
+            let p = self.parent[x as usize];
+            self.parent[x as usize] = self.parent[p as usize];
+            x = p;
+        }
+        x
+    }
+
+    /// Joins the clusters of `a` and `b` unless that would make two
+    /// nodes of one face one node that could not be one directly
+    /// (farther apart than `tight` or than either's reach).
+    fn union(&mut self, a: u32, b: u32) {
+        let (x, y) = (self.find(a), self.find(b));
+        if x == y {
+            return;
+        }
+        let tight = self.tight;
+        let clash = self.members[x as usize].iter().any(|&(f, p, rp)| {
+            self.members[y as usize].iter().any(|&(g, q, rq)| f == g && p.distance(q) > tight.min(rp).min(rq))
+        });
+        if clash {
+            return;
+        }
+        self.merge(x, y);
+    }
+
+    /// Joins the lone node `a` to the cluster of `b`, its neighbour a
+    /// segment away, if every node of their face there is within `tight` of it.
+    fn absorb(&mut self, a: u32, b: u32) -> bool {
+        let (x, y) = (self.find(a), self.find(b));
+        let Some(&(f, p, _)) = self.members[x as usize].first() else { return false };
+        if x == y || self.members[y as usize].iter().any(|&(g, q, _)| g == f && p.distance(q) > self.tight) {
+            return false;
+        }
+        self.merge(x, y);
+        true
+    }
+
+    /// Merges the clusters with roots `x` and `y`.
+    fn merge(&mut self, x: u32, y: u32) {
+        let (small, big) =
+            if self.members[x as usize].len() < self.members[y as usize].len() { (x, y) } else { (y, x) };
+        let moved = core::mem::take(&mut self.members[small as usize]);
+        self.members[big as usize].extend(moved);
+        self.parent[small as usize] = big;
+    }
+}
+
+/// Gives nodes within both their reaches of each other one id (within
+/// `tight` inside one face), new nodes the id of the node they stand for,
+/// and a lone node one short segment from a shared one that id.
+fn name_nodes(
+    faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>],
+    bodies: &[u32],
+    radius_before: &PerNode<f64>,
+    twins: &[(NodeRef, NodeRef)],
+    sew: f64,
+    tight: f64,
+) -> u32 {
+    let pos = positions(faces);
+    // Reach after insertion: a new node has its twin's, an old one keeps its own.
+    let mut radius: PerNode<f64> = pos.iter().map(|f| f.iter().map(|p| alloc::vec![0.0; p.len()]).collect()).collect();
+    let mut index: PerNode<u32> = pos.iter().map(|f| f.iter().map(|p| alloc::vec![0; p.len()]).collect()).collect();
+    let mut flat: Vec<(u32, DVec3)> = Vec::new();
+    for (fi, item) in faces.iter().enumerate() {
+        let Some((_, o)) = item else { continue };
+        for (k, poly) in o.loops.polys.iter().enumerate() {
+            let mut old = 0usize;
+            let new_here: crate::collections::HashSet<u32> =
+                twins.iter().filter(|(n, _)| n.0 as usize == fi && n.1 as usize == k).map(|(n, _)| n.2).collect();
+            for i in 0..poly.uv.len() {
+                if !new_here.contains(&(i as u32)) {
+                    radius[fi][k][i] = radius_before[fi][k].get(old).copied().unwrap_or(0.0);
+                    old += 1;
+                }
+                index[fi][k][i] = flat.len() as u32;
+                flat.push((fi as u32, pos[fi][k][i]));
+            }
+        }
+    }
+    // Twins name their node by its place in the new outlines, where the
+    // loop above has just put the old nodes' reaches (reading the old
+    // places instead gave a new node some other node's reach, often none).
+    for &(n, q) in twins {
+        let r = radius[q.0 as usize][q.1 as usize].get(q.2 as usize).copied().unwrap_or(0.0);
+        radius[n.0 as usize][n.1 as usize][n.2 as usize] = r;
+    }
+    let r_flat: Vec<f64> = radius.iter().flatten().flatten().copied().collect();
+    let mut cl = Clusters {
+        parent: (0..flat.len() as u32).collect(),
+        members: flat.iter().zip(&r_flat).map(|(&(f, p), &r)| alloc::vec![(f, p, r)]).collect(),
+        tight,
+    };
+    // Twins first (they are one node by construction), then neighbours by distance.
+    let id_of = |n: NodeRef, index: &PerNode<u32>| index[n.0 as usize][n.1 as usize].get(n.2 as usize).copied();
+    for &(n, q) in twins {
+        if let (Some(a), Some(b)) = (id_of(n, &index), id_of(q, &index)) {
+            cl.union(a, b);
+        }
+    }
+    if sew > 0.0 {
+        let mut grid = CellGrid::new(1.0 / sew);
+        for (i, &(_, p)) in flat.iter().enumerate() {
+            grid.insert(p, i as u32);
+        }
+        let body = |f: u32| crate::model::body_of(bodies, f as usize);
+        let mut pairs: Vec<(f64, u32, u32)> = Vec::new();
+        for (i, &(fi, p)) in flat.iter().enumerate() {
+            for &j in grid.near(p) {
+                if j as usize <= i {
+                    continue;
+                }
+                let (fj, q) = flat[j as usize];
+                if body(fi) != body(fj) {
+                    continue;
+                }
+                let d = p.distance(q);
+                let limit = if fi == fj { tight } else { sew };
+                if d <= limit.min(r_flat[i]).min(r_flat[j as usize]) {
+                    pairs.push((d, i as u32, j));
+                }
+            }
+        }
+        pairs.sort_by(|x, y| x.0.total_cmp(&y.0));
+        for (_, a, b) in pairs {
+            cl.union(a, b);
+        }
+        // A node no other face took, one segment shorter than `tight` from
+        // a node shared with a face within `sew` of it, is that node: there
+        // the other border has one node for this one's tiny jog. Only nodes
+        // shared before this take others in, so it does not run along a border.
+        let shared_before: Vec<bool> = (0..flat.len() as u32)
+            .map(|a| {
+                let r = cl.find(a);
+                cl.members[r as usize].len() > 1
+            })
+            .collect();
+        for (fi, item) in faces.iter().enumerate() {
+            let Some((_, o)) = item else { continue };
+            for (k, poly) in o.loops.polys.iter().enumerate() {
+                let n = poly.uv.len();
+                for i in 0..n {
+                    let a = index[fi][k][i];
+                    if shared_before[a as usize] {
+                        continue;
+                    }
+                    let p = flat[a as usize].1;
+                    for j in [(i + n - 1) % n, (i + 1) % n] {
+                        let b = index[fi][k][j];
+                        if b == a || !shared_before[b as usize] || flat[b as usize].1.distance(p) > tight {
+                            continue;
+                        }
+                        let rb = cl.find(b);
+                        let shared =
+                            cl.members[rb as usize].iter().any(|&(g, q, _)| g != fi as u32 && q.distance(p) <= sew);
+                        if shared && cl.absorb(a, b) {
+                            break;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Compact ids.
+    let mut ids: HashMap<u32, u32> = HashMap::default();
+    for (fi, item) in faces.iter_mut().enumerate() {
+        let Some((_, o)) = item else { continue };
+        for k in 0..o.gids.len() {
+            for i in 0..o.gids[k].len() {
+                let root = cl.find(index[fi][k][i]);
+                let next = ids.len() as u32;
+                o.gids[k][i] = *ids.entry(root).or_insert(next);
+            }
+        }
+    }
+    ids.len() as u32
+}
