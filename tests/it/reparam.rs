@@ -306,3 +306,53 @@ fn reparam_command_writes_iges() {
     assert!(!dir.join("out.stl").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A corpus file (`../shared/corpus`), when the corpus is there.
+fn corpus(name: &str) -> Option<Model> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus").join(name);
+    let bytes = std::fs::read(path).ok()?;
+    Some(read_iges(&bytes).unwrap())
+}
+
+/// Paper 001's acceptance on corpus faces the ratio test flags, each meshed
+/// on its own at the tolerance its model gets: with `auto` the rebuild is
+/// kept, with no more triangles than `off`, a higher 1st-percentile angle,
+/// and within tolerance of the ORIGINAL face by the yardstick.
+#[test]
+fn reparam_flagged_corpus_faces_win() {
+    // (file, face, relative tolerance)
+    let rows: &[(&str, usize, f64)] = &[("PRO20359-L1.igs", 0, 1e-2), ("PRO20359-L1.igs", 0, 1e-3)];
+    for &(file, index, rel) in rows {
+        let Some(m) = corpus(file) else {
+            println!("{file}: corpus not found, skipped");
+            continue;
+        };
+        let tol = mesh(&m, rel, Reparam::Off).report.tolerance;
+        let one = Model {
+            units: m.units.clone(),
+            faces: vec![m.faces[index].clone()],
+            warnings: Vec::new(),
+            tolerance: None,
+            bodies: Vec::new(),
+        };
+        assert!(step_ratio(&one.faces[0].surface) > RATIO_LIMIT, "{file} face {index}");
+        let run = |mode| mesh_model(&one, &MeshOptions::default().with_tolerance(tol).with_reparam(mode)).unwrap();
+        let (off, auto) = (run(Reparam::Off), run(Reparam::Auto));
+        let (o, a) = (&off.report, &auto.report);
+        let yard = measure_mesh(&one, &auto.mesh, &MeasureOptions::default().with_tolerance(tol));
+        println!(
+            "{file} face {index} at {rel}: off {} tris p1 {:.3}°, auto {} tris p1 {:.3}°, measured {:.3e} <= {tol:.3e}",
+            o.triangles, o.p1_angle_deg, a.triangles, a.p1_angle_deg, yard.max_deviation
+        );
+        assert!(a.reparameterized[0].rebuilt, "{file} face {index} at {rel}: {:?}", a.warnings);
+        assert!(a.triangles <= o.triangles, "{file} face {index} at {rel}: {} > {}", a.triangles, o.triangles);
+        assert!(
+            a.p1_angle_deg > o.p1_angle_deg,
+            "{file} face {index} at {rel}: p1 {} <= {}",
+            a.p1_angle_deg,
+            o.p1_angle_deg
+        );
+        assert!(yard.max_deviation <= tol, "{file} face {index} at {rel}: {} > {tol}", yard.max_deviation);
+        assert!(a.max_deviation <= tol && a.inverted_triangles == 0, "{file} face {index} at {rel}");
+    }
+}
