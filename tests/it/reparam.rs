@@ -324,7 +324,8 @@ fn reparam_flagged_corpus_faces_win() {
     let mut rows: Vec<(&str, usize, f64)> = vec![("PRO20359-L1.igs", 0, 1e-2), ("PRO20359-L1.igs", 0, 1e-3)];
     // Face 5's loop closes with a stub of no length (the rebuilt loop crossed itself).
     rows.extend((0..8).map(|f| ("asmo_car.igs", f, 1e-2)));
-    rows.extend([1, 3, 4, 6, 7].map(|f| ("asmo_car.igs", f, 1e-3)));
+    // Face 0 at 1e-3: the rebuild takes fewer triangles, but few long ones on a thin face.
+    rows.extend([0, 1, 3, 4, 5, 6, 7].map(|f| ("asmo_car.igs", f, 1e-3)));
     let mut tols = std::collections::HashMap::new();
     for (file, index, rel) in rows {
         let Some(m) = corpus(file) else {
