@@ -120,10 +120,10 @@ impl Surface for FaceSurface {
     }
     fn breaks(&self, along_u: bool) -> Vec<f64> {
         match self {
-            // Every 8th knot: the mesher's first intervals then follow the
-            // samples (spaced by model-space length) at about a quarter of the
-            // chords the tolerance needs, so its interval splitting stays
-            // local where curvature varies, without forcing rows at coarse tolerances.
+            // Every 8th knot: where breaks still start intervals (the border
+            // loop of an untrimmed face, projection, quality mode) they follow
+            // the samples, spaced by model-space length, without forcing
+            // rows at coarse tolerances. The grid ignores them ([`Surface::even_parameters`]).
             Self::Rebuilt(s) => {
                 let b = s.breaks(along_u);
                 let last = b.len().saturating_sub(1);
@@ -131,6 +131,9 @@ impl Surface for FaceSurface {
             }
             _ => self.base_nurbs().breaks(along_u),
         }
+    }
+    fn even_parameters(&self) -> bool {
+        matches!(self, Self::Rebuilt(_))
     }
     fn bounding_box(&self) -> Aabb {
         match self {

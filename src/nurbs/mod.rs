@@ -56,6 +56,12 @@ pub trait Surface {
     fn breaks(&self, along_u: bool) -> Vec<f64>;
     /// A box that contains the surface.
     fn bounding_box(&self) -> Aabb;
+    /// Whether parameters follow model-space length and the surface is C²
+    /// across its knots (paper 001's rebuild): its knots then mark no feature
+    /// the mesher's grid must start from.
+    fn even_parameters(&self) -> bool {
+        false
+    }
 
     /// Unit normal `Su × Sv`, defined also where the surface degenerates.
     ///

@@ -608,10 +608,29 @@ fn rebuild_loop(
         at
     };
     // Loop vertices landed once, so curves meet exactly.
-    let ends: Vec<DVec2> = lp.curves.iter().map(|c| land(c.point(c.domain().0).truncate())).collect();
+    let mut ends: Vec<DVec2> = lp.curves.iter().map(|c| land(c.point(c.domain().0).truncate())).collect();
+    // A piece of no length in model space whose ends land within a millionth
+    // of the unit domain (a stub a file's loop closes with; not a piece along
+    // a pole) is left out, its neighbours meeting there: as a curve it would
+    // double back over them.
+    let n = lp.curves.len();
+    let mut stub = vec![false; n];
+    for (ci, c) in lp.curves.iter().enumerate() {
+        let next = (ci + 1) % n;
+        if n - stub.iter().filter(|&&s| s).count() > 1
+            && ends[ci].distance(ends[next]) <= 1e-6
+            && model_length(old, c) <= 1e-3 * goal
+        {
+            stub[ci] = true;
+            ends[next] = ends[ci];
+        }
+    }
     let mut out = Vec::with_capacity(lp.curves.len());
     let mut worst = 0.0f64;
     for (ci, c) in lp.curves.iter().enumerate() {
+        if stub[ci] {
+            continue;
+        }
         let start = ends[ci];
         let end = ends[(ci + 1) % ends.len()];
         let (a, b) = c.domain();
@@ -647,6 +666,15 @@ fn rebuild_loop(
                     }
                 })
                 .collect();
+            if degenerate {
+                // The mapped path (along a pole) moved to the landed ends: the map
+                // is only close to where projection puts them.
+                let (d0, d1) = (start - st[0], end - st[samples]);
+                for (i, q) in st.iter_mut().enumerate() {
+                    let x = i as f64 / samples as f64;
+                    *q += d0 * (1.0 - x) + d1 * x;
+                }
+            }
             st[0] = start;
             st[samples] = end;
             // The samples are equally spaced in model space: equal parameter steps keep the
@@ -678,6 +706,13 @@ fn rebuild_loop(
         }
     }
     Ok((out, worst))
+}
+
+/// Length in model space of the trim curve `c` on `surface`, from 64 chords.
+fn model_length(surface: &FaceSurface, c: &NurbsCurve) -> f64 {
+    let (a, b) = c.domain();
+    let pts: Vec<DVec3> = (0..=64).map(|k| surface.point(c.point(a + (b - a) * k as f64 / 64.0).truncate())).collect();
+    pts.windows(2).map(|w| w[0].distance(w[1])).sum()
 }
 
 /// Distance from `q` to the segment `a`–`b`.
@@ -715,6 +750,40 @@ mod tests {
         let k = vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
         let even = NurbsSurface::try_new([3, 3], k.clone(), k, &pts, None).unwrap();
         assert!(step_ratio(&even) < RATIO_LIMIT, "ratio {}", step_ratio(&even));
+    }
+
+    /// A polyline loop that closes with a stub of no length on the border
+    /// (asmo_car's face 5 ends its loop 1e-6 past the point it started from):
+    /// the stub is left out of the rebuilt loop rather than made a curve that
+    /// doubles back over its neighbours, and the rebuilt face meshes.
+    #[test]
+    fn loop_stub_of_no_length_is_left_out() {
+        let d = 1e-7;
+        let corners =
+            [(1.0, 0.6 + d), (1.0, 1.0), (0.0, 1.0), (0.0, 0.0), (1.0, 0.0), (1.0, 0.4), (0.5, 0.5), (1.0, 0.6)];
+        let mut pts: Vec<DVec3> = corners.iter().map(|&(u, v)| DVec3::new(u, v, 0.0)).collect();
+        pts.push(pts[0]);
+        let mut knots = vec![0.0];
+        knots.extend((0..pts.len()).map(|k| k as f64));
+        knots.push((pts.len() - 1) as f64);
+        let lp = TrimLoop { curves: vec![NurbsCurve::try_new(1, knots, pts, None).unwrap()] };
+        let face = Face { name: None, surface: FaceSurface::Nurbs(crowded()), loops: vec![lp] };
+        let pieces = split_at_corners(&face.surface, &face.loops[0]).curves.len();
+        let r = rebuild_face(&face, 0.01).unwrap();
+        assert_eq!(r.face.loops[0].curves.len(), pieces - 1);
+        for c in &r.face.loops[0].curves {
+            let (a, b) = c.domain();
+            assert!(c.point(a).distance(c.point(b)) > 1e-3, "a curve of no extent: {:?}", c.point(a));
+        }
+        let model = crate::Model {
+            units: "mm".into(),
+            faces: vec![r.face],
+            warnings: Vec::new(),
+            tolerance: None,
+            bodies: Vec::new(),
+        };
+        let m = crate::mesh_model(&model, &crate::MeshOptions::default().with_tolerance(0.01)).unwrap();
+        assert!(m.report.triangles > 0 && m.report.faces_skipped == 0, "{:?}", m.report.warnings);
     }
 
     #[test]

@@ -400,9 +400,19 @@ pub(crate) fn initial_from_outline(
     o: &Outline<'_>,
     budget: usize,
 ) -> Result<WorkMesh, Error> {
-    check_grid(index, &o.pu, &o.pv, budget)?;
+    // The grid's rectangle is the loops' box, which may reach far beyond
+    // the region they keep (a rebuilt face's loops on its whole old domain):
+    // a grid up to four times the budget is triangulated, and judged by the
+    // triangles the loops keep.
+    let cells = o.pu.len().saturating_sub(1).saturating_mul(o.pv.len().saturating_sub(1));
+    if cells > budget.saturating_mul(2).min(MAX_BAND_CELLS) {
+        check_grid(index, &o.pu, &o.pv, budget)?;
+    }
     let band = Band::new(surface, &o.loops, &o.pu, &o.pv);
     let tris = band.triangulate(index)?;
+    if tris.len() > budget {
+        check_grid(index, &o.pu, &o.pv, budget)?;
+    }
     let mut wm = WorkMesh::default();
     band.build(surface, &tris, &mut wm, Some(&o.gids));
     Ok(wm)
@@ -420,6 +430,11 @@ fn trimmed<'a>(
 ) -> Result<Vec<&'a crate::NurbsCurve>, Error> {
     Err(Error::Mesh { face: index, message: "trimmed faces need the `std` feature".into() })
 }
+
+/// Most cells of a grid over the budget that [`initial_from_outline`] still
+/// triangulates to count what its loops keep.
+#[cfg(feature = "std")]
+const MAX_BAND_CELLS: usize = 1_000_000;
 
 pub(super) fn check_grid(index: usize, pu: &[f64], pv: &[f64], budget: usize) -> Result<(), Error> {
     let cells = pu.len().saturating_sub(1).saturating_mul(pv.len().saturating_sub(1));

@@ -143,6 +143,8 @@ pub fn mesh_model_with_progress(
             if failed || auto {
                 let orig = orig.unwrap_or_else(|| face::mesh_face(index, original, &lim, &crit, budget, auto_tight));
                 let mut why = rebuild_loses(&fr, &orig);
+                // The mesh shorter edges may start from: the capped one, or the free one where it failed.
+                let mut start = (fr, face_lim, face_crit);
                 if why.is_some() && auto && cap.is_finite() {
                     // The edge cap follows the sharpest bend; where that bend
                     // is local, the rebuild may pay without it.
@@ -150,6 +152,14 @@ pub fn mesh_model_with_progress(
                     let c = refine::Criteria { max_edge: crit.max_edge, ..face_crit };
                     let free = face::mesh_face(index, f, &l, &c, trial, auto_tight);
                     if rebuild_loses(&free, &orig).is_none() {
+                        (why, face_lim, face_crit) = (None, l, c);
+                    } else if start.0.is_err() {
+                        start = (free, l, c);
+                    }
+                }
+                if why.is_some() && auto {
+                    let (r, l, c) = &start;
+                    if let Some((l, c)) = shorter_edges(index, f, r, &orig, (l, c), trial, auto_tight) {
                         (why, face_lim, face_crit) = (None, l, c);
                     }
                 }
@@ -408,6 +418,56 @@ fn reparameterize(model: &Model, mine: &[bool], mode: Reparam, tol: f64, report:
         }
     }
     out
+}
+
+/// Most meshes [`shorter_edges`] tries.
+const SHORTER_TRIES: usize = 6;
+
+/// Beyond paper 001: a rebuilt face whose mesh `rebuilt` takes fewer
+/// triangles than the original's but loses on shape (a thin face meshed by
+/// few long triangles) may spend the difference on shorter edges. The edge
+/// limit starts at half the longest edge and falls by √2 a try (about twice
+/// the triangles), until the mesh wins or takes more triangles than the
+/// original's; the limits of the winning mesh, if one does.
+fn shorter_edges(
+    index: usize,
+    face: &crate::Face,
+    rebuilt: &Result<face::FaceResult, Error>,
+    original: &Result<face::FaceResult, Error>,
+    (lim, crit): (&params::Limits, &refine::Criteria),
+    budget: usize,
+    tight: f64,
+) -> Option<(params::Limits, refine::Criteria)> {
+    let (Ok(new), Ok(old)) = (rebuilt, original) else { return None };
+    if new.mesh.tris.is_empty() || new.mesh.tris.len() >= old.mesh.tris.len() {
+        return None;
+    }
+    let pos = |v: u32| new.mesh.pos.get(v as usize).copied().unwrap_or_default();
+    let longest = new
+        .mesh
+        .tris
+        .iter()
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .map(|(a, b)| pos(a).distance(pos(b)))
+        .fold(0.0f64, f64::max);
+    let mut edge = 0.5 * longest;
+    for _ in 0..SHORTER_TRIES {
+        if !(edge > crit.min_edge && edge.is_finite()) {
+            return None;
+        }
+        let l = params::Limits { max_edge: lim.max_edge.min(edge), ..*lim };
+        let c = refine::Criteria { max_edge: crit.max_edge.min(edge), ..*crit };
+        let r = face::mesh_face(index, face, &l, &c, budget, tight);
+        match &r {
+            Ok(m) if !m.mesh.tris.is_empty() && m.mesh.tris.len() <= old.mesh.tris.len() => {}
+            _ => return None,
+        }
+        if rebuild_loses(&r, original).is_none() {
+            return Some((l, c));
+        }
+        edge *= core::f64::consts::FRAC_1_SQRT_2;
+    }
+    None
 }
 
 /// Why the mesh of a rebuilt face loses to the original's, if it does: it

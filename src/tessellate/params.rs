@@ -39,6 +39,15 @@ pub(crate) const MAX_PARAMS: usize = 20_000;
 /// How badly the interval `[a, b]` fails: the factor by which it must be
 /// split (1.0 = accepted). `eval(t)` gives point and unit normal (or tangent).
 fn interval_need(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits) -> (f64, f64) {
+    let (demand, sag) = interval_demand(eval, a, b, lim);
+    (demand.max(1.0), sag)
+}
+
+/// How many chords `[a, b]` needs, as a fraction, and its largest sag: sag
+/// falls as the square of the step, turn and length as the step, so over
+/// short intervals the demand adds up along the curve. 0 at or below the
+/// shortest edge.
+fn interval_demand(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits) -> (f64, f64) {
     let (pa, na) = eval(a);
     let (pb, nb) = eval(b);
     let chord = pb - pa;
@@ -51,19 +60,19 @@ fn interval_need(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Lim
         turn = turn.max(crate::math::angle_between(na, n)).max(crate::math::angle_between(n, nb));
     }
     if len <= lim.min_edge {
-        return (1.0, sag);
+        return (0.0, sag);
     }
-    let mut need: f64 = 1.0;
-    if sag > lim.tol {
-        need = need.max(sqrt(sag / lim.tol));
+    let mut demand: f64 = 0.0;
+    if sag > 0.0 {
+        demand = demand.max(sqrt(sag / lim.tol));
     }
-    if turn > lim.angle {
-        need = need.max(turn / lim.angle);
+    if turn > 0.0 {
+        demand = demand.max(turn / lim.angle);
     }
-    if len > lim.max_edge {
-        need = need.max(len / lim.max_edge);
+    if len > 0.0 {
+        demand = demand.max(len / lim.max_edge);
     }
-    (need, sag)
+    (demand, sag)
 }
 
 /// Distance from `p` to the segment `ab`.
@@ -223,7 +232,15 @@ fn split_rec(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits, depth: usize, o
 }
 
 fn need_all(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits) -> (f64, f64) {
-    let mut need: f64 = 1.0;
+    over_probes(probes, a, b, lim, interval_need, 1.0)
+}
+
+/// A test of one interval of one curve: a need and the largest sag.
+type IntervalTest = fn(&dyn Fn(f64) -> (DVec3, DVec3), f64, f64, &Limits) -> (f64, f64);
+
+/// The largest `test` over the parts of `[a, b]` where each probe matters, starting from `floor`.
+fn over_probes(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits, test: IntervalTest, floor: f64) -> (f64, f64) {
+    let mut need: f64 = floor;
     let mut sag: f64 = 0.0;
     let mut take = |(n, s): (f64, f64)| {
         need = need.max(n);
@@ -231,7 +248,7 @@ fn need_all(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits) -> (f64, f64) {
     };
     for p in probes {
         match &p.inside {
-            None => take(interval_need(p.eval, a, b, lim)),
+            None => take(test(p.eval, a, b, lim)),
             Some(pieces) => {
                 // Only the part of [a, b] inside the region is tested; a piece
                 // a rounding error long says nothing.
@@ -239,13 +256,82 @@ fn need_all(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits) -> (f64, f64) {
                 for &(lo, hi) in pieces {
                     let (x, y) = (a.max(lo), b.min(hi));
                     if y - x > eps {
-                        take(interval_need(p.eval, x, y, lim));
+                        take(test(p.eval, x, y, lim));
                     }
                 }
             }
         }
     }
     (need, sag)
+}
+
+/// Fine intervals whose demand [`equidistribute`] sums.
+const FINE: usize = 256;
+
+/// Parameters over `[t0, t1]` of a surface with even parameters (paper
+/// 001's rebuild), where knots mark no feature: the fractional chord demand
+/// of [`FINE`] equal intervals is summed and the lines put at equal shares
+/// of it (equidistribution), so the rows follow curvature without the
+/// rounding up that one equal split per knot group costs. An interval that
+/// still fails raises the demand under it and the lines are placed again;
+/// after four rounds what fails is split as [`subdivide_probes`] splits.
+fn equidistribute(probes: &[Probe<'_>], t0: f64, t1: f64, lim: &Limits) -> (Vec<f64>, f64) {
+    let xs: Vec<f64> =
+        (0..=FINE).map(|k| if k == FINE { t1 } else { t0 + (t1 - t0) * k as f64 / FINE as f64 }).collect();
+    let mut demand: Vec<f64> =
+        xs.windows(2).map(|w| over_probes(probes, w[0], w[1], lim, interval_demand, 0.0).0).collect();
+    let gap = (t1 - t0) * 1e-9;
+    for round in 0..4 {
+        let mut cum = Vec::with_capacity(FINE + 1);
+        cum.push(0.0);
+        for d in &demand {
+            cum.push(cum.last().copied().unwrap_or(0.0) + d);
+        }
+        let total = cum[FINE];
+        if !(total.is_finite() && total < MAX_PARAMS as f64) {
+            break;
+        }
+        let n = (ceil(total) as usize).max(1);
+        let mut ts = Vec::with_capacity(n + 1);
+        ts.push(t0);
+        for k in 1..n {
+            let target = total * k as f64 / n as f64;
+            let i = cum.partition_point(|&c| c <= target).clamp(1, FINE) - 1;
+            let w = if cum[i + 1] > cum[i] { (target - cum[i]) / (cum[i + 1] - cum[i]) } else { 0.0 };
+            let t = xs[i] + (xs[i + 1] - xs[i]) * w.clamp(0.0, 1.0);
+            if t > ts.last().copied().unwrap_or(t0) + gap && t < t1 - gap {
+                ts.push(t);
+            }
+        }
+        ts.push(t1);
+        let needs: Vec<(f64, f64)> = ts.windows(2).map(|w| need_all(probes, w[0], w[1], lim)).collect();
+        if needs.iter().all(|&(nd, _)| nd <= 1.0) || round == 3 {
+            let mut out = Vec::with_capacity(ts.len());
+            out.push(t0);
+            let mut worst: f64 = 0.0;
+            for (w, &(nd, sag)) in ts.windows(2).zip(&needs) {
+                if nd <= 1.0 {
+                    worst = worst.max(sag);
+                    out.push(w[1]);
+                } else {
+                    split_rec(probes, w[0], w[1], lim, 0, &mut out, &mut worst);
+                }
+            }
+            return (out, worst);
+        }
+        // The fine intervals under a failing one take its need (sag falls as h², so
+        // its square root scales the step), and a little over against rounding.
+        for (w, &(nd, _)) in ts.windows(2).zip(&needs) {
+            if nd > 1.0 {
+                for (k, d) in demand.iter_mut().enumerate() {
+                    if xs[k + 1] > w[0] && xs[k] < w[1] {
+                        *d *= nd * 1.02;
+                    }
+                }
+            }
+        }
+    }
+    subdivide_probes(probes, &[t0, t1], lim)
 }
 
 /// Initial intervals along one direction: the knot breaks inside `[lo, hi]`,
@@ -312,6 +398,9 @@ pub(crate) fn grid_params(
     let curves: Vec<_> = (0..=lines).map(|k| s0 + (s1 - s0) * k as f64 / lines as f64).map(|s| (s, make(s))).collect();
     let probes: Vec<Probe<'_>> =
         curves.iter().map(|(s, c)| Probe { eval: c, inside: region.map(|r| r(along_u, *s)) }).collect();
+    if surface.even_parameters() && t1 > t0 {
+        return equidistribute(&probes, t0, t1, lim);
+    }
     let breaks = initial_breaks(&surface.breaks(along_u), t0, t1, 16);
     subdivide_probes(&probes, &breaks, lim)
 }
@@ -365,6 +454,30 @@ mod tests {
         // A chord the caller rejects (a straight (u,v) segment off the surface) is not taken.
         let none = |_: f64, _: f64| false;
         assert_eq!(coarsen(&[&line], &none, &ts_line(), &lim(0.01)).len(), 17);
+    }
+
+    /// On a curve whose bend is concentrated (a parabola sharp at one end),
+    /// equidistributed lines all pass, and are fewer than equal splits of 16
+    /// knot groups give: those round up in every group.
+    #[test]
+    fn equidistributed_lines_pass_with_fewer_intervals() {
+        let curve = |t: f64| {
+            let x = 3.0 * t;
+            let p = DVec3::new(x, 0.0, 2.0 * (1.0 - t) * (1.0 - t) * (1.0 - t));
+            let d = DVec3::new(3.0, 0.0, -6.0 * (1.0 - t) * (1.0 - t)).normalize();
+            (p, DVec3::new(-d.z, 0.0, d.x))
+        };
+        let probes = [Probe { eval: &curve, inside: None }];
+        let l = lim(1e-3);
+        let (even, _) = equidistribute(&probes, 0.0, 1.0, &l);
+        let breaks: Vec<f64> = (0..=16).map(|k| k as f64 / 16.0).collect();
+        let (grouped, _) = subdivide_probes(&probes, &breaks, &l);
+        assert!(even.len() < grouped.len(), "{} lines against {}", even.len(), grouped.len());
+        assert!(even.windows(2).all(|w| w[1] > w[0]), "{even:?}");
+        assert_eq!((even[0], even[even.len() - 1]), (0.0, 1.0));
+        for w in even.windows(2) {
+            assert!(need_all(&probes, w[0], w[1], &l).0 <= 1.0, "interval {w:?} fails");
+        }
     }
 
     fn ts_line() -> Vec<f64> {
