@@ -274,6 +274,15 @@ fn domain_outline<'a>(surface: &dyn Surface, loops: &'a [crate::TrimLoop], lim: 
         return None;
     }
     let n = at.len();
+    // A segment follows one piece to its end at most: a node must start
+    // every piece, else the segment's curve stops short of its end node.
+    let pieces = lp.curves.len() as u32;
+    if (0..n).any(|i| {
+        let (a, b) = (at[i], at[(i + 1) % n]);
+        !(b.curve == a.curve && b.t > a.t || b.curve == (a.curve + 1) % pieces && b.t == 0.0)
+    }) {
+        return None;
+    }
     let seg = (0..n)
         .map(|i| {
             let (a, b) = (at[i], at[(i + 1) % n]);
@@ -368,8 +377,12 @@ pub(crate) fn domain_loop(surface: &dyn Surface) -> Option<crate::TrimLoop> {
     if !(hi.x > lo.x && hi.y > lo.y) {
         return None;
     }
-    let bu = super::params::initial_breaks(&surface.breaks(true), lo.x, hi.x, 16);
-    let bv = super::params::initial_breaks(&surface.breaks(false), lo.y, hi.y, 16);
+    // A surface C² across its knots (a rebuilt one) kinks nowhere: its grid
+    // lines ignore the knots, and so do its border's pieces, each of which
+    // must start at a border node.
+    let breaks = |along_u: bool| if surface.even_parameters() { Vec::new() } else { surface.breaks(along_u) };
+    let bu = super::params::initial_breaks(&breaks(true), lo.x, hi.x, 16);
+    let bv = super::params::initial_breaks(&breaks(false), lo.y, hi.y, 16);
     let corners = rect_border(lo, hi, &bu, &bv);
     let n = corners.len();
     let mut curves = Vec::with_capacity(n);

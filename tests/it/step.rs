@@ -371,6 +371,27 @@ fn corpus_meshes_within_tolerance_watertight() {
     assert!(failures.is_empty(), "STEP corpus failures:\n{}", failures.join("\n"));
 }
 
+/// The fuselage's eight untrimmed faces are poorly parameterized; rebuilt
+/// (`auto`), their border pieces must start at border nodes as their grid
+/// lines fall, or a border edge follows its curve only part of its way, is
+/// never split where a neighbour's nodes are, and the closed shell opens.
+#[test]
+fn corpus_fuselage_rebuilt_faces_keep_the_shell_closed() {
+    let path = corpus_dir().join("bug28366_fuselage.stp");
+    let Ok(bytes) = std::fs::read(&path) else {
+        eprintln!("no corpus at {}: test not run", corpus_dir().display());
+        return;
+    };
+    let (model, shells) = read_step_with_shells(&bytes).expect("reads");
+    let options = MeshOptions::default().with_relative_tolerance(1e-3).with_reparam(surfmesh::Reparam::Auto);
+    let r = mesh_model(&model, &options).expect("meshes");
+    let rep = &r.report;
+    assert!(rep.reparameterized.iter().filter(|f| f.rebuilt).count() >= 4, "{:?}", rep.reparameterized);
+    assert!(rep.max_deviation <= rep.tolerance, "deviation {} > {}", rep.max_deviation, rep.tolerance);
+    assert_eq!((rep.free_edges, rep.boundary_edges, rep.inverted_triangles), (0, 0, 0));
+    assert_eq!(closed_shell_defects(&r, &shells), (0, 0));
+}
+
 /// Found by fuzzing (a timeout): a mutated bicubic sheet whose control point
 /// pulled far out folds the surface inside the face. Across the fold the
 /// normal flips however small the triangle, so the angle limit split down to
