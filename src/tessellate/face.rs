@@ -277,18 +277,18 @@ fn domain_outline<'a>(surface: &dyn Surface, loops: &'a [crate::TrimLoop], lim: 
     // A segment follows one piece to its end at most: a node must start
     // every piece, else the segment's curve stops short of its end node.
     let pieces = lp.curves.len() as u32;
-    if (0..n).any(|i| {
-        let (a, b) = (at[i], at[(i + 1) % n]);
-        !(b.curve == a.curve && b.t > a.t || b.curve == (a.curve + 1) % pieces && b.t == 0.0)
-    }) {
-        return None;
-    }
     let seg = (0..n)
         .map(|i| {
             let (a, b) = (at[i], at[(i + 1) % n]);
-            (a.curve, a.t, if b.curve == a.curve && b.t > a.t { b.t } else { 1.0 })
+            if b.curve == a.curve && b.t > a.t {
+                Some((a.curve, a.t, b.t))
+            } else if b.curve == (a.curve + 1) % pieces && b.t == 0.0 {
+                Some((a.curve, a.t, 1.0))
+            } else {
+                None
+            }
         })
-        .collect();
+        .collect::<Option<Vec<_>>>()?;
     let loops = Loops { polys: alloc::vec![Polyline { uv, at, seg }], curves: lp.curves.iter().collect() };
     let gids = alloc::vec![alloc::vec![u32::MAX; n]];
     Some(Outline { loops, pu, pv, gids })

@@ -64,19 +64,7 @@ pub(crate) fn close_slivers(faces: &mut [FaceWork<'_>], width: f64) -> usize {
 /// its inner side is the border, and what is left open beside that is a
 /// hole the passes after close. Returns how many it removed.
 fn remove_flaps(faces: &mut [FaceWork<'_>], width: f64) -> usize {
-    let mut uses: HashMap<(u32, u32), u32> = HashMap::default();
-    for f in faces.iter() {
-        let m = &f.mesh;
-        for t in &m.tris {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                let (ga, gb) = (m.gid[a as usize], m.gid[b as usize]);
-                if ga != NONE && gb != NONE && ga != gb && m.edge_triangles(a, b) == 1 {
-                    *uses.entry((ga.min(gb), ga.max(gb))).or_default() += 1;
-                }
-            }
-        }
-    }
+    let (_, uses) = border_sides(faces);
     let used = |m: &super::refine::WorkMesh, a: u32, b: u32| {
         let (ga, gb) = (m.gid[a as usize], m.gid[b as usize]);
         if ga == NONE || gb == NONE || ga == gb {
@@ -119,10 +107,9 @@ fn remove_flaps(faces: &mut [FaceWork<'_>], width: f64) -> usize {
     removed
 }
 
-/// Border edges used once in the whole model, and the edges at each node.
-fn open_sides(faces: &[FaceWork<'_>]) -> (Vec<Side>, HashMap<u32, Vec<usize>>) {
-    // Border edges whose ends are model nodes, and how often each pair of
-    // nodes is a border edge anywhere (twice: two faces meet there).
+/// Border edges whose ends are model nodes, and how often each pair of
+/// nodes is a border edge anywhere (twice: two faces meet there).
+fn border_sides(faces: &[FaceWork<'_>]) -> (Vec<Side>, HashMap<(u32, u32), u32>) {
     let mut sides: Vec<Side> = Vec::new();
     let mut uses: HashMap<(u32, u32), u32> = HashMap::default();
     for (fi, f) in faces.iter().enumerate() {
@@ -139,6 +126,12 @@ fn open_sides(faces: &[FaceWork<'_>]) -> (Vec<Side>, HashMap<u32, Vec<usize>>) {
             }
         }
     }
+    (sides, uses)
+}
+
+/// Border edges used once in the whole model, and the edges at each node.
+fn open_sides(faces: &[FaceWork<'_>]) -> (Vec<Side>, HashMap<u32, Vec<usize>>) {
+    let (sides, uses) = border_sides(faces);
     let open: Vec<Side> =
         sides.into_iter().filter(|s| uses.get(&(s.ga.min(s.gb), s.ga.max(s.gb))) == Some(&1)).collect();
     // Faces need not agree on orientation, so the hole's sides are joined
@@ -328,23 +321,6 @@ mod tests {
         m
     }
 
-    /// Border edges (one triangle in their face) each pair of nodes is, over all faces.
-    fn border_uses(faces: &[FaceWork<'_>]) -> HashMap<(u32, u32), u32> {
-        let mut uses: HashMap<(u32, u32), u32> = HashMap::default();
-        for f in faces {
-            for t in &f.mesh.tris {
-                for k in 0..3 {
-                    let (a, b) = (t[k], t[(k + 1) % 3]);
-                    let (ga, gb) = (f.mesh.gid[a as usize], f.mesh.gid[b as usize]);
-                    if ga != NONE && gb != NONE && f.mesh.edge_triangles(a, b) == 1 {
-                        *uses.entry((ga.min(gb), ga.max(gb))).or_default() += 1;
-                    }
-                }
-            }
-        }
-        uses
-    }
-
     /// The lower face's border node 3 pokes 0.03 over the upper face's
     /// border 1-2: no triangle between them faces the plane's way, so the
     /// upper face's border takes node 3, and no border edge is left unpaired.
@@ -359,9 +335,9 @@ mod tests {
         );
         let work = |mesh| FaceWork { surface: &plane, curves: Vec::new(), mesh, crit: CRIT };
         let mut faces = alloc::vec![work(upper), work(lower)];
-        assert_eq!(border_uses(&faces).get(&(1, 2)), Some(&1));
+        assert_eq!(border_sides(&faces).1.get(&(1, 2)), Some(&1));
         assert_eq!(close_slivers(&mut faces, 0.1), 1);
-        let uses = border_uses(&faces);
+        let uses = border_sides(&faces).1;
         for pair in [(1, 3), (2, 3)] {
             assert_eq!(uses.get(&pair), Some(&2), "{pair:?} is not shared");
         }
@@ -405,10 +381,10 @@ mod tests {
             work(beside(15.0)),
             work(mesh(&[(10.0, 10.0, 3), (10.0, 15.0, NONE), (10.03, 5.0, 2)], &[[0, 1, 2]]))
         ];
-        assert_eq!(border_uses(&faces).get(&(2, 3)), Some(&3));
+        assert_eq!(border_sides(&faces).1.get(&(2, 3)), Some(&3));
         assert_eq!(remove_flaps(&mut faces, 0.1), 1);
         assert_eq!(faces[0].mesh.tris.len(), 2);
-        let uses = border_uses(&faces);
+        let uses = border_sides(&faces).1;
         assert_eq!(uses.get(&(2, 3)), Some(&2));
         assert_eq!(uses.get(&(1, 3)), Some(&1));
         assert!(!uses.contains_key(&(1, 2)));

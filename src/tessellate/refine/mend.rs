@@ -275,23 +275,41 @@ impl WorkMesh {
         self.gid[x as usize] = gid;
         self.add_triangle([b, a, x], [uv_b, uv_a, uv]);
         self.measure_slots();
-        let nt = self.tris.len() - 1;
-        let (m, turn) = self.cached_measure(surface, nt, c);
-        let (_, _, len) = self.longest_edge(nt);
-        let fits = m.max <= c.tol && (turn <= c.angle || c.short_for_angle(&m, turn, len));
-        if fits && !self.inverted(surface, nt) {
+        if self.fits_placed(surface, c, self.tris.len() - 1) {
             return true;
         }
+        self.pop_triangle();
+        self.truncate_vertices(old_v);
+        false
+    }
+
+    /// Whether triangle `t`, just placed, passes the limits (a turn refinement
+    /// keeps too passes, see [`Self::turn_ok`]) and faces the surface's way.
+    #[cfg(feature = "std")]
+    fn fits_placed(&mut self, surface: &dyn Surface, c: &Criteria, t: usize) -> bool {
+        let (m, turn) = self.cached_measure(surface, t, c);
+        m.max <= c.tol && self.turn_ok(c, &m, turn, t as u32) && !self.inverted(surface, t)
+    }
+
+    /// Takes back the last triangle added.
+    #[cfg(feature = "std")]
+    fn pop_triangle(&mut self) {
+        let Some(&v) = self.tris.last() else { return };
+        let t = (self.tris.len() - 1) as u32;
         for k in 0..3 {
-            self.detach(self.tris[nt][k], self.tris[nt][(k + 1) % 3], nt as u32);
+            self.detach(v[k], v[(k + 1) % 3], t);
         }
         self.tris.pop();
         self.uvs.pop();
         self.measures.truncate(self.tris.len());
-        self.pos.truncate(old_v);
-        self.normal.truncate(old_v);
-        self.gid.truncate(old_v);
-        false
+    }
+
+    /// Takes back the vertices from `n` on.
+    #[cfg(feature = "std")]
+    fn truncate_vertices(&mut self, n: usize) {
+        self.pos.truncate(n);
+        self.normal.truncate(n);
+        self.gid.truncate(n);
     }
 
     /// Splits border edge `a-b` (one triangle) at `p`, another face's node
@@ -339,21 +357,10 @@ impl WorkMesh {
         self.add_triangle([m, x1, x2], [uv, u1, u2]);
         self.measure_slots();
         self.measures[t] = STALE;
-        let nt = self.tris.len() - 1;
-        let fits = |w: &mut Self, s: usize| {
-            let (mm, turn) = w.cached_measure(surface, s, c);
-            let (_, _, len) = w.longest_edge(s);
-            mm.max <= c.tol && (turn <= c.angle || c.short_for_angle(&mm, turn, len)) && !w.inverted(surface, s)
-        };
-        if fits(self, t) && fits(self, nt) {
+        if self.fits_placed(surface, c, t) && self.fits_placed(surface, c, self.tris.len() - 1) {
             return true;
         }
-        for k in 0..3 {
-            self.detach(self.tris[nt][k], self.tris[nt][(k + 1) % 3], nt as u32);
-        }
-        self.tris.pop();
-        self.uvs.pop();
-        self.measures.truncate(self.tris.len());
+        self.pop_triangle();
         self.detach(x0, m, tu);
         self.detach(m, x2, tu);
         self.tris[t] = old_t;
@@ -361,9 +368,7 @@ impl WorkMesh {
         self.attach(x0, x1, tu);
         self.attach(x1, x2, tu);
         self.measures[t] = STALE;
-        self.pos.truncate(old_v);
-        self.normal.truncate(old_v);
-        self.gid.truncate(old_v);
+        self.truncate_vertices(old_v);
         false
     }
 
