@@ -11,10 +11,16 @@ use crate::nurbs::{project_to_surface, ProjectionOptions, Surface};
 pub(crate) struct TriMeasure {
     /// Largest sample distance.
     pub max: f64,
-    /// Sum of sample distances.
+    /// Sum of sample distances; [`sample_count`] of them, known from the
+    /// grid, so the measure cache need not hold a count per triangle.
     pub sum: f64,
-    /// Number of samples.
-    pub count: u32,
+}
+
+/// How many points [`measure_triangle`] samples with `steps` divisions per
+/// edge: the barycentric grid without its three corners.
+pub(crate) fn sample_count(steps: usize) -> u32 {
+    let n = steps.max(2);
+    ((n + 1) * (n + 2) / 2 - 3) as u32
 }
 
 /// Projection settings for measuring: the hint is close, so few iterations do.
@@ -46,7 +52,6 @@ pub(crate) fn measure_triangle(
             let d = distance_from_hint(surface, q, hint, opts);
             m.max = m.max.max(d);
             m.sum += d;
-            m.count += 1;
         }
     }
     m
@@ -198,5 +203,26 @@ mod tests {
             points > samples && derivs >= 2 * samples,
             "{samples} samples: {derivs} with derivatives, {points} points"
         );
+    }
+
+    /// The mean deviation divides the sum by [`sample_count`]: it must be
+    /// the number of points sampled, here each exactly `h` off a plane.
+    #[test]
+    fn sample_count_is_the_number_of_points_measured() {
+        let corner = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        let plane = crate::nurbs::analytic::bilinear(
+            [[corner(-10.0, -10.0), corner(-10.0, 10.0)], [corner(10.0, -10.0), corner(10.0, 10.0)]],
+            [-10.0, 10.0],
+            [-10.0, 10.0],
+        )
+        .unwrap();
+        let h = 0.25;
+        let uv = [DVec2::new(0.0, 0.0), DVec2::new(4.0, 0.0), DVec2::new(0.0, 3.0)];
+        let p = uv.map(|q| DVec3::new(q.x, q.y, h));
+        for steps in 0..7 {
+            let m = measure_triangle(&plane, &p, &uv, steps, &measure_projection());
+            assert!((m.max - h).abs() < 1e-12);
+            assert!((m.sum / h - f64::from(sample_count(steps))).abs() < 1e-9, "steps {steps}: {}", m.sum / h);
+        }
     }
 }

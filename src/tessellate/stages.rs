@@ -161,6 +161,6 @@ impl FaceStages<'_> {
         if refined {
             mesh.refine(self.surface(), &curves, &self.setup.crit, self.budget);
         }
-        (0..mesh.tris.len()).map(|t| (mesh.uvs[t], mesh.inverted(self.surface(), t))).collect()
+        (0..mesh.tris.len()).map(|t| (mesh.uv(t), mesh.inverted(self.surface(), t))).collect()
     }
 }

@@ -99,8 +99,8 @@ impl WorkMesh {
         if u == NONE || adj[0] != t && adj[1] != t {
             return None;
         }
-        let (tv, tuv) = (self.tris[t as usize], self.uvs[t as usize]);
-        let (uv_, uuv) = (self.tris[u as usize], self.uvs[u as usize]);
+        let (tv, tuv) = (self.tris[t as usize], self.uv(t as usize));
+        let (uv_, uuv) = (self.tris[u as usize], self.uv(u as usize));
         let i = (0..3).find(|&k| tv[k] == a && tv[(k + 1) % 3] == b)?;
         let j = (0..3).find(|&k| uv_[k] == b && uv_[(k + 1) % 3] == a)?;
         let cv = tv[(i + 2) % 3];
@@ -158,7 +158,7 @@ impl WorkMesh {
         let mut at: Option<DVec2> = None;
         let mut n = 0.0;
         for &t in &ring {
-            let (tv, tuv) = (self.tris[t as usize], self.uvs[t as usize]);
+            let (tv, tuv) = (self.tris[t as usize], self.uv(t as usize));
             for k in 0..3 {
                 let (a, b) = (tv[k], tv[(k + 1) % 3]);
                 if (a == x || b == x) && self.edges.get(&key(a, b)).is_none_or(|e| e[1] == NONE) {
@@ -179,25 +179,18 @@ impl WorkMesh {
         let old_uv = at?;
         let new_uv = centre / n;
         let area = |w: [DVec2; 3]| (w[1] - w[0]).perp_dot(w[2] - w[0]);
-        let signs: Vec<f64> = ring.iter().map(|&t| area(self.uvs[t as usize])).collect();
+        let signs: Vec<f64> = ring.iter().map(|&t| area(self.uv(t as usize))).collect();
         let sense = signs.iter().sum::<f64>();
         let (old_p, old_n) = (self.pos[x as usize], self.normal[x as usize]);
         let set = |m: &mut Self, q: DVec2, p: DVec3, nn: DVec3| {
             m.pos[x as usize] = p;
             m.normal[x as usize] = nn;
-            for &t in &ring {
-                let tv = m.tris[t as usize];
-                for k in 0..3 {
-                    if tv[k] == x {
-                        m.uvs[t as usize][k] = q;
-                    }
-                }
-            }
+            m.move_uv(x, &ring, q);
         };
         set(self, new_uv, surface.point(new_uv), surface.normal(new_uv));
         let good = ring.iter().all(|&t| {
             let (m, turn) = self.measure(surface, t as usize, c);
-            area(self.uvs[t as usize]) * sense > 0.0
+            area(self.uv(t as usize)) * sense > 0.0
                 && !self.inverted(surface, t as usize)
                 && m.max <= c.tol
                 && self.turn_ok(c, &m, turn, t)
@@ -226,7 +219,7 @@ impl WorkMesh {
         }
         for ((x, tri), w) in [t, u].into_iter().zip(to).zip(uvs) {
             self.tris[x as usize] = tri;
-            self.uvs[x as usize] = w;
+            self.set_uv(x as usize, w);
             for k in 0..3 {
                 self.attach(tri[k], tri[(k + 1) % 3], x);
             }
@@ -259,7 +252,8 @@ impl WorkMesh {
         let Some(k) = (0..3).find(|&k| self.tris[t][k] == a && self.tris[t][(k + 1) % 3] == b) else {
             return false;
         };
-        let (uv_a, uv_b) = (self.uvs[t][k], self.uvs[t][(k + 1) % 3]);
+        let tuv = self.uv(t);
+        let (uv_a, uv_b) = (tuv[k], tuv[(k + 1) % 3]);
         let hint = (uv_a + uv_b) * 0.5;
         let uv = project_to_surface(surface, p, Some(hint), &Default::default()).uv;
         // Far from the edge in (u,v): across a seam, not beside it.
@@ -300,7 +294,9 @@ impl WorkMesh {
             self.detach(v[k], v[(k + 1) % 3], t);
         }
         self.tris.pop();
-        self.uvs.pop();
+        if !self.odd_uv.is_empty() {
+            self.odd_uv.remove(&t);
+        }
         self.measures.truncate(self.tris.len());
     }
 
@@ -310,6 +306,7 @@ impl WorkMesh {
         self.pos.truncate(n);
         self.normal.truncate(n);
         self.gid.truncate(n);
+        self.vuv.truncate(n);
     }
 
     /// Splits border edge `a-b` (one triangle) at `p`, another face's node
@@ -321,7 +318,7 @@ impl WorkMesh {
         let Some(t) = self.edges.get(&key(a, b)).filter(|e| e[1] == NONE).map(|e| e[0] as usize) else {
             return false;
         };
-        let (old_t, old_uv) = (self.tris[t], self.uvs[t]);
+        let (old_t, old_uv) = (self.tris[t], self.uv(t));
         let Some(k) = (0..3).find(|&k| key(old_t[k], old_t[(k + 1) % 3]) == key(a, b)) else {
             return false;
         };
@@ -351,7 +348,7 @@ impl WorkMesh {
         self.detach(x0, x1, tu);
         self.detach(x1, x2, tu);
         self.tris[t] = [x0, m, x2];
-        self.uvs[t] = [u0, uv, u2];
+        self.set_uv(t, [u0, uv, u2]);
         self.attach(x0, m, tu);
         self.attach(m, x2, tu);
         self.add_triangle([m, x1, x2], [uv, u1, u2]);
@@ -364,7 +361,7 @@ impl WorkMesh {
         self.detach(x0, m, tu);
         self.detach(m, x2, tu);
         self.tris[t] = old_t;
-        self.uvs[t] = old_uv;
+        self.set_uv(t, old_uv);
         self.attach(x0, x1, tu);
         self.attach(x1, x2, tu);
         self.measures[t] = STALE;
@@ -396,7 +393,13 @@ impl WorkMesh {
             *m = STALE;
         }
         self.tris.swap_remove(t);
-        self.uvs.swap_remove(t);
+        if !self.odd_uv.is_empty() {
+            // The last triangle's own corners, if it has them, move with it.
+            self.odd_uv.remove(&(t as u32));
+            if let Some(w) = self.odd_uv.remove(&(last as u32)) {
+                self.odd_uv.insert(t as u32, w);
+            }
+        }
         self.measures.truncate(self.tris.len());
     }
 
@@ -408,7 +411,7 @@ impl WorkMesh {
         if facet.length_squared() == 0.0 {
             return false;
         }
-        let uv = self.uvs[t];
+        let uv = self.uv(t);
         let n = surface.normal((uv[0] + uv[1] + uv[2]) / 3.0);
         facet.dot(n) < 0.0
     }
