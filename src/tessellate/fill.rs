@@ -64,7 +64,7 @@ pub(crate) fn close_slivers(faces: &mut [FaceWork<'_>], width: f64) -> usize {
 /// its inner side is the border, and what is left open beside that is a
 /// hole the passes after close. Returns how many it removed.
 fn remove_flaps(faces: &mut [FaceWork<'_>], width: f64) -> usize {
-    let (_, uses) = border_sides(faces);
+    let uses = border_uses(faces);
     let used = |m: &super::refine::WorkMesh, a: u32, b: u32| {
         let (ga, gb) = (m.gid[a as usize], m.gid[b as usize]);
         if ga == NONE || gb == NONE || ga == gb {
@@ -107,11 +107,9 @@ fn remove_flaps(faces: &mut [FaceWork<'_>], width: f64) -> usize {
     removed
 }
 
-/// Border edges whose ends are model nodes, and how often each pair of
-/// nodes is a border edge anywhere (twice: two faces meet there).
-fn border_sides(faces: &[FaceWork<'_>]) -> (Vec<Side>, HashMap<(u32, u32), u32>) {
-    let mut sides: Vec<Side> = Vec::new();
-    let mut uses: HashMap<(u32, u32), u32> = HashMap::default();
+/// Calls `visit` with every border edge whose ends are two different model
+/// nodes, face by face.
+fn each_border_side(faces: &[FaceWork<'_>], mut visit: impl FnMut(Side)) {
     for (fi, f) in faces.iter().enumerate() {
         let m = &f.mesh;
         for t in &m.tris {
@@ -121,19 +119,31 @@ fn border_sides(faces: &[FaceWork<'_>]) -> (Vec<Side>, HashMap<(u32, u32), u32>)
                 if ga == NONE || gb == NONE || ga == gb || m.edge_triangles(a, b) != 1 {
                     continue;
                 }
-                sides.push(Side { face: fi as u32, a, b, ga, gb });
-                *uses.entry((ga.min(gb), ga.max(gb))).or_default() += 1;
+                visit(Side { face: fi as u32, a, b, ga, gb });
             }
         }
     }
-    (sides, uses)
+}
+
+/// How often each pair of nodes is a border edge anywhere (twice: two
+/// faces meet there). Counted, not listed: a list of every border edge
+/// of the model was the largest thing allocated while all faces are held.
+fn border_uses(faces: &[FaceWork<'_>]) -> HashMap<(u32, u32), u32> {
+    let mut uses: HashMap<(u32, u32), u32> = HashMap::default();
+    each_border_side(faces, |s| *uses.entry((s.ga.min(s.gb), s.ga.max(s.gb))).or_default() += 1);
+    uses
 }
 
 /// Border edges used once in the whole model, and the edges at each node.
 fn open_sides(faces: &[FaceWork<'_>]) -> (Vec<Side>, HashMap<u32, Vec<usize>>) {
-    let (sides, uses) = border_sides(faces);
-    let open: Vec<Side> =
-        sides.into_iter().filter(|s| uses.get(&(s.ga.min(s.gb), s.ga.max(s.gb))) == Some(&1)).collect();
+    let uses = border_uses(faces);
+    let mut open: Vec<Side> = Vec::new();
+    each_border_side(faces, |s| {
+        if uses.get(&(s.ga.min(s.gb), s.ga.max(s.gb))) == Some(&1) {
+            open.push(s);
+        }
+    });
+    drop(uses);
     // Faces need not agree on orientation, so the hole's sides are joined
     // by their nodes, whichever way each runs.
     let mut at_node: HashMap<u32, Vec<usize>> = HashMap::default();
@@ -335,9 +345,9 @@ mod tests {
         );
         let work = |mesh| FaceWork { surface: &plane, curves: Vec::new(), mesh, crit: CRIT };
         let mut faces = alloc::vec![work(upper), work(lower)];
-        assert_eq!(border_sides(&faces).1.get(&(1, 2)), Some(&1));
+        assert_eq!(border_uses(&faces).get(&(1, 2)), Some(&1));
         assert_eq!(close_slivers(&mut faces, 0.1), 1);
-        let uses = border_sides(&faces).1;
+        let uses = border_uses(&faces);
         for pair in [(1, 3), (2, 3)] {
             assert_eq!(uses.get(&pair), Some(&2), "{pair:?} is not shared");
         }
@@ -381,10 +391,10 @@ mod tests {
             work(beside(15.0)),
             work(mesh(&[(10.0, 10.0, 3), (10.0, 15.0, NONE), (10.03, 5.0, 2)], &[[0, 1, 2]]))
         ];
-        assert_eq!(border_sides(&faces).1.get(&(2, 3)), Some(&3));
+        assert_eq!(border_uses(&faces).get(&(2, 3)), Some(&3));
         assert_eq!(remove_flaps(&mut faces, 0.1), 1);
         assert_eq!(faces[0].mesh.tris.len(), 2);
-        let uses = border_sides(&faces).1;
+        let uses = border_uses(&faces);
         assert_eq!(uses.get(&(2, 3)), Some(&2));
         assert_eq!(uses.get(&(1, 3)), Some(&1));
         assert!(!uses.contains_key(&(1, 2)));
