@@ -279,6 +279,7 @@ fn run(
     drop(bytes);
     let t1 = now_ms();
     let mut result = mesh_model_with_progress(&model, options, progress)?;
+    drop(model);
     let t2 = now_ms();
     if let (Some(t0), Some(t1), Some(t2)) = (t0, t1, t2) {
         result.report.parse_ms = t1 - t0;
@@ -453,9 +454,12 @@ fn to_js(result: &MeshResult, parts: &Parts) -> Result<JsValue, Error> {
         names.push(&JsValue::from_str(n));
     }
     let out = Object::new();
+    // One f32 copy at a time, each freed once JS has its own.
+    let positions: JsValue = Float32Array::from(flat(&mesh.positions).as_slice()).into();
+    let normals: JsValue = Float32Array::from(flat(&mesh.normals).as_slice()).into();
     let fields: [(&str, JsValue); 8] = [
-        ("positions", Float32Array::from(flat(&mesh.positions).as_slice()).into()),
-        ("normals", Float32Array::from(flat(&mesh.normals).as_slice()).into()),
+        ("positions", positions),
+        ("normals", normals),
         ("indices", Uint32Array::from(mesh.indices.as_slice()).into()),
         ("faceRanges", Uint32Array::from(ranges.as_slice()).into()),
         ("faceParts", Uint32Array::from(parts.faces.as_slice()).into()),
