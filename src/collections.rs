@@ -52,3 +52,195 @@ impl<T> CellGrid<T> {
             .flatten()
     }
 }
+
+/// A map from pairs of `u32` (never both `u32::MAX`) to small values, for
+/// the edges of a face's mesh while it is refined: open addressing with
+/// linear probing, grown by a quarter at 80 % load. A [`HashMap`] doubles,
+/// so its tables ran half empty (32 bytes an edge where the entry is 16),
+/// and every face's tables are held until the model is assembled.
+#[derive(Debug, Clone)]
+pub(crate) struct PairMap<V> {
+    slots: alloc::vec::Vec<(u64, V)>,
+    len: usize,
+}
+
+/// The key of an empty slot.
+const FREE: u64 = u64::MAX;
+
+impl<V> Default for PairMap<V> {
+    fn default() -> Self {
+        Self { slots: alloc::vec::Vec::new(), len: 0 }
+    }
+}
+
+impl<V: Copy> PairMap<V> {
+    fn pack(k: &(u32, u32)) -> u64 {
+        (u64::from(k.0) << 32) | u64::from(k.1)
+    }
+
+    /// The slot a key's probe starts at (multiplicative hash, scaled to the table).
+    fn home(&self, key: u64) -> usize {
+        let h = (key ^ (key >> 29)).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32;
+        ((h * self.slots.len() as u64) >> 32) as usize
+    }
+
+    /// The slot holding `key`, if any.
+    fn find(&self, key: u64) -> Option<usize> {
+        let n = self.slots.len();
+        if n == 0 || key == FREE {
+            return None;
+        }
+        let mut i = self.home(key);
+        loop {
+            match self.slots[i].0 {
+                k if k == key => return Some(i),
+                FREE => return None,
+                _ => i = if i + 1 == n { 0 } else { i + 1 },
+            }
+        }
+    }
+
+    /// Number of entries.
+    #[cfg(test)]
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn get(&self, k: &(u32, u32)) -> Option<&V> {
+        self.find(Self::pack(k)).map(|i| &self.slots[i].1)
+    }
+
+    pub fn get_mut(&mut self, k: &(u32, u32)) -> Option<&mut V> {
+        self.find(Self::pack(k)).map(|i| &mut self.slots[i].1)
+    }
+
+    pub fn contains_key(&self, k: &(u32, u32)) -> bool {
+        self.find(Self::pack(k)).is_some()
+    }
+
+    /// The value of `k`, inserting `fill` first if it has none.
+    pub fn get_or_insert(&mut self, k: (u32, u32), fill: V) -> &mut V {
+        let key = Self::pack(&k);
+        if let Some(i) = self.find(key) {
+            return &mut self.slots[i].1;
+        }
+        if 5 * (self.len + 1) > 4 * self.slots.len() {
+            self.grow(fill);
+        }
+        let n = self.slots.len();
+        let mut i = self.home(key);
+        while self.slots[i].0 != FREE {
+            i = if i + 1 == n { 0 } else { i + 1 };
+        }
+        self.slots[i] = (key, fill);
+        self.len += 1;
+        &mut self.slots[i].1
+    }
+
+    /// Sets the value of `k`.
+    pub fn insert(&mut self, k: (u32, u32), v: V) {
+        *self.get_or_insert(k, v) = v;
+    }
+
+    /// Removes `k`, returning its value; later entries of its probe run
+    /// move back, so no tombstones are left.
+    pub fn remove(&mut self, k: &(u32, u32)) -> Option<V> {
+        let mut i = self.find(Self::pack(k))?;
+        let out = self.slots[i].1;
+        let n = self.slots.len();
+        let mut j = i;
+        loop {
+            j = if j + 1 == n { 0 } else { j + 1 };
+            let key = self.slots[j].0;
+            if key == FREE {
+                break;
+            }
+            // An entry stays if its home lies cyclically in (i, j].
+            let h = self.home(key);
+            let stays = if i <= j { i < h && h <= j } else { i < h || h <= j };
+            if !stays {
+                self.slots[i] = self.slots[j];
+                i = j;
+            }
+        }
+        self.slots[i].0 = FREE;
+        self.len -= 1;
+        Some(out)
+    }
+
+    /// The entries, in no particular order.
+    pub fn iter(&self) -> impl Iterator<Item = ((u32, u32), &V)> + '_ {
+        self.slots.iter().filter(|s| s.0 != FREE).map(|(k, v)| (((k >> 32) as u32, *k as u32), v))
+    }
+
+    /// A table a quarter larger (at least 8 slots), entries moved over;
+    /// `fill` stands in the empty slots' values.
+    fn grow(&mut self, fill: V) {
+        let n = (self.slots.len() + self.slots.len() / 4).max(8);
+        let old = core::mem::replace(&mut self.slots, alloc::vec![(FREE, fill); n]);
+        for (key, v) in old {
+            if key != FREE {
+                let mut i = self.home(key);
+                while self.slots[i].0 != FREE {
+                    i = if i + 1 == n { 0 } else { i + 1 };
+                }
+                self.slots[i] = (key, v);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alloc::vec::Vec;
+
+    /// Against a [`HashMap`] through a long run of inserts, updates and
+    /// removals (which move probe runs back): the same entries every step.
+    #[test]
+    fn pair_map_agrees_with_a_hash_map() {
+        let mut ours: PairMap<[u32; 2]> = PairMap::default();
+        let mut theirs: HashMap<(u32, u32), [u32; 2]> = HashMap::default();
+        let mut x: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for step in 0..60_000u32 {
+            let r = next();
+            // Few distinct keys, so that removals hit and runs collide.
+            let k = ((r % 900) as u32, u32::MAX - 3 + ((r >> 20) % 3) as u32);
+            match (r >> 40) % 4 {
+                0 | 1 => {
+                    let v = ours.get_or_insert(k, [step, 0]);
+                    v[1] += 1;
+                    theirs.entry(k).or_insert([step, 0])[1] += 1;
+                }
+                2 => assert_eq!(ours.remove(&k), theirs.remove(&k)),
+                _ => {
+                    if let Some(v) = ours.get_mut(&k) {
+                        v[0] ^= 1;
+                    }
+                    if let Some(v) = theirs.get_mut(&k) {
+                        v[0] ^= 1;
+                    }
+                }
+            }
+            assert_eq!(ours.len(), theirs.len());
+            if step % 997 == 0 {
+                let mut a: Vec<_> = ours.iter().map(|(k, v)| (k, *v)).collect();
+                let mut b: Vec<_> = theirs.iter().map(|(k, v)| (*k, *v)).collect();
+                a.sort_unstable();
+                b.sort_unstable();
+                assert_eq!(a, b);
+                for (k, v) in &b {
+                    assert_eq!(ours.get(k), Some(v));
+                    assert!(ours.contains_key(k));
+                }
+            }
+        }
+        assert!(ours.get(&(5000, 5000)).is_none());
+    }
+}

@@ -3,7 +3,7 @@
 //! edge too long is split at its longest edge (with the neighbour across that
 //! edge, so the mesh stays conforming), until all pass.
 
-use crate::collections::HashMap;
+use crate::collections::{HashMap, PairMap};
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
@@ -52,14 +52,14 @@ pub(crate) struct WorkMesh {
     vuv: Vec<DVec2>,
     /// The corner (u,v)s of triangles where one differs from its vertex's.
     odd_uv: HashMap<u32, [DVec2; 3]>,
-    edges: HashMap<(u32, u32), [u32; 2]>,
-    trim: HashMap<(u32, u32), TrimEdge>,
+    edges: PairMap<[u32; 2]>,
+    trim: PairMap<TrimEdge>,
     /// Per vertex: its node id across the model (`NONE` for inner vertices),
     /// so that borders of different faces can name the same node.
     pub gid: Vec<u32>,
     /// Border edges another face (or another stretch of this face's border,
     /// across a seam) shares: a split of one must be made in the other.
-    pub shared: crate::collections::HashSet<(u32, u32)>,
+    pub shared: PairMap<()>,
     /// Shared edges refinement split, as `(a, b, new vertex)`, for the caller
     /// to make the same split where the edge is shared.
     pub events: Vec<(u32, u32, u32)>,
@@ -199,8 +199,8 @@ impl WorkMesh {
     pub fn keep_only_triangles(&mut self) {
         self.vuv = Vec::new();
         self.odd_uv = HashMap::default();
-        self.edges = HashMap::default();
-        self.trim = HashMap::default();
+        self.edges = PairMap::default();
+        self.trim = PairMap::default();
         self.gid = Vec::new();
         self.shared = Default::default();
         self.events = Vec::new();
@@ -243,7 +243,7 @@ impl WorkMesh {
     }
 
     fn attach(&mut self, a: u32, b: u32, t: u32) {
-        let e = self.edges.entry(key(a, b)).or_insert([NONE, NONE]);
+        let e = self.edges.get_or_insert(key(a, b), [NONE, NONE]);
         if e[0] == NONE {
             e[0] = t;
         } else if e[1] == NONE {
@@ -313,7 +313,7 @@ impl WorkMesh {
     /// Splits edge `a-b` at its middle and the (one or two) triangles on it;
     /// pushes the triangles that changed or were added to `out`.
     fn split_edge(&mut self, surface: &dyn Surface, curves: &[&NurbsCurve], a: u32, b: u32, out: &mut Vec<u32>) {
-        let shared = self.shared.contains(&key(a, b));
+        let shared = self.shared.contains_key(&key(a, b));
         if let Some(m) = self.split_edge_at(surface, curves, a, b, 0.5, None, out) {
             if shared {
                 self.events.push((a, b, m));
@@ -391,7 +391,7 @@ impl WorkMesh {
 
     /// Edges used by exactly one triangle.
     pub fn boundary_edges(&self) -> Vec<(u32, u32)> {
-        let mut out: Vec<(u32, u32)> = self.edges.iter().filter(|(_, t)| t[1] == NONE).map(|(k, _)| *k).collect();
+        let mut out: Vec<(u32, u32)> = self.edges.iter().filter(|(_, t)| t[1] == NONE).map(|(k, _)| k).collect();
         out.sort_unstable();
         out
     }
@@ -530,9 +530,9 @@ impl WorkMesh {
             out.push(t);
             out.push(t2);
         }
-        if self.shared.remove(&key(a, b)) {
-            self.shared.insert(key(a, m));
-            self.shared.insert(key(m, b));
+        if self.shared.remove(&key(a, b)).is_some() {
+            self.shared.insert(key(a, m), ());
+            self.shared.insert(key(m, b), ());
         }
         if let (Some(te), Some((_, ta, tm, tb))) = (trim, trim_at) {
             self.trim.remove(&key(a, b));

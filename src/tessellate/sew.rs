@@ -275,7 +275,7 @@ pub(crate) fn refine_all(
     let mut uses = border_uses(faces);
     for list in uses.values().filter(|l| l.len() > 1) {
         for &(fi, a, b) in list {
-            faces[fi as usize].mesh.shared.insert((a.min(b), a.max(b)));
+            faces[fi as usize].mesh.shared.insert((a.min(b), a.max(b)), ());
         }
     }
     let mut total: usize = faces.iter().map(|f| f.mesh.tris.len()).sum();
