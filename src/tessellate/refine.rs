@@ -207,6 +207,21 @@ impl WorkMesh {
         self.measures = Vec::new();
     }
 
+    /// Gives back the room kept for growth, once refinement is done with
+    /// the face for now: every face is held until the model is assembled,
+    /// and a later split here grows it again.
+    pub fn shrink(&mut self) {
+        self.pos.shrink_to_fit();
+        self.normal.shrink_to_fit();
+        self.gid.shrink_to_fit();
+        self.vuv.shrink_to_fit();
+        self.tris.shrink_to_fit();
+        self.measures.shrink_to_fit();
+        self.edges.shrink();
+        self.trim.shrink();
+        self.shared.shrink();
+    }
+
     /// A slot in the measure cache per triangle.
     fn measure_slots(&mut self) {
         let missing = self.tris.len().saturating_sub(self.measures.len());

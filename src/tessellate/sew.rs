@@ -293,6 +293,7 @@ pub(crate) fn refine_all(
         let before = f.mesh.tris.len();
         let room = budget.saturating_sub(total - before);
         budget_hit |= f.mesh.refine_from(f.surface, &f.curves, &f.crit, room, todo);
+        f.mesh.shrink();
         total = total - before + f.mesh.tris.len();
         let events = core::mem::take(&mut f.mesh.events);
         for (a, b, m) in events {
