@@ -9,16 +9,23 @@ pub(crate) type HashMap<K, V> = hashbrown::HashMap<K, V, foldhash::fast::FixedSt
 pub(crate) type HashSet<K> = hashbrown::HashSet<K, foldhash::fast::FixedState>;
 
 /// Items hashed by position on a uniform grid of cubes, for "what lies near
-/// this point" queries (welding, crack counting, sewing).
+/// this point" queries (welding, crack counting, sewing). Each cube holds
+/// its first and last item and each item the next of its cube: a list per
+/// cube, not a vector, which for the one or two points most cubes hold took
+/// twice the memory (welding a whole model's vertices set the wasm peak).
 pub(crate) struct CellGrid<T> {
     inv: f64,
-    cells: HashMap<(i64, i64, i64), alloc::vec::Vec<T>>,
+    cells: HashMap<(i64, i64, i64), (u32, u32)>,
+    items: alloc::vec::Vec<(T, u32)>,
 }
+
+/// The end of a cube's list.
+const LAST: u32 = u32::MAX;
 
 impl<T> CellGrid<T> {
     /// A grid of cubes `1 / inv` long.
     pub fn new(inv: f64) -> Self {
-        Self { inv, cells: HashMap::default() }
+        Self { inv, cells: HashMap::default(), items: alloc::vec::Vec::new() }
     }
 
     /// The cube holding `p`.
@@ -29,7 +36,24 @@ impl<T> CellGrid<T> {
 
     /// Adds `item` in the cube holding `p`.
     pub fn insert(&mut self, p: glam::DVec3, item: T) {
-        self.cells.entry(self.key(p)).or_default().push(item);
+        let i = self.items.len() as u32;
+        self.items.push((item, LAST));
+        let key = self.key(p);
+        if let Some(c) = self.cells.get_mut(&key) {
+            if let Some(last) = self.items.get_mut(c.1 as usize) {
+                last.1 = i;
+            }
+            c.1 = i;
+        } else {
+            self.cells.insert(key, (i, i));
+        }
+    }
+
+    /// The items of cube `c`, in the order added.
+    fn cube(&self, c: (i64, i64, i64)) -> impl Iterator<Item = &T> + '_ {
+        let first = self.cells.get(&c).map(|&(first, _)| first);
+        core::iter::successors(first, |&i| self.items.get(i as usize).map(|x| x.1).filter(|&n| n != LAST))
+            .filter_map(|i| self.items.get(i as usize).map(|x| &x.0))
     }
 
     /// The items of the 27 cubes around (and including) the one holding `p`,
@@ -38,8 +62,7 @@ impl<T> CellGrid<T> {
         let (x, y, z) = self.key(p);
         (-1..=1)
             .flat_map(move |dx| (-1..=1).flat_map(move |dy| (-1..=1).map(move |dz| (x + dx, y + dy, z + dz))))
-            .filter_map(|c| self.cells.get(&c))
-            .flatten()
+            .flat_map(|c| self.cube(c))
     }
 
     /// The items of every cube that meets the box `[lo, hi]`, in the order of [`CellGrid::near`].
@@ -48,8 +71,7 @@ impl<T> CellGrid<T> {
         let (a, b) = (self.key(lo), self.key(hi));
         (a.0..=b.0)
             .flat_map(move |x| (a.1..=b.1).flat_map(move |y| (a.2..=b.2).map(move |z| (x, y, z))))
-            .filter_map(|c| self.cells.get(&c))
-            .flatten()
+            .flat_map(|c| self.cube(c))
     }
 }
 
@@ -74,6 +96,13 @@ impl<V> Default for PairMap<V> {
 }
 
 impl<V: Copy> PairMap<V> {
+    /// An empty map with room for `n` entries (`fill` stands in the empty slots).
+    pub fn with_capacity(n: usize, fill: V) -> Self {
+        let mut m = Self::default();
+        m.rebuild((n + n / 4).max(8), fill);
+        m
+    }
+
     fn pack(k: &(u32, u32)) -> u64 {
         (u64::from(k.0) << 32) | u64::from(k.1)
     }
@@ -261,5 +290,23 @@ mod tests {
             }
         }
         assert!(ours.get(&(5000, 5000)).is_none());
+    }
+
+    /// Cubes come x outer, z inner, and each cube's items in the order added.
+    #[test]
+    fn cell_grid_keeps_cube_and_insertion_order() {
+        let mut g: CellGrid<u32> = CellGrid::new(1.0);
+        let at = |x: f64, y: f64, z: f64| glam::DVec3::new(x, y, z);
+        g.insert(at(0.5, 0.5, 1.5), 0);
+        g.insert(at(0.5, 0.5, 0.5), 1);
+        g.insert(at(-0.5, 0.5, 0.5), 2);
+        g.insert(at(0.5, 0.5, 0.5), 3);
+        g.insert(at(0.5, 0.5, 1.5), 4);
+        g.insert(at(0.2, 0.7, 0.1), 5);
+        g.insert(at(5.0, 5.0, 5.0), 6);
+        let near: Vec<u32> = g.near(at(0.5, 0.5, 0.5)).copied().collect();
+        assert_eq!(near, [2, 1, 3, 5, 0, 4]);
+        assert_eq!(g.near(at(5.5, 5.5, 5.5)).copied().collect::<Vec<_>>(), [6]);
+        assert!(g.near(at(50.0, 0.0, 0.0)).next().is_none());
     }
 }

@@ -57,9 +57,11 @@ pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol
     for (i, &m) in map.iter().enumerate() {
         pos[m as usize] = mesh.positions[i];
     }
-    // Directed edge counts keyed by the undirected pair.
-    let mut edges: crate::collections::HashMap<(u32, u32), (u32, u32)> = crate::collections::HashMap::default();
-    let mut owner: crate::collections::HashMap<(u32, u32), u32> = crate::collections::HashMap::default();
+    // Per undirected pair: the triangles running it low to high, high to
+    // low, and the face of the last one; room for a closed mesh's edges
+    // from the start (this is the largest table of the whole run).
+    let mut edges: crate::collections::PairMap<[u32; 3]> =
+        crate::collections::PairMap::with_capacity(mesh.indices.len() / 2 + 16, [0; 3]);
     for (ti, t) in mesh.indices.chunks_exact(3).enumerate() {
         let v = [map[t[0] as usize], map[t[1] as usize], map[t[2] as usize]];
         if v[0] == v[1] || v[1] == v[2] || v[2] == v[0] {
@@ -67,20 +69,16 @@ pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol
         }
         for k in 0..3 {
             let (a, b) = (v[k], v[(k + 1) % 3]);
-            owner.insert((a.min(b), a.max(b)), face_of(ti));
-            let e = edges.entry((a.min(b), a.max(b))).or_insert((0, 0));
-            if a < b {
-                e.0 += 1;
-            } else {
-                e.1 += 1;
-            }
+            let e = edges.get_or_insert((a.min(b), a.max(b)), [0; 3]);
+            e[usize::from(a > b)] += 1;
+            e[2] = face_of(ti);
         }
     }
     let mut out = EdgeCounts::default();
     let mut free: Vec<(u32, u32, u32)> = Vec::new();
-    for (&k, &(f, r)) in &edges {
+    for (k, &[f, r, owner]) in edges.iter() {
         match f + r {
-            1 => free.push((k.0, k.1, owner.get(&k).copied().unwrap_or(0))),
+            1 => free.push((k.0, k.1, owner)),
             2 => {
                 if f != 1 {
                     out.misoriented_edges += 1;
@@ -89,6 +87,7 @@ pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol
             _ => out.nonmanifold_edges += 1,
         }
     }
+    drop(edges);
     out.boundary_edges = free.len();
     out.free_edges = count_cracks(&free, &pos, sew_tol, &body_of_face);
     out
