@@ -178,7 +178,10 @@ fn parameters(
         text.extend_from_slice(content(r));
     }
     let mut tok = Tokenizer::new(&text, param, record);
-    let params = tok.fields(MAX_PARAMS).map_err(|m| iges_error(Section::Parameter, pline, de, m))?;
+    let mut params = tok.fields(MAX_PARAMS).map_err(|m| iges_error(Section::Parameter, pline, de, m))?;
+    // Every entity's parameters are held until the faces are built: no
+    // room left over from growing (a quarter of the list on average).
+    params.shrink_to_fit();
     match params.first() {
         Some(Value::Int(k)) if *k == kind => Ok((pline, params)),
         other => Err(iges_error(
