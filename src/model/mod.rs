@@ -118,6 +118,15 @@ impl Surface for FaceSurface {
             Self::Offset { base, distance } => offset_derivs(base, *distance, uv),
         }
     }
+    fn tangents(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
+        match self {
+            Self::Nurbs(s) | Self::Rebuilt(s) => s.tangents(uv),
+            Self::Offset { .. } => {
+                let d = self.derivs(uv);
+                (d.point, d.su, d.sv)
+            }
+        }
+    }
     fn breaks(&self, along_u: bool) -> Vec<f64> {
         match self {
             // Every 8th knot: where breaks still start intervals (the border
@@ -147,6 +156,18 @@ impl Surface for FaceSurface {
                 }
                 b
             }
+        }
+    }
+    fn point_normal(&self, uv: DVec2) -> (DVec3, DVec3) {
+        match self {
+            Self::Nurbs(s) | Self::Rebuilt(s) => s.point_normal(uv),
+            Self::Offset { .. } => (self.point(uv), self.normal(uv)),
+        }
+    }
+    fn normal_from_tangents(&self, uv: DVec2, su: DVec3, sv: DVec3) -> DVec3 {
+        match self {
+            Self::Nurbs(s) | Self::Rebuilt(s) => s.normal_from_tangents(uv, su, sv),
+            Self::Offset { .. } => self.normal(uv),
         }
     }
     fn normal(&self, uv: DVec2) -> DVec3 {

@@ -1,6 +1,8 @@
 //! Rational B-spline curves in 2-D (z = 0) and 3-D.
 
+use alloc::collections::BinaryHeap;
 use alloc::vec::Vec;
+use core::cmp::Ordering;
 use glam::{DVec3, DVec4};
 
 use super::knots::{KnotVector, MAX_DERIV};
@@ -114,7 +116,7 @@ impl NurbsCurve {
 
     fn point_n<const N: usize>(&self, t: f64) -> DVec3 {
         let mut b = [[0.0; N]; MAX_DERIV + 1];
-        let span = self.knots.basis_into(t, 0, &mut b);
+        let span = self.knots.basis_fast(None, t, 0, &mut b);
         let p = self.degree();
         let mut h = DVec4::ZERO;
         for j in 0..=p {
@@ -145,13 +147,7 @@ impl NurbsCurve {
     /// Derivatives at `t` in the span holding it, or in `span` when given.
     fn derivs_n<const N: usize>(&self, span: Option<usize>, t: f64) -> CurveDerivs {
         let mut b = [[0.0; N]; MAX_DERIV + 1];
-        let span = match span {
-            Some(s) => {
-                self.knots.basis_in_span(s, t, 2, &mut b);
-                s
-            }
-            None => self.knots.basis_into(t, 2, &mut b),
-        };
+        let span = self.knots.basis_fast(span, t, 2, &mut b);
         let p = self.degree();
         let mut h = [DVec4::ZERO; 3];
         for (k, hk) in h.iter_mut().enumerate() {
@@ -245,7 +241,14 @@ impl NurbsCurve {
         let pa = self.point(a);
         // (t, point, distance, span).
         let mut best = (a, pa, pa.distance(target), self.knots.span(a));
-        let mut pieces: Vec<Piece> = Vec::new();
+        // Best-first: a heap ordered by the bound (ties by age), not a scan
+        // of every waiting piece per step, which made long curves quadratic.
+        let mut pieces: BinaryHeap<Queued> = BinaryHeap::new();
+        let mut seq = 0usize;
+        let mut queue = |heap: &mut BinaryHeap<Queued>, piece: Piece| {
+            heap.push(Queued { piece, seq });
+            seq += 1;
+        };
         for w in self.knots.breakpoints().windows(2) {
             let span = self.knots.span(0.5 * (w[0] + w[1]));
             let ctrl = self.bezier_of_span(span);
@@ -257,17 +260,19 @@ impl NurbsCurve {
                     best = (t, q, d, span);
                 }
             }
-            pieces.push(piece);
+            queue(&mut pieces, piece);
         }
         let mut examined = 0;
         while examined < MAX_PIECES {
-            let Some(k) = (0..pieces.len()).min_by(|&i, &j| pieces[i].bound.total_cmp(&pieces[j].bound)) else {
+            let Some(next) = pieces.peek() else {
                 break;
             };
-            if pieces[k].bound >= best.2 * best.2 {
+            if next.piece.bound >= best.2 * best.2 {
                 break;
             }
-            let piece = pieces.swap_remove(k);
+            let Some(Queued { piece, .. }) = pieces.pop() else {
+                break;
+            };
             examined += 1;
             if piece.t1 - piece.t0 <= LEAF * (piece.span_hi - piece.span_lo) {
                 let mid = 0.5 * (piece.t0 + piece.t1);
@@ -284,8 +289,8 @@ impl NurbsCurve {
             if d < best.2 {
                 best = (right.t0, q, d, right.span);
             }
-            pieces.push(left);
-            pieces.push(right);
+            queue(&mut pieces, left);
+            queue(&mut pieces, right);
         }
         // Polish within the span (a best found at a piece's end, or after the cap).
         let (lo, hi) = (self.knots.knots()[best.3], self.knots.knots()[best.3 + 1]);
@@ -326,10 +331,12 @@ impl NurbsCurve {
     /// Safeguarded Newton iterations from `t` on the polynomial piece of
     /// `span`, staying inside its parameter range `[lo, hi]`.
     fn newton_in_span(&self, target: DVec3, span: usize, lo: f64, hi: f64, mut t: f64) -> (f64, DVec3, f64) {
-        let mut point = self.derivs_in(span, t).point;
+        // Derivatives at `t`, kept from the evaluation that accepted it.
+        let mut c = self.derivs_in(span, t);
+        let mut point = c.point;
         let mut dist = point.distance(target);
+        let stop = 1e-14 * (hi - lo).max(1.0);
         for _ in 0..32 {
-            let c = self.derivs_in(span, t);
             let r = c.point - target;
             let f = c.d1.dot(r);
             let df = c.d1.length_squared() + c.d2.dot(r);
@@ -338,18 +345,24 @@ impl NurbsCurve {
             if !step.is_finite() {
                 break;
             }
+            // Converged: a move this short ends the search whether it is
+            // taken or not (trying it only compares rounding noise, halving twelve times).
+            if ((t + step).clamp(lo, hi) - t).abs() <= stop {
+                break;
+            }
             let mut accepted = false;
             for _ in 0..12 {
                 let tn = (t + step).clamp(lo, hi);
-                let pn = self.derivs_in(span, tn).point;
-                let dn = pn.distance(target);
+                let cn = self.derivs_in(span, tn);
+                let dn = cn.point.distance(target);
                 if dn <= dist {
                     let moved = (tn - t).abs();
                     t = tn;
-                    point = pn;
+                    point = cn.point;
                     dist = dn;
+                    c = cn;
                     accepted = true;
-                    if moved <= 1e-14 * (hi - lo).max(1.0) {
+                    if moved <= stop {
                         return (t, point, dist);
                     }
                     break;
@@ -369,6 +382,33 @@ const MAX_PIECES: usize = 2048;
 
 /// A piece this fraction of its knot span long is finished by Newton, not split.
 const LEAF: f64 = 1.0 / 256.0;
+
+/// A waiting [`Piece`] in [`NurbsCurve::project`]'s heap: the greatest is
+/// the one of the lowest bound, the earliest queued among equal bounds.
+struct Queued {
+    piece: Piece,
+    seq: usize,
+}
+
+impl Ord for Queued {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.piece.bound.total_cmp(&self.piece.bound).then(other.seq.cmp(&self.seq))
+    }
+}
+
+impl PartialOrd for Queued {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl PartialEq for Queued {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+
+impl Eq for Queued {}
 
 /// A Bézier piece of one knot span, with the lower bound of its squared
 /// distance to the target.

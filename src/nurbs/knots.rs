@@ -156,6 +156,68 @@ impl KnotVector {
         span
     }
 
+    /// As [`KnotVector::basis_into`] (or, given `span`, as
+    /// [`KnotVector::basis_in_span`], returning that span), computed in
+    /// scratch of exactly degree + 1 for degrees up to 7 (then the loops
+    /// unroll) and copied into `ders`; the values are the same.
+    pub(crate) fn basis_fast<const N: usize>(
+        &self,
+        span: Option<usize>,
+        t: f64,
+        nd: usize,
+        ders: &mut [[f64; N]; MAX_DERIV + 1],
+    ) -> usize {
+        match self.degree {
+            1 => self.basis_exact::<2, N>(span, t, nd, ders),
+            2 => self.basis_exact::<3, N>(span, t, nd, ders),
+            3 => self.basis_exact::<4, N>(span, t, nd, ders),
+            4 => self.basis_exact::<5, N>(span, t, nd, ders),
+            5 => self.basis_exact::<6, N>(span, t, nd, ders),
+            6 => self.basis_exact::<7, N>(span, t, nd, ders),
+            7 => self.basis_exact::<8, N>(span, t, nd, ders),
+            _ => self.basis_at(span, t, nd, ders),
+        }
+    }
+
+    /// [`KnotVector::basis_fast`] for degree `M - 1` (`M <= N`).
+    fn basis_exact<const M: usize, const N: usize>(
+        &self,
+        span: Option<usize>,
+        t: f64,
+        nd: usize,
+        ders: &mut [[f64; N]; MAX_DERIV + 1],
+    ) -> usize {
+        if M > N {
+            return self.basis_at(span, t, nd, ders);
+        }
+        let mut exact = [[0.0; M]; MAX_DERIV + 1];
+        let span = self.basis_at(span, t, nd, &mut exact);
+        for (to, from) in ders.iter_mut().zip(&exact).take(nd.min(MAX_DERIV) + 1) {
+            if let Some(to) = to.get_mut(..M) {
+                to.copy_from_slice(from);
+            }
+        }
+        span
+    }
+
+    /// [`KnotVector::basis_in_span`] in `span` when given (returning it),
+    /// else [`KnotVector::basis_into`].
+    fn basis_at<const N: usize>(
+        &self,
+        span: Option<usize>,
+        t: f64,
+        nd: usize,
+        ders: &mut [[f64; N]; MAX_DERIV + 1],
+    ) -> usize {
+        match span {
+            Some(s) => {
+                self.basis_in_span(s, t, nd, ders);
+                s
+            }
+            None => self.basis_into(t, nd, ders),
+        }
+    }
+
     /// As [`KnotVector::basis_into`] with the polynomial piece of span `span`
     /// (clamped to `degree..control_count()`) instead of the span holding `t`.
     pub(crate) fn basis_in_span<const N: usize>(
@@ -168,33 +230,84 @@ impl KnotVector {
         if self.degree >= N {
             return;
         }
-        let p = self.degree;
-        let nd = nd.min(MAX_DERIV);
-        let ndu = self.basis_triangle::<N>(span, t);
-        for j in 0..=p {
-            ders[0][j] = ndu[j][p];
+        // Scratch of exactly degree + 1: the degree is then a constant and
+        // the loops unroll (the same operations in the same order).
+        if self.degree + 1 == N {
+            self.basis_of_degree::<N>(N - 1, span, t, nd, ders);
+        } else {
+            self.basis_of_degree::<N>(self.degree, span, t, nd, ders);
         }
+    }
+
+    /// The body of [`KnotVector::basis_in_span`] for degree `p` (`p < N`,
+    /// equal to `self.degree`); inlined so that a constant `p` specializes it.
+    #[inline(always)]
+    fn basis_of_degree<const N: usize>(
+        &self,
+        p: usize,
+        span: usize,
+        t: f64,
+        nd: usize,
+        ders: &mut [[f64; N]; MAX_DERIV + 1],
+    ) {
+        let nd = nd.min(MAX_DERIV);
+        let t = self.clamp(t);
+        let span = span.clamp(p, self.control_count() - 1);
+        let u = &self.knots;
+        // A2.2's in-place rows instead of A2.3's full triangle: the
+        // derivatives need only the degree p-1 and p-2 rows (kept as copies)
+        // and knot differences, which `left` and `right` give again exactly;
+        // no N×N table to clear per call. Same operations, same order.
+        let mut left = [0.0f64; N];
+        let mut right = [0.0f64; N];
+        let mut row = [0.0f64; N];
+        let mut row1 = [0.0f64; N];
+        let mut row2 = [0.0f64; N];
+        row[0] = 1.0;
+        for j in 1..=p {
+            if j + 1 == p {
+                row2 = row;
+            }
+            if j == p {
+                row1 = row;
+            }
+            left[j] = t - u[span + 1 - j];
+            right[j] = u[span + j] - t;
+            let mut saved = 0.0;
+            for r in 0..j {
+                let gap = right[r + 1] + left[j - r];
+                let temp = if gap != 0.0 { row[r] / gap } else { 0.0 };
+                row[r] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            row[j] = saved;
+        }
+        ders[0][..=p].copy_from_slice(&row[..=p]);
         if nd == 0 {
             return;
         }
         // First and second derivatives from the degree p-1 and p-2 functions
-        // the triangle holds (The NURBS Book eq. 2.9, the terms of A2.3
-        // for k <= 2 written out): `basis(r, j)` is N of degree j, `gap(j, r)`
-        // a knot difference; a zero gap drops its term.
-        let basis = |r: usize, j: usize| ndu[r][j];
-        let gap = |j: usize, r: usize| ndu[j][r];
+        // (The NURBS Book eq. 2.9, the terms of A2.3 for k <= 2 written out):
+        // `gap(j, r)` is the knot difference A2.3's triangle holds at `[j][r]`;
+        // a zero gap drops its term.
+        let gap = |j: usize, r: usize| right[r + 1] + left[j - r];
         let over = |x: f64, gap: f64| if gap != 0.0 { x / gap } else { 0.0 };
+        // 1 / gap(p, r), shared by the coefficients of neighbours r and r + 1.
+        let mut inv = [0.0f64; N];
+        for (r, x) in inv.iter_mut().enumerate().take(p) {
+            *x = over(1.0, gap(p, r));
+        }
         let pf = p as f64;
         for r in 0..=p {
             // Coefficients of the degree p-1 functions in N', as A2.3's a[.][0] and a[.][1].
-            let c0 = if r >= 1 { over(1.0, gap(p, r - 1)) } else { 0.0 };
-            let c1 = if r < p { -over(1.0, gap(p, r)) } else { 0.0 };
+            let c0 = if r >= 1 { inv[r - 1] } else { 0.0 };
+            let c1 = if r < p { -inv[r] } else { 0.0 };
             let mut d1 = 0.0;
             if r >= 1 {
-                d1 += c0 * basis(r - 1, p - 1);
+                d1 += c0 * row1[r - 1];
             }
             if r < p {
-                d1 += c1 * basis(r, p - 1);
+                d1 += c1 * row1[r];
             }
             ders[1][r] = pf * d1;
             if nd >= 2 {
@@ -204,25 +317,26 @@ impl KnotVector {
                 }
                 let mut d2 = 0.0;
                 if r >= 2 {
-                    d2 += over(c0, gap(p - 1, r - 2)) * basis(r - 2, p - 2);
+                    d2 += over(c0, gap(p - 1, r - 2)) * row2[r - 2];
                 }
                 if r >= 1 && r < p {
-                    d2 += over(c1 - c0, gap(p - 1, r - 1)) * basis(r - 1, p - 2);
+                    d2 += over(c1 - c0, gap(p - 1, r - 1)) * row2[r - 1];
                 }
                 if r + 2 <= p {
-                    d2 += over(-c1, gap(p - 1, r)) * basis(r, p - 2);
+                    d2 += over(-c1, gap(p - 1, r)) * row2[r];
                 }
                 ders[2][r] = pf * (pf - 1.0) * d2;
             }
         }
     }
 
-    /// The Cox-de Boor triangle of A2.3 for the piece of span `span`
+    /// The Cox-de Boor triangle of A2.3 (for the tests' reference) for the piece of span `span`
     /// (clamped to `degree..control_count()`) at `t` (clamped): `[r][j]` for
     /// `r <= j` is the degree-`j` function `N_{span-j+r}`, `[j][r]` for `r < j`
-    /// the knot difference it was divided by. Needs `N > degree`.
-    fn basis_triangle<const N: usize>(&self, span: usize, t: f64) -> [[f64; N]; N] {
-        let p = self.degree;
+    /// the knot difference it was divided by. `p` is the degree (an argument
+    /// so that a constant specializes it). Needs `N > degree`.
+    #[cfg(test)]
+    fn basis_triangle<const N: usize>(&self, p: usize, span: usize, t: f64) -> [[f64; N]; N] {
         let t = self.clamp(t);
         let span = span.clamp(p, self.control_count() - 1);
         let u = &self.knots;
@@ -282,7 +396,7 @@ mod tests {
         const N: usize = MAX_DEGREE + 1;
         let p = kv.degree;
         let mut ders = [[0.0f64; N]; MAX_DERIV + 1];
-        let ndu = kv.basis_triangle::<N>(span, t);
+        let ndu = kv.basis_triangle::<N>(kv.degree, span, t);
         for j in 0..=p {
             ders[0][j] = ndu[j][p];
         }

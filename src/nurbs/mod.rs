@@ -63,6 +63,27 @@ pub trait Surface {
         false
     }
 
+    /// `(S, Su, Sv)`: what a normal needs. The default takes them from
+    /// [`Surface::derivs`]; a surface that can skip the second derivatives
+    /// should, with the same values.
+    fn tangents(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
+        let d = self.derivs(uv);
+        (d.point, d.su, d.sv)
+    }
+
+    /// `S(uv)` and [`Surface::normal`] at `uv`, the same values, from one
+    /// evaluation with first derivatives where the surface is regular.
+    fn point_normal(&self, uv: DVec2) -> (DVec3, DVec3) {
+        let (p, su, sv) = self.tangents(uv);
+        (p, self.normal_from_tangents(uv, su, sv))
+    }
+
+    /// [`Surface::normal`] at `uv` given `Su` and `Sv` there (already
+    /// evaluated): their cross product where regular, else the normal's own limit.
+    fn normal_from_tangents(&self, uv: DVec2, su: DVec3, sv: DVec3) -> DVec3 {
+        regular_cross(su, sv).unwrap_or_else(|| self.normal(uv))
+    }
+
     /// Unit normal `Su × Sv`, defined also where the surface degenerates.
     ///
     /// At a collapsed edge (sphere pole) `Su × Sv` vanishes, or is made only of
@@ -70,17 +91,19 @@ pub trait Surface {
     /// taken from a point nudged toward the domain's centre, which is the
     /// direction every nearby facet sees.
     fn normal(&self, uv: DVec2) -> DVec3 {
-        let d = self.derivs(uv);
-        if let Some(n) = regular_normal(&d) {
+        let (_, su, sv) = self.tangents(uv);
+        if let Some(n) = regular_cross(su, sv) {
             return n;
         }
+        let d = self.derivs(uv);
         let [lo, hi] = self.domain();
         let centre = (lo + hi) * 0.5;
         let mut f = 1e-7;
         for _ in 0..6 {
             f *= 10.0;
             let q = uv + (centre - uv) * f;
-            if let Some(n) = regular_normal(&self.derivs(q)) {
+            let (_, su, sv) = self.tangents(q);
+            if let Some(n) = regular_cross(su, sv) {
                 // The exact limit where it exists, on the side the nudge found.
                 return match collapsed_normal(&d) {
                     Some(exact) if exact.dot(n) > 0.0 => exact,
@@ -117,9 +140,14 @@ fn collapsed_normal(d: &SurfaceDerivs) -> Option<DVec3> {
 /// orders of magnitude shorter than the other (a collapsed edge, where what is
 /// left of it is rounding noise pointing anywhere) or the two are parallel.
 pub(crate) fn regular_normal(d: &SurfaceDerivs) -> Option<DVec3> {
+    regular_cross(d.su, d.sv)
+}
+
+/// [`regular_normal`] from the two first derivatives alone.
+fn regular_cross(su: DVec3, sv: DVec3) -> Option<DVec3> {
     const DEGENERATE: f64 = 1e-10;
-    let n = d.su.cross(d.sv);
+    let n = su.cross(sv);
     let len = n.length();
-    let scale = d.su.length_squared() + d.sv.length_squared();
+    let scale = su.length_squared() + sv.length_squared();
     (len.is_finite() && len > 0.0 && len > DEGENERATE * scale).then(|| n / len)
 }

@@ -141,13 +141,29 @@ impl NurbsSurface {
         Aabb::from_points(self.control_points())
     }
 
-    /// Homogeneous derivatives `A^{(k,l)}` for `k + l <= order` (order ≤ 2).
+    /// Homogeneous derivatives `A^{(k,l)}` for `k + l <= order` (order ≤ 2;
+    /// the others are left zero).
+    ///
+    /// Degrees up to 3 each way (planes, quadrics, bicubics: nearly every
+    /// face) get scratch of exactly degree + 1, so both degrees are constants
+    /// and every loop unrolls; the operations and their order are the same.
     fn homogeneous_derivs(&self, uv: DVec2, order: usize) -> [[DVec4; 3]; 3] {
-        match self.ku.degree().max(self.kv.degree()) {
-            0..=3 => self.homogeneous_derivs_n::<4>(uv, order),
-            4..=7 => self.homogeneous_derivs_n::<8>(uv, order),
-            8..=11 => self.homogeneous_derivs_n::<12>(uv, order),
-            _ => self.homogeneous_derivs_n::<{ super::MAX_DEGREE + 1 }>(uv, order),
+        match (self.ku.degree(), self.kv.degree()) {
+            (1, 1) => self.homogeneous_derivs_exact::<2, 2>(uv, order),
+            (1, 2) => self.homogeneous_derivs_exact::<2, 3>(uv, order),
+            (2, 1) => self.homogeneous_derivs_exact::<3, 2>(uv, order),
+            (2, 2) => self.homogeneous_derivs_exact::<3, 3>(uv, order),
+            (1, 3) => self.homogeneous_derivs_exact::<2, 4>(uv, order),
+            (3, 1) => self.homogeneous_derivs_exact::<4, 2>(uv, order),
+            (2, 3) => self.homogeneous_derivs_exact::<3, 4>(uv, order),
+            (3, 2) => self.homogeneous_derivs_exact::<4, 3>(uv, order),
+            (3, 3) => self.homogeneous_derivs_exact::<4, 4>(uv, order),
+            (p, q) => match p.max(q) {
+                0..=3 => self.homogeneous_derivs_class::<4>(uv, order),
+                4..=7 => self.homogeneous_derivs_class::<8>(uv, order),
+                8..=11 => self.homogeneous_derivs_class::<12>(uv, order),
+                _ => self.homogeneous_derivs_class::<{ super::MAX_DEGREE + 1 }>(uv, order),
+            },
         }
     }
 
@@ -191,26 +207,56 @@ impl NurbsSurface {
         out
     }
 
-    fn homogeneous_derivs_n<const N: usize>(&self, uv: DVec2, order: usize) -> [[DVec4; 3]; 3] {
-        let mut bu = [[0.0; N]; 3];
-        let mut bv = [[0.0; N]; 3];
-        let su = self.ku.basis_into(uv.x, order, &mut bu);
-        let sv = self.kv.basis_into(uv.y, order, &mut bv);
-        let (p, q) = (self.ku.degree(), self.kv.degree());
+    /// Degrees `NU - 1` and `NV - 1` (the caller checked), as constants.
+    fn homogeneous_derivs_exact<const NU: usize, const NV: usize>(&self, uv: DVec2, order: usize) -> [[DVec4; 3]; 3] {
+        self.homogeneous_derivs_n::<NU, NV>(NU - 1, NV - 1, uv, order)
+    }
+
+    /// Any degrees below `N`.
+    fn homogeneous_derivs_class<const N: usize>(&self, uv: DVec2, order: usize) -> [[DVec4; 3]; 3] {
+        self.homogeneous_derivs_n::<N, N>(self.ku.degree(), self.kv.degree(), uv, order)
+    }
+
+    /// The tensor product for degrees `p < NU`, `q < NV` (equal to the knot
+    /// vectors' degrees); inlined so that constant degrees specialize it.
+    #[inline(always)]
+    fn homogeneous_derivs_n<const NU: usize, const NV: usize>(
+        &self,
+        p: usize,
+        q: usize,
+        uv: DVec2,
+        order: usize,
+    ) -> [[DVec4; 3]; 3] {
+        let mut bu = [[0.0; NU]; 3];
+        let mut bv = [[0.0; NV]; 3];
+        // Exact scratch already unrolls the basis; a degree class gets the
+        // basis in exact scratch (degrees up to 7) and copies it.
+        let (su, sv) = if p + 1 == NU && q + 1 == NV {
+            (self.ku.basis_into(uv.x, order, &mut bu), self.kv.basis_into(uv.y, order, &mut bv))
+        } else {
+            (self.ku.basis_fast(None, uv.x, order, &mut bu), self.kv.basis_fast(None, uv.y, order, &mut bv))
+        };
         let nv = self.kv.control_count();
         let mut out = [[DVec4::ZERO; 3]; 3];
-        let mut temp = [DVec4::ZERO; N];
-        for k in 0..=order {
-            for (s, t) in temp.iter_mut().enumerate().take(q + 1) {
-                let mut acc = DVec4::ZERO;
-                for r in 0..=p {
-                    acc += self.points[(su - p + r) * nv + sv - q + s] * bu[k][r];
+        // temp[k][s] = sum over r of P[r][s]·Nu^(k)[r]: each control row is
+        // read once for all orders (sums in the same order as one order at a time).
+        let mut temp = [[DVec4::ZERO; NV]; 3];
+        let first = (su - p) * nv + sv - q;
+        for r in 0..=p {
+            let Some(row) = self.points.get(first + r * nv..first + r * nv + q + 1) else {
+                continue;
+            };
+            for k in 0..=order {
+                let w = bu[k][r];
+                for (t, h) in temp[k].iter_mut().zip(row) {
+                    *t += *h * w;
                 }
-                *t = acc;
             }
+        }
+        for (k, tk) in temp.iter().enumerate().take(order + 1) {
             for l in 0..=(order - k) {
                 let mut acc = DVec4::ZERO;
-                for (s, t) in temp.iter().enumerate().take(q + 1) {
+                for (s, t) in tk.iter().enumerate().take(q + 1) {
                     acc += *t * bv[l][s];
                 }
                 out[k][l] = acc;
@@ -331,6 +377,16 @@ impl Surface for NurbsSurface {
     fn point(&self, uv: DVec2) -> DVec3 {
         let a = self.homogeneous_derivs(uv, 0)[0][0];
         a.truncate() / a.w
+    }
+
+    fn tangents(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
+        // First order only: the same sums as in `derivs`, the second-order ones left out.
+        let a = self.homogeneous_derivs(uv, 1);
+        let w = a[0][0].w;
+        let s = a[0][0].truncate() / w;
+        let su = (a[1][0].truncate() - s * a[1][0].w) / w;
+        let sv = (a[0][1].truncate() - s * a[0][1].w) / w;
+        (s, su, sv)
     }
 
     fn derivs(&self, uv: DVec2) -> SurfaceDerivs {

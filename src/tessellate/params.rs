@@ -392,7 +392,7 @@ pub(crate) fn grid_params(
     let make = |s: f64| {
         move |t: f64| {
             let uv = if along_u { DVec2::new(t, s) } else { DVec2::new(s, t) };
-            (surface.point(uv), surface.normal(uv))
+            surface.point_normal(uv)
         }
     };
     let curves: Vec<_> = (0..=lines).map(|k| s0 + (s1 - s0) * k as f64 / lines as f64).map(|s| (s, make(s))).collect();

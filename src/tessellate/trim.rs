@@ -152,7 +152,7 @@ pub(crate) fn prepare_loops<'a>(
                 let uv = d.point.truncate();
                 let s = surface.derivs(uv);
                 let tangent = s.su * d.d1.x + s.sv * d.d1.y;
-                (s.point, surface.normal(uv), tangent)
+                (s.point, surface.normal_from_tangents(uv, s.su, s.sv), tangent)
             };
             let by_normal = |t: f64| {
                 let (p, n, _) = on_surface(t);
