@@ -151,7 +151,14 @@ pub(crate) fn mesh_face(
         let domain = domain_loops(face);
         let loops = if face.loops.is_empty() { &domain } else { &face.loops };
         let mut o = outline(index, &face.surface, loops, face.loops.is_empty(), lim)?;
-        super::sew::unify(&mut [Some((&face.surface as &dyn Surface, &mut o))], &[], tight, tight, tight + lim.tol);
+        super::sew::unify(
+            &mut [Some((&face.surface as &dyn Surface, &mut o))],
+            &[],
+            &[],
+            tight,
+            tight,
+            tight + lim.tol,
+        );
         let mut wm = initial_from_outline(index, &face.surface, &o, budget)?;
         let outcome = wm.refine(&face.surface, &o.loops.curves, crit, budget);
         Ok(FaceResult { mesh: wm, outcome })
