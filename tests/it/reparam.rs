@@ -402,3 +402,41 @@ fn reparam_auto_sews_rebuilt_faces_to_their_neighbours() {
         assert!(yard.max_deviation <= tol && a.max_deviation <= tol, "rel {rel}: {} > {tol}", yard.max_deviation);
     }
 }
+
+/// The flagged corpus faces whose rebuild cannot win, each meshed on its
+/// own at its model's tolerance: `auto` falls back to the original with a
+/// warning and meshes exactly what `off` does. asmo_car's face 2 at 1e-3
+/// is a thin quad that both mesh in 2 triangles on the same 4 corners, so
+/// the angles tie; ship_kcs's face 17 folds, and its rebuild's grid takes
+/// more triangles than the original's whole mesh.
+#[test]
+fn reparam_losing_corpus_faces_mesh_as_off() {
+    for (file, index, rel) in [("asmo_car.igs", 2, 1e-3), ("ship_kcs.igs", 17, 1e-2), ("ship_kcs.igs", 17, 1e-3)] {
+        let Some(m) = corpus(file) else {
+            println!("{file}: corpus not found, skipped");
+            continue;
+        };
+        let tol = reparameterize_model(&m, Reparam::Off, Tolerance::Relative(rel)).unwrap().tolerance;
+        let one = Model {
+            units: m.units.clone(),
+            faces: vec![m.faces[index].clone()],
+            warnings: Vec::new(),
+            tolerance: None,
+            bodies: Vec::new(),
+        };
+        assert!(step_ratio(&one.faces[0].surface) > RATIO_LIMIT, "{file} face {index}");
+        let run = |mode| mesh_model(&one, &MeshOptions::default().with_tolerance(tol).with_reparam(mode)).unwrap();
+        let (off, auto) = (run(Reparam::Off), run(Reparam::Auto));
+        let (o, a) = (&off.report, &auto.report);
+        println!(
+            "{file} face {index} at {rel}: off {} tris p1 {:.3}°, auto {} tris p1 {:.3}°: {:?}",
+            o.triangles, o.p1_angle_deg, a.triangles, a.p1_angle_deg, a.warnings
+        );
+        assert_eq!(a.reparameterized.len(), 1, "{file} face {index} at {rel}");
+        assert!(!a.reparameterized[0].rebuilt, "{file} face {index} at {rel}");
+        assert!(a.warnings.iter().any(|w| w.ends_with("meshed the original")), "{:?}", a.warnings);
+        assert_eq!(auto.mesh.indices, off.mesh.indices, "{file} face {index} at {rel}");
+        assert_eq!(auto.mesh.positions, off.mesh.positions, "{file} face {index} at {rel}");
+        assert!(a.max_deviation <= tol && a.inverted_triangles == 0, "{file} face {index} at {rel}");
+    }
+}
