@@ -42,7 +42,7 @@ export interface MeshOptions {
   minEdge?: number;
   /** Triangle budget; refinement stops with a warning past it. */
   maxTriangles?: number;
-  /** Rebuild poorly parameterized faces first: "off" (default), "auto" (flagged faces), "force". */
+  /** Rebuild poorly parameterized faces first: "auto" (default: flagged faces, a rebuild kept where it wins), "off", "force". */
   reparam?: "auto" | "off" | "force";
   /** "fast" (default): fewest triangles within the tolerance; "quality": near-equilateral triangles of size H (paper 003). */
   mode?: "fast" | "quality";

@@ -641,3 +641,19 @@ fn step_assembly_parts_and_colours_reach_js() {
     let bytes = binding::memory_bytes();
     assert!(bytes >= 65536.0 && bytes % 65536.0 == 0.0, "{bytes}");
 }
+
+/// Paper 001 by default: a crowded surface is flagged and rebuilt without
+/// the option, and `"off"` leaves it as it is.
+#[wasm_bindgen_test]
+fn reparam_auto_is_the_default() {
+    let crowded = include_bytes!("data/crowded_uv.json");
+    let plain = ok(crowded, options(&[("toleranceRel", num(1e-2))]));
+    let off = ok(crowded, options(&[("toleranceRel", num(1e-2)), ("reparam", "off".into())]));
+    let list = |o: &Output| Array::from(&Reflect::get(&o.report, &"reparameterized".into()).unwrap());
+    assert_eq!(list(&off).length(), 0);
+    assert_eq!(list(&plain).length(), 1);
+    let rebuilt = Reflect::get(&list(&plain).get(0), &"rebuilt".into()).unwrap();
+    assert_eq!(rebuilt.as_bool(), Some(true));
+    assert!(plain.triangles() < off.triangles(), "{} vs {}", plain.triangles(), off.triangles());
+    assert!(plain.number("max_deviation") <= plain.number("tolerance"));
+}

@@ -22,15 +22,15 @@ pub(crate) use interp::{chord_params, interpolate_curve, interpolate_surface};
 
 /// When faces are re-parameterized before meshing.
 ///
-/// Off by default for now: rebuilt faces hold the tolerance against the
-/// original and get better-shaped triangles, but the mesher does not yet
-/// always turn the even parameters into fewer triangles.
+/// Auto by default: a flagged face's rebuild is kept only where its mesh
+/// wins (no more triangles, better angles) and the original is meshed
+/// otherwise, so the default never meshes a face worse than `Off`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Reparam {
-    /// Faces the ratio test flags.
-    Auto,
-    /// Never (the default).
+    /// Faces the ratio test flags (the default).
     #[default]
+    Auto,
+    /// Never.
     Off,
     /// Every face.
     Force,

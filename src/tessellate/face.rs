@@ -151,7 +151,17 @@ pub(crate) fn mesh_face(
         let domain = domain_loops(face);
         let loops = if face.loops.is_empty() { &domain } else { &face.loops };
         let mut o = outline(index, &face.surface, loops, face.loops.is_empty(), lim)?;
-        super::sew::unify(&mut [Some((&face.surface as &dyn Surface, &mut o))], &[], tight, tight, tight + lim.tol);
+        // A grid [`initial_from_outline`] refuses anyway is refused before
+        // sewing its many border nodes (a rebuild's trial on a folded face).
+        check_band_cells(index, &o, budget)?;
+        super::sew::unify(
+            &mut [Some((&face.surface as &dyn Surface, &mut o))],
+            &[],
+            &[],
+            tight,
+            tight,
+            tight + lim.tol,
+        );
         let mut wm = initial_from_outline(index, &face.surface, &o, budget)?;
         let outcome = wm.refine(&face.surface, &o.loops.curves, crit, budget);
         Ok(FaceResult { mesh: wm, outcome })
@@ -417,10 +427,7 @@ pub(crate) fn initial_from_outline(
     // the region they keep (a rebuilt face's loops on its whole old domain):
     // a grid up to four times the budget is triangulated, and judged by the
     // triangles the loops keep.
-    let cells = o.pu.len().saturating_sub(1).saturating_mul(o.pv.len().saturating_sub(1));
-    if cells > budget.saturating_mul(2).min(MAX_BAND_CELLS) {
-        check_grid(index, &o.pu, &o.pv, budget)?;
-    }
+    check_band_cells(index, o, budget)?;
     let band = Band::new(surface, &o.loops, &o.pu, &o.pv);
     let tris = band.triangulate(index)?;
     if tris.len() > budget {
@@ -448,6 +455,17 @@ fn trimmed<'a>(
 /// triangulates to count what its loops keep.
 #[cfg(feature = "std")]
 const MAX_BAND_CELLS: usize = 1_000_000;
+
+/// [`check_grid`] for a grid of more cells than [`initial_from_outline`]
+/// triangulates to count what the loops keep.
+#[cfg(feature = "std")]
+fn check_band_cells(index: usize, o: &Outline<'_>, budget: usize) -> Result<(), Error> {
+    let cells = o.pu.len().saturating_sub(1).saturating_mul(o.pv.len().saturating_sub(1));
+    if cells > budget.saturating_mul(2).min(MAX_BAND_CELLS) {
+        check_grid(index, &o.pu, &o.pv, budget)?;
+    }
+    Ok(())
+}
 
 pub(super) fn check_grid(index: usize, pu: &[f64], pv: &[f64], budget: usize) -> Result<(), Error> {
     let cells = pu.len().saturating_sub(1).saturating_mul(pv.len().saturating_sub(1));

@@ -616,9 +616,11 @@ impl<'a> Chosen<'a> {
 fn unify_outlines(chosen: &mut [Option<Chosen<'_>>], bodies: &[u32], sew_tol: f64, tight: f64, reach: f64) -> u32 {
     #[cfg(feature = "std")]
     {
+        // A rebuilt face's border lies up to its fit error from its neighbours'.
+        let moved: Vec<f64> = chosen.iter().map(|c| c.as_ref().map_or(0.0, |c| c.fit_error)).collect();
         let mut faces: Vec<Option<(&dyn Surface, &mut face::Outline<'_>)>> =
             chosen.iter_mut().map(|c| c.as_mut().map(|c| (&c.face.surface as &dyn Surface, &mut c.outline))).collect();
-        sew::unify(&mut faces, bodies, sew_tol, tight, reach)
+        sew::unify(&mut faces, bodies, &moved, sew_tol, tight, reach)
     }
     #[cfg(not(feature = "std"))]
     {

@@ -58,8 +58,8 @@ pub struct MeshOptions {
     /// verification samples stays within the tolerance too. Default 0.8.
     pub safety: f64,
     /// Re-parameterization of poorly parameterized faces before meshing
-    /// (paper 001). Default [`Reparam::Off`]; [`Reparam::Auto`] rebuilds the
-    /// faces the ratio test flags.
+    /// (paper 001). Default [`Reparam::Auto`]: the faces the ratio test
+    /// flags are rebuilt, each kept only where its mesh wins.
     pub reparam: Reparam,
     /// Fewest triangles ([`MeshMode::Fast`], default) or analysis quality.
     pub mode: MeshMode,
@@ -107,7 +107,7 @@ impl Default for MeshOptions {
             max_triangles: 4_000_000,
             measure_steps: 4,
             safety: 0.8,
-            reparam: Reparam::Off,
+            reparam: Reparam::Auto,
             mode: MeshMode::Fast,
             quality: QualityOptions::default(),
             share: None,

@@ -187,7 +187,7 @@ function readOptions() {
   const maxEdge = $('max-edge').value.trim();
   if (maxEdge !== '') options.maxEdge = Number(maxEdge);
   const reparam = $('reparam').value;
-  if (reparam !== 'off' && meshMode() !== 'quality') options.reparam = reparam;
+  if (reparam !== 'auto' && meshMode() !== 'quality') options.reparam = reparam;
   return options;
 }
 

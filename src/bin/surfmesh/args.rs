@@ -79,8 +79,9 @@ Options of `mesh`:
   --weights C1,C2,C3,C4  quality mode: the splitting function's weights
                       (default 1,0.3,0.6,1)
   --passes N          quality mode: improvement rounds (default 6)
-  --reparam MODE      rebuild poorly parameterized faces before meshing: off
-                      (default), auto (faces the step-ratio test flags), force
+  --reparam MODE      rebuild poorly parameterized faces before meshing: auto
+                      (default: faces the step-ratio test flags, each rebuild
+                      kept only where its mesh wins), off, force
   --format F          input format: json, iges (igs) or step (stp, p21); default:
                       from the extension, else from the content
   -o, --output FILE   write the mesh; .stl, .obj, .glb, .msh (Gmsh 4.1) or

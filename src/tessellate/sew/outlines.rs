@@ -39,10 +39,13 @@ type Additions = PerNode<Vec<(f64, f64, NodeRef)>>;
 /// shut. Returns the ids given.
 ///
 /// `reach`: how far a node may lie from the other border's chord
-/// (chordal tolerance plus `sew`).
+/// (chordal tolerance plus `sew`). `moved`: per face, how far its border
+/// may lie from where the model put it (a rebuilt face's fit error, paper
+/// 001; zero for the others, and missing entries are zero).
 pub(crate) fn unify(
     faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>],
     bodies: &[u32],
+    moved: &[f64],
     sew: f64,
     tight: f64,
     reach: f64,
@@ -63,7 +66,7 @@ pub(crate) fn unify(
     let mut twins: Vec<(NodeRef, NodeRef)> = Vec::new();
     let (mut sew_used, mut radius) = (tight, None);
     if sew > 0.0 && reach.is_finite() {
-        let (adds, r, used) = insertions(faces, bodies, &pos, sew, tight, reach, total / count as f64);
+        let (adds, r, used) = insertions(faces, bodies, moved, &pos, sew, tight, reach, total / count as f64);
         (sew_used, radius) = (used, Some(r));
         twins = insert(faces, &adds);
     }
@@ -136,11 +139,16 @@ fn radii_each(pos: &PerNode<DVec3>, sew_of: &dyn Fn(NodeRef) -> f64, tight: f64)
 /// that otherwise meets exactly) take four times the 90th percentile of
 /// theirs, counted at the nodes whose nearest other face is the other one
 /// and apart from it (a node both borders have is no gap, and one beside
-/// a thin face between them is nearer that face). Returns the additions,
-/// each node's reach, and the largest sewing distance used.
+/// a thin face between them is nearer that face). A face whose border was
+/// moved (`moved`: a rebuilt face, paper 001) widens by that much the
+/// distance of every pair it is in, up to `sew`: the model's gaps were
+/// measured where the border was. Returns the additions, each node's
+/// reach, and the largest sewing distance used.
+#[allow(clippy::too_many_arguments)]
 fn insertions(
     faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
     bodies: &[u32],
+    moved: &[f64],
     pos: &PerNode<DVec3>,
     sew: f64,
     tight: f64,
@@ -255,15 +263,26 @@ fn insertions(
     }
     let ceiling = sew.max(tight);
     let model_sew = (4.0 * q90(&mut gaps)).max(0.125 * sew).clamp(tight, ceiling);
+    let moved_by = |f: u32| moved.get(f as usize).copied().filter(|m| m.is_finite()).unwrap_or(0.0).max(0.0);
+    // The least a pair is sewn at: the model's distance, widened by how far
+    // either face's border was moved.
+    let floor = |a: u32, b: u32| (model_sew + moved_by(a) + if a == b { 0.0 } else { moved_by(b) }).min(ceiling);
+    for (&q, &(g, _)) in &nearest_face {
+        pair_gaps.entry((q.0.min(g), q.0.max(g))).or_default();
+    }
     let pair_sew: HashMap<(u32, u32), f64> = pair_gaps
         .into_iter()
         .map(|(key, mut g)| {
             let s = if g.len() >= PAIR_MIN { 4.0 * q90(&mut g) } else { 0.0 };
-            (key, s.clamp(model_sew, ceiling))
+            (key, s.clamp(floor(key.0, key.1), ceiling))
         })
         .collect();
     let sew_of = |q: NodeRef| {
-        nearest_face.get(&q).and_then(|&(g, _)| pair_sew.get(&(q.0.min(g), q.0.max(g)))).copied().unwrap_or(model_sew)
+        nearest_face
+            .get(&q)
+            .and_then(|&(g, _)| pair_sew.get(&(q.0.min(g), q.0.max(g))))
+            .copied()
+            .unwrap_or_else(|| floor(q.0, q.0))
     };
     let radius = radii_each(pos, &sew_of, tight);
     let sew = pair_sew.values().fold(model_sew, |m, &s| m.max(s));
@@ -294,7 +313,9 @@ fn insertions(
         }) {
             continue;
         }
-        if seg.0 != q.0 && d > tight.max(4.0 * nearest.get(&q).copied().unwrap_or(0.0)) {
+        // A moved border (a rebuilt face's) is as near as it was, within how far it moved.
+        let near_enough = (tight + moved_by(seg.0) + moved_by(q.0)).max(4.0 * nearest.get(&q).copied().unwrap_or(0.0));
+        if seg.0 != q.0 && d > near_enough {
             continue;
         }
         if d > nearest_in.get(&(q, seg.0)).copied().unwrap_or(0.0) + tight {
