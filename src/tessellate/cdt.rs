@@ -9,7 +9,7 @@
 use alloc::format;
 use alloc::vec::Vec;
 use glam::DVec2;
-use spade::handles::FixedFaceHandle;
+use spade::handles::{FixedFaceHandle, FixedVertexHandle};
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
 use crate::Error;
@@ -27,16 +27,29 @@ pub(crate) fn triangulate_region(
     // (`TooSmall`); files do hold such values (3e-49 for 0), which are 0.
     let flush = |x: f64| if x.abs() < 1e-40 { 0.0 } else { x };
     let verts: Vec<Point2<f64>> = points.iter().map(|p| Point2::new(flush(p.x), flush(p.y))).collect();
-    let mut conflict = None;
-    let cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(verts, constraints.to_vec(), |e| {
-        conflict = Some(e)
-    })
-    .map_err(|e| Error::Mesh { face, message: format!("triangulation failed: {e:?}") })?;
-    if let Some(e) = conflict {
-        return Err(Error::Mesh { face, message: format!("trim loops cross (segment {} - {})", e[0], e[1]) });
+    // Vertices one by one in their given order, then the constraints in
+    // theirs: spade's bulk loader puts the vertices it skips (those on a line
+    // through its start centre, common on iso-parametric grids) back in a
+    // per-process random order, and on cocircular grid cells that order picks
+    // the diagonals, so the same file gave different meshes run to run.
+    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
+    for v in verts {
+        cdt.insert(v).map_err(|e| Error::Mesh { face, message: format!("triangulation failed: {e:?}") })?;
     }
     if cdt.num_vertices() != points.len() {
         return Err(Error::Mesh { face, message: "trim loop nodes coincide".into() });
+    }
+    for &[a, b] in constraints {
+        if a >= points.len() || b >= points.len() || a == b {
+            return Err(Error::Mesh { face, message: format!("bad trim segment {a} - {b}") });
+        }
+        let (a, b) = (FixedVertexHandle::from_index(a), FixedVertexHandle::from_index(b));
+        if cdt.try_add_constraint(a, b).is_empty() && !cdt.exists_constraint(a, b) {
+            return Err(Error::Mesh {
+                face,
+                message: format!("trim loops cross (segment {} - {})", a.index(), b.index()),
+            });
+        }
     }
     // Flood fill from the hull: crossing a constraint edge flips inside/outside.
     let nfaces = cdt.num_inner_faces() + 1;
@@ -78,4 +91,45 @@ pub(crate) fn triangulate_region(
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A grid of cocircular cells with its border and a diamond hole as
+    /// constraints: many nodes lie on lines through the centre, which a bulk
+    /// loader skips and re-inserts in its own order. The same input must give
+    /// the same triangles every time (same mesh run to run).
+    #[test]
+    fn same_input_same_triangles() {
+        let n = 24;
+        let mut points = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                points.push(DVec2::new(i as f64, j as f64));
+            }
+        }
+        let id = |i: usize, j: usize| j * (n + 1) + i;
+        let mut constraints = Vec::new();
+        let border: Vec<usize> = (0..n)
+            .map(|i| id(i, 0))
+            .chain((0..n).map(|j| id(n, j)))
+            .chain((0..n).map(|i| id(n - i, n)))
+            .chain((0..n).map(|j| id(0, n - j)))
+            .collect();
+        for k in 0..border.len() {
+            constraints.push([border[k], border[(k + 1) % border.len()]]);
+        }
+        let c = n / 2;
+        let hole = [id(c, c - 3), id(c + 3, c), id(c, c + 3), id(c - 3, c)];
+        for k in 0..4 {
+            constraints.push([hole[k], hole[(k + 1) % 4]]);
+        }
+        let first = triangulate_region(0, &points, &constraints).unwrap();
+        assert!(!first.is_empty());
+        for _ in 0..40 {
+            assert_eq!(triangulate_region(0, &points, &constraints).unwrap(), first);
+        }
+    }
 }
