@@ -153,6 +153,16 @@ pub fn bilinear(p: [[DVec3; 2]; 2], u: [f64; 2], v: [f64; 2]) -> Result<NurbsSur
     )
 }
 
+/// The plane z = 0 over [-h, h]², u = x and v = y: the flat face the meshing tests build on.
+#[cfg(test)]
+pub(crate) fn xy_plane(h: f64) -> NurbsSurface {
+    let c = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+    match bilinear([[c(-h, -h), c(-h, h)], [c(h, -h), c(h, h)]], [-h, h], [-h, h]) {
+        Ok(s) => s,
+        Err(e) => panic!("plane of half side {h}: {e:?}"),
+    }
+}
+
 /// The surface swept by `profile` turning about the axis through `origin`
 /// along the unit vector `axis`, by angles from `start` to `end` (right-hand
 /// rule; angle 0 is the profile itself). u: the profile's parameter; v: the

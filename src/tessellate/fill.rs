@@ -304,15 +304,12 @@ fn ear(p: &[DVec3], first: usize, width: f64) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::nurbs::analytic::bilinear;
     use crate::tessellate::refine::{Criteria, WorkMesh};
     use glam::DVec2;
 
     /// The plane z = 0 over [-20, 20]², u = x and v = y.
     fn plane() -> crate::nurbs::NurbsSurface {
-        let c = |x: f64, y: f64| DVec3::new(x, y, 0.0);
-        bilinear([[c(-20.0, -20.0), c(-20.0, 20.0)], [c(20.0, -20.0), c(20.0, 20.0)]], [-20.0, 20.0], [-20.0, 20.0])
-            .unwrap()
+        crate::nurbs::analytic::xy_plane(20.0)
     }
 
     const CRIT: Criteria = Criteria { tol: 0.1, angle: 0.5, max_edge: f64::INFINITY, min_edge: 0.0, steps: 4 };

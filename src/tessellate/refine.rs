@@ -664,17 +664,10 @@ impl WorkMesh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::nurbs::analytic::bilinear;
 
     /// The plane z = 0 over [-10, 10]², u = x and v = y.
     fn plane() -> crate::nurbs::NurbsSurface {
-        let corner = |x: f64, y: f64| DVec3::new(x, y, 0.0);
-        bilinear(
-            [[corner(-10.0, -10.0), corner(-10.0, 10.0)], [corner(10.0, -10.0), corner(10.0, 10.0)]],
-            [-10.0, 10.0],
-            [-10.0, 10.0],
-        )
-        .unwrap()
+        crate::nurbs::analytic::xy_plane(10.0)
     }
 
     fn at(x: f64, y: f64) -> DVec2 {

@@ -314,6 +314,19 @@ fn corpus(name: &str) -> Option<Model> {
     Some(read_iges(&bytes).unwrap())
 }
 
+/// Face `index` of `m` as a model of its own, checked to be one the ratio test flags.
+fn flagged_face(m: &Model, file: &str, index: usize) -> Model {
+    let one = Model {
+        units: m.units.clone(),
+        faces: vec![m.faces[index].clone()],
+        warnings: Vec::new(),
+        tolerance: None,
+        bodies: Vec::new(),
+    };
+    assert!(step_ratio(&one.faces[0].surface) > RATIO_LIMIT, "{file} face {index}");
+    one
+}
+
 /// Paper 001's acceptance on corpus faces the ratio test flags, each meshed
 /// on its own at the tolerance its model gets: with `auto` the rebuild is
 /// kept, with no more triangles than `off`, a higher 1st-percentile angle,
@@ -333,14 +346,7 @@ fn reparam_flagged_corpus_faces_win() {
             continue;
         };
         let tol = *tols.entry((file, rel.to_bits())).or_insert_with(|| mesh(&m, rel, Reparam::Off).report.tolerance);
-        let one = Model {
-            units: m.units.clone(),
-            faces: vec![m.faces[index].clone()],
-            warnings: Vec::new(),
-            tolerance: None,
-            bodies: Vec::new(),
-        };
-        assert!(step_ratio(&one.faces[0].surface) > RATIO_LIMIT, "{file} face {index}");
+        let one = flagged_face(&m, file, index);
         let run = |mode| mesh_model(&one, &MeshOptions::default().with_tolerance(tol).with_reparam(mode)).unwrap();
         let (off, auto) = (run(Reparam::Off), run(Reparam::Auto));
         let (o, a) = (&off.report, &auto.report);
@@ -417,14 +423,7 @@ fn reparam_losing_corpus_faces_mesh_as_off() {
             continue;
         };
         let tol = reparameterize_model(&m, Reparam::Off, Tolerance::Relative(rel)).unwrap().tolerance;
-        let one = Model {
-            units: m.units.clone(),
-            faces: vec![m.faces[index].clone()],
-            warnings: Vec::new(),
-            tolerance: None,
-            bodies: Vec::new(),
-        };
-        assert!(step_ratio(&one.faces[0].surface) > RATIO_LIMIT, "{file} face {index}");
+        let one = flagged_face(&m, file, index);
         let run = |mode| mesh_model(&one, &MeshOptions::default().with_tolerance(tol).with_reparam(mode)).unwrap();
         let (off, auto) = (run(Reparam::Off), run(Reparam::Auto));
         let (o, a) = (&off.report, &auto.report);
