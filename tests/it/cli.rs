@@ -757,3 +757,37 @@ fn strictly_inside(polygon: &[glam::DVec2], p: glam::DVec2, margin: f64) -> bool
     }
     inside
 }
+
+/// Two processes meshing the same file write the same bytes. trj7's grid
+/// cells are cocircular in many places, where the triangulation's insertion
+/// order picks the diagonal; that order once came from a hash set seeded
+/// afresh in each process, and each run wrote another OBJ.
+#[test]
+fn two_runs_write_the_same_mesh() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus/trj7_b1-ec-214.stp");
+    if !file.exists() {
+        eprintln!("SKIPPED: no corpus file {} (needs ../shared/corpus)", file.display());
+        return;
+    }
+    let dir = scratch("two-runs");
+    let outs: Vec<PathBuf> = (0..2).map(|i| dir.join(format!("run{i}.obj"))).collect();
+    // Both processes at once: a debug build takes a while on this file.
+    let spawned: Vec<_> = outs
+        .iter()
+        .map(|o| {
+            Command::new(BIN)
+                .args([std::ffi::OsStr::new("mesh"), file.as_os_str(), "-o".as_ref(), o.as_os_str()])
+                .stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .unwrap()
+        })
+        .collect();
+    let children: Vec<Output> = spawned.into_iter().map(|c| c.wait_with_output().unwrap()).collect();
+    for c in &children {
+        assert!(c.status.success(), "{}", stderr(c));
+    }
+    let (a, b) = (std::fs::read(&outs[0]).unwrap(), std::fs::read(&outs[1]).unwrap());
+    assert!(a.len() > 100_000, "trj7's OBJ is {} bytes", a.len());
+    assert!(a == b, "two runs on trj7 wrote different meshes");
+}
