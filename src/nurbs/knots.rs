@@ -333,8 +333,8 @@ impl KnotVector {
     /// The Cox-de Boor triangle of A2.3 (for the tests' reference) for the piece of span `span`
     /// (clamped to `degree..control_count()`) at `t` (clamped): `[r][j]` for
     /// `r <= j` is the degree-`j` function `N_{span-j+r}`, `[j][r]` for `r < j`
-    /// the knot difference it was divided by. `p` is the degree (an argument
-    /// so that a constant specializes it). Needs `N > degree`.
+    /// the knot difference it was divided by; `p` is the degree. Needs
+    /// `N > degree`.
     #[cfg(test)]
     fn basis_triangle<const N: usize>(&self, p: usize, span: usize, t: f64) -> [[f64; N]; N] {
         let t = self.clamp(t);
