@@ -103,6 +103,38 @@ fn cylinders_with_and_without_a_seam_edge_mesh_closed() {
     }
 }
 
+/// On a plane, a circle's trim curve is the circle itself under the plane's
+/// affine inverse: on the circle to rounding, with a rational quadratic's
+/// handful of control points, where a fitted cubic took 172 (paper 001 §3.4
+/// fits only where no exact image exists).
+#[test]
+fn circles_on_planes_become_exact_trim_curves() {
+    use surfmesh::Surface;
+    let model = read_step(&data("step_cylinder.stp")).unwrap();
+    let mut disks = 0;
+    for f in model
+        .faces
+        .iter()
+        .filter(|f| matches!(f.name.as_deref(), Some(n) if n.ends_with("top") || n.ends_with("bottom")))
+    {
+        disks += 1;
+        let s: &dyn Surface = &f.surface;
+        let curves: Vec<_> = f.loops.iter().flat_map(|l| &l.curves).collect();
+        let points: usize = curves.iter().map(|c| c.control_points().count()).sum();
+        assert!(points <= 12, "{:?}: {points} control points for one circle", f.name);
+        for c in curves {
+            let (a, b) = c.domain();
+            for i in 0..=200 {
+                let p = s.point(c.point(a + (b - a) * i as f64 / 200.0).truncate());
+                let off = (p.x.hypot(p.y) - 5.0).abs();
+                assert!(off <= 1e-9, "{:?}: {p} is {off:e} off the circle of radius 5", f.name);
+                assert!(p.z.abs() <= 1e-9 || (p.z - 10.0).abs() <= 1e-9, "{:?}: {p} off its plane", f.name);
+            }
+        }
+    }
+    assert_eq!(disks, 2);
+}
+
 #[test]
 fn dome_closed_at_its_pole_and_cone_at_its_apex() {
     let (model, shells) = read_step_with_shells(&data("step_dome_cone.stp")).unwrap();
