@@ -89,6 +89,11 @@ fn positions(faces: &[Option<(&dyn Surface, &mut Outline<'_>)>]) -> PerNode<DVec
 /// Each node's reach: `sew`, at most 0.3 of its shortest loop segment.
 /// Segments along a pole, and those shorter than a thousandth of `tight`
 /// (a trim edge far below any weld: its ends are one point), do not count.
+/// One `fill` per node of `pos`.
+fn per_node<T: Clone>(pos: &PerNode<DVec3>, fill: T) -> PerNode<T> {
+    pos.iter().map(|f| f.iter().map(|p| alloc::vec![fill.clone(); p.len()]).collect()).collect()
+}
+
 fn radii(pos: &PerNode<DVec3>, sew: f64, tight: f64) -> PerNode<f64> {
     radii_each(pos, &|_| sew, tight)
 }
@@ -168,7 +173,40 @@ fn insertions(
     let at = |n: NodeRef| pos[n.0 as usize][n.1 as usize][n.2 as usize];
     let body = |f: usize| crate::model::body_of(bodies, f);
     let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
-    // Every node on some other segment: (segment, fraction, curve parameter, distance, node).
+    // A node goes only onto borders about as near as the nearest other
+    // face's: a face thinner than `sew` keeps its far border to itself.
+    // Of one face's borders it goes onto the nearest only (and onto
+    // another as near within `tight`, the other side of a seam): a face
+    // pinched narrower than `sew` is not sewn across its neck. Per node
+    // (NaN: none seen), noted as the pairs are found, so a pair that can
+    // only tell a distance is not kept (on a plate of 1000 holes those were
+    // most of 12 MB of pairs).
+    let mut nearest: PerNode<f64> = per_node(pos, f64::NAN);
+    let mut nearest_face: PerNode<(u32, f64)> = per_node(pos, (super::NONE, f64::NAN));
+    let mut nearest_in: HashMap<(NodeRef, u32), f64> = HashMap::default();
+    let mut note = |seg: NodeRef, s: f64, d: f64, q: NodeRef| {
+        let (a, b, c) = (q.0 as usize, q.1 as usize, q.2 as usize);
+        if seg.0 != q.0 {
+            let e = &mut nearest_face[a][b][c];
+            if e.1.is_nan() {
+                *e = (super::NONE, f64::INFINITY);
+            }
+            if d < e.1 {
+                *e = (seg.0, d);
+            }
+        }
+        if s == BEYOND {
+            return;
+        }
+        if seg.0 != q.0 {
+            let e = &mut nearest[a][b][c];
+            *e = if e.is_nan() { f64::INFINITY } else { *e }.min(d);
+        }
+        let e = nearest_in.entry((q, seg.0)).or_insert(f64::INFINITY);
+        *e = e.min(d);
+    };
+    // Every node on some other segment, to be added there: (segment,
+    // fraction, curve parameter, distance, node).
     let mut cands: Vec<(NodeRef, f64, f64, f64, NodeRef)> = Vec::new();
     for (fi, item) in faces.iter().enumerate() {
         let Some((surface, o)) = item else { continue };
@@ -196,7 +234,7 @@ fn insertions(
                         // node the other border has too (a gap of nothing).
                         let e = q.distance(pa).min(q.distance(pb));
                         if e <= limit {
-                            cands.push((na, BEYOND, 0.0, e, qn));
+                            note(na, BEYOND, e, qn);
                         }
                         continue;
                     }
@@ -214,39 +252,15 @@ fn insertions(
                     }
                     let (s, d) = nearest_fraction(&|s: f64| on_curve(s).distance(q), s0);
                     if d <= limit && s > 1e-9 && s < 1.0 - 1e-9 {
+                        note(na, s, d, qn);
                         cands.push((na, s, ta + (tb - ta) * s, d, qn));
                     } else if q.distance(pa).min(q.distance(pb)) <= limit {
-                        // At an end: recorded for the gap estimate only.
-                        cands.push((na, -1.0, 0.0, q.distance(pa).min(q.distance(pb)), qn));
+                        // At an end: noted for the gap estimate only.
+                        note(na, -1.0, q.distance(pa).min(q.distance(pb)), qn);
                     }
                 }
             }
         }
-    }
-    // A node goes only onto borders about as near as the nearest other
-    // face's: a face thinner than `sew` keeps its far border to itself.
-    // Of one face's borders it goes onto the nearest only (and onto
-    // another as near within `tight`, the other side of a seam): a face
-    // pinched narrower than `sew` is not sewn across its neck.
-    let mut nearest: HashMap<NodeRef, f64> = HashMap::default();
-    let mut nearest_face: HashMap<NodeRef, (u32, f64)> = HashMap::default();
-    let mut nearest_in: HashMap<(NodeRef, u32), f64> = HashMap::default();
-    for &(seg, s, _, d, q) in &cands {
-        if seg.0 != q.0 {
-            let e = nearest_face.entry(q).or_insert((super::NONE, f64::INFINITY));
-            if d < e.1 {
-                *e = (seg.0, d);
-            }
-        }
-        if s == BEYOND {
-            continue;
-        }
-        if seg.0 != q.0 {
-            let e = nearest.entry(q).or_insert(f64::INFINITY);
-            *e = e.min(d);
-        }
-        let e = nearest_in.entry((q, seg.0)).or_insert(f64::INFINITY);
-        *e = e.min(d);
     }
     // The gaps the model has, and those of each pair of faces side by
     // side (counted at the nodes whose nearest other face is the other).
@@ -254,9 +268,20 @@ fn insertions(
         gaps.sort_by(f64::total_cmp);
         gaps.get((gaps.len() * 9) / 10).copied().unwrap_or(0.0)
     };
-    let mut gaps: Vec<f64> = nearest.values().copied().collect();
+    let mut gaps: Vec<f64> = nearest.iter().flatten().flatten().copied().filter(|d| !d.is_nan()).collect();
+    // Each node whose nearest other face is known, with that face and distance.
+    let seen_face = || {
+        nearest_face.iter().enumerate().flat_map(|(a, f)| {
+            f.iter().enumerate().flat_map(move |(b, l)| {
+                l.iter()
+                    .enumerate()
+                    .filter(|(_, e)| !e.1.is_nan())
+                    .map(move |(c, &e)| ((a as u32, b as u32, c as u32), e))
+            })
+        })
+    };
     let mut pair_gaps: HashMap<(u32, u32), Vec<f64>> = HashMap::default();
-    for (&q, &(g, d)) in &nearest_face {
+    for (q, (g, d)) in seen_face() {
         if d > tight {
             pair_gaps.entry((q.0.min(g), q.0.max(g))).or_default().push(d);
         }
@@ -267,7 +292,7 @@ fn insertions(
     // The least a pair is sewn at: the model's distance, widened by how far
     // either face's border was moved.
     let floor = |a: u32, b: u32| (model_sew + moved_by(a) + if a == b { 0.0 } else { moved_by(b) }).min(ceiling);
-    for (&q, &(g, _)) in &nearest_face {
+    for (q, (g, _)) in seen_face() {
         pair_gaps.entry((q.0.min(g), q.0.max(g))).or_default();
     }
     let pair_sew: HashMap<(u32, u32), f64> = pair_gaps
@@ -278,9 +303,9 @@ fn insertions(
         })
         .collect();
     let sew_of = |q: NodeRef| {
-        nearest_face
-            .get(&q)
-            .and_then(|&(g, _)| pair_sew.get(&(q.0.min(g), q.0.max(g))))
+        Some(nearest_face[q.0 as usize][q.1 as usize][q.2 as usize])
+            .filter(|e| !e.1.is_nan())
+            .and_then(|(g, _)| pair_sew.get(&(q.0.min(g), q.0.max(g))))
             .copied()
             .unwrap_or_else(|| floor(q.0, q.0))
     };
@@ -314,7 +339,8 @@ fn insertions(
             continue;
         }
         // A moved border (a rebuilt face's) is as near as it was, within how far it moved.
-        let near_enough = (tight + moved_by(seg.0) + moved_by(q.0)).max(4.0 * nearest.get(&q).copied().unwrap_or(0.0));
+        let near_enough = (tight + moved_by(seg.0) + moved_by(q.0))
+            .max(4.0 * Some(nearest[q.0 as usize][q.1 as usize][q.2 as usize]).filter(|d| !d.is_nan()).unwrap_or(0.0));
         if seg.0 != q.0 && d > near_enough {
             continue;
         }
