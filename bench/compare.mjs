@@ -1,7 +1,8 @@
 // Side-by-side benchmark: surfmesh (wasm in Node, and native) against
 // occt-import-js (OCCT's mesher in wasm), verb-nurbs (JS) and the curvo crate
 // (native), on every JSON surface in tests/data/ and every file of
-// ../shared/corpus/ that surfmesh reads, at relative tolerances 1e-2 and 1e-3.
+// ../shared/corpus/ that surfmesh reads, and two drilled plates (bench/plate.mjs),
+// at relative tolerances 1e-2 and 1e-3.
 //
 // Every mesh, whoever made it, is measured by the same code (examples/measure.rs,
 // i.e. surfmesh::measure_mesh): deviation from the exact surfaces, coverage,
@@ -16,7 +17,7 @@
 // mesher allows. Memory: peak resident set of a process that runs one mesher
 // on one file (Node: above a bare Node's).
 //
-// npm run bench [-- --runs 5 --tols 1e-2,1e-3 --only NAME --no-corpus --no-build --out DIR --profile debug]
+// npm run bench [-- --runs 5 --tols 1e-2,1e-3 --only NAME --no-corpus --no-plates --no-build --out DIR --profile debug]
 // Writes DIR/latest.json and DIR/latest.md (DIR: bench/results). Builds what it
 // needs first: the CLI and the two example runners (cargo, release unless
 // --profile debug), and the npm package when it is older than the sources.
@@ -26,6 +27,7 @@ import { existsSync, mkdirSync, mkdtempSync, readdirSync, readFileSync, rmSync, 
 import { cpus, loadavg, tmpdir } from 'node:os';
 import { dirname, extname, join, relative } from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { plateStep } from './plate.mjs';
 
 const root = join(dirname(fileURLToPath(import.meta.url)), '..');
 const argv = process.argv.slice(2);
@@ -239,6 +241,16 @@ function inputs() {
       if (!ext || f === 'SOURCES.md') continue;
       if (formats.includes(ext)) list.push({ path: join(corpus, f), name: f, kind: 'cad' });
       else skipped.push({ name: f, reason: `surfmesh does not read .${ext} yet` });
+    }
+  }
+  // Stress parts written here (bench/plate.mjs): a face with 100 holes, and
+  // a part of 1006 faces whose top and bottom have 1000 holes each.
+  if (!argv.includes('--no-corpus') && !argv.includes('--no-plates')) {
+    for (const [nx, ny] of [[10, 10], [25, 40]]) {
+      const name = `plate_${nx}x${ny}_holes.stp`;
+      const path = join(tmp, name);
+      writeFileSync(path, plateStep(nx, ny));
+      list.push({ path, name, kind: 'cad' });
     }
   }
   return { list: list.filter((x) => !ONLY || x.name.includes(ONLY)), skipped, formats };

@@ -12,6 +12,7 @@ import { tmpdir } from 'node:os';
 import { dirname, join } from 'node:path';
 import { after, test } from 'node:test';
 import { fileURLToPath } from 'node:url';
+import { plateStep } from '../bench/plate.mjs';
 
 const root = join(dirname(fileURLToPath(import.meta.url)), '..');
 const pkg = join(root, 'pkg');
@@ -75,6 +76,24 @@ test('the Node build meshes the bundled freeform surface within its tolerance', 
   assert.ok(report.max_deviation <= report.tolerance, `${report.max_deviation} > ${report.tolerance}`);
   assert.ok(report.time_ms > 0 && report.parse_ms >= 0, 'the binding fills in the times');
   assert.match(surfmesh.version(), /^\d+\.\d+\.\d+$/);
+});
+
+test('a part of 1006 faces, two of them with 1000 holes each, meshes closed and within tolerance', (t) => {
+  const bytes = new TextEncoder().encode(plateStep(25, 40));
+  const before = surfmesh.memoryBytes();
+  const out = surfmesh.mesh(bytes, 'step', { toleranceRel: 1e-3 });
+  const { report } = out;
+  assert.equal(report.faces, 1006);
+  assert.equal(out.faceRanges.length, 2 * 1006);
+  for (let f = 0; f < 1006; f += 1) assert.ok(out.faceRanges[2 * f + 1] > 0, `face ${f} has no triangles`);
+  assert.equal(report.faces_skipped, 0);
+  assert.equal(report.free_edges, 0, 'cracks');
+  assert.equal(report.boundary_edges, 0, 'a closed solid has no border');
+  assert.equal(report.nonmanifold_edges, 0);
+  assert.equal(report.inverted_triangles, 0);
+  assert.ok(report.max_deviation <= report.tolerance, `${report.max_deviation} > ${report.tolerance}`);
+  const output = out.positions.byteLength + out.normals.byteLength + out.indices.byteLength;
+  t.diagnostic(`${report.triangles} triangles; wasm memory ${surfmesh.memoryBytes()} bytes (before ${before}), output ${output}`);
 });
 
 test('thrown errors are Error objects with exactly the command line message', () => {
