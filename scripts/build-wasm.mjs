@@ -66,6 +66,7 @@ function readConfig() {
   return {
     profile: build.cargo_profile ?? 'release',
     optLevel: build.opt_level,
+    stackSize: build.stack_size,
     outName: build.out_name ?? 'surfmesh',
     packageDir: join(root, build.package_dir ?? 'pkg'),
     opt: config.wasm_opt ?? { enabled: false },
@@ -150,6 +151,10 @@ function main() {
   const env = { ...process.env };
   if (config.optLevel !== undefined) {
     env[`CARGO_PROFILE_${config.profile.toUpperCase().replace(/-/g, '_')}_OPT_LEVEL`] = String(config.optLevel);
+  }
+  if (config.stackSize !== undefined) {
+    if (!Number.isInteger(config.stackSize) || config.stackSize % 65536 !== 0) fail('wasm-pack.toml stack_size: a whole number of 64 KiB pages');
+    env.CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUSTFLAGS = `-C link-arg=-zstack-size=${config.stackSize}`;
   }
   run('cargo', ['build', '--lib', '--target', 'wasm32-unknown-unknown', '--profile', config.profile], { env });
   const meta = JSON.parse(capture('cargo', ['metadata', '--format-version', '1', '--no-deps']));

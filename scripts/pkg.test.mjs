@@ -96,6 +96,16 @@ test('a part of 1006 faces, two of them with 1000 holes each, meshes closed and 
   t.diagnostic(`${report.triangles} triangles; wasm memory ${surfmesh.memoryBytes()} bytes (before ${before}), output ${output}`);
 });
 
+test('a fresh module holds its 256 KiB stack, not the default 1 MiB, before its first call', () => {
+  const r = spawnSync(process.execPath, ['-e', `process.stdout.write(String(require(${JSON.stringify(join(pkg, 'node'))}).memoryBytes()))`], {
+    encoding: 'utf8',
+  });
+  assert.equal(r.status, 0, r.stderr);
+  const bytes = Number(r.stdout);
+  // Stack, static data and the allocator's first pages (wasm-pack.toml stack_size).
+  assert.ok(bytes >= 262144 && bytes < 1 << 20, `${bytes} bytes at load`);
+});
+
 test('thrown errors are Error objects with exactly the command line message', () => {
   for (const [name, text] of Object.entries(badInputs)) {
     const expected = cliError(name, text);

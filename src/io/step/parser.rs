@@ -352,6 +352,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Graph, Error> {
         _ => return Err(step_error(0, lx.line, "not a STEP file: it does not start with ISO-10303-21;")),
     }
     expect(&mut lx, &mut g, 0, &Tok::Semicolon, "';' after ISO-10303-21")?;
+    presize(&mut g, bytes);
     let mut scratch: Vec<Value> = Vec::new();
     let mut seen_data = false;
     loop {
@@ -395,6 +396,27 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Graph, Error> {
     }
     g.shrink();
     Ok(g)
+}
+
+/// Room for the arenas from a count of separators (every value ends at a
+/// `,` or `)`, every instance at a `;`), so they are not grown by doubling:
+/// in the wasm heap a grown arena held its old and new copies at once. Only
+/// room that can be had, at most a value per 4 bytes of input (the densest
+/// real lists, of references, take 5 or more; a file of bare commas would
+/// fail at its first one), and [`Graph::shrink`] gives back what strings'
+/// separators over-counted.
+fn presize(g: &mut Graph, bytes: &[u8]) {
+    let (mut ends, mut semis) = (0usize, 0usize);
+    for &c in bytes {
+        match c {
+            b',' | b')' => ends += 1,
+            b';' => semis += 1,
+            _ => {}
+        }
+    }
+    let _ = g.values.try_reserve_exact(ends.min(bytes.len() / 4).min(MAX_VALUES));
+    let _ = g.instances.try_reserve_exact(semis);
+    let _ = g.parts.try_reserve_exact(semis);
 }
 
 fn expect(lx: &mut Lexer<'_>, g: &mut Graph, id: u64, want: &Tok, what: &str) -> Result<(), Error> {
