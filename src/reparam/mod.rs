@@ -243,10 +243,11 @@ impl Map1 {
         let (u0, u1) = (self.old[i - 1], self.old[i]);
         let w = if b > a { (x - a) / (b - a) } else { 0.0 };
         let (l0, l1) = (Self::lerp(&arc.params, &arc.arc, u0), Self::lerp(&arc.params, &arc.arc, u1));
-        if !(l1 > l0) {
-            return u0 + (u1 - u0) * w;
+        if l1 > l0 {
+            Self::lerp(&arc.arc, &arc.params, l0 + (l1 - l0) * w).clamp(u0.min(u1), u0.max(u1))
+        } else {
+            u0 + (u1 - u0) * w
         }
-        Self::lerp(&arc.arc, &arc.params, l0 + (l1 - l0) * w).clamp(u0.min(u1), u0.max(u1))
     }
 }
 
