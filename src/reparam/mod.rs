@@ -393,22 +393,27 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize) -> Result<Fit, String> {
         None => map.to_old(x),
     };
     // The points checked, per direction (0: u-edge mid-points, 1: v-edge
-    // ones, 2: cell centres): the new surface's point, its start on the
-    // original, and the distance to the original's point there.
-    let mut checks: Vec<(f64, usize, DVec3, DVec2)> = Vec::with_capacity(3 * map_u.new.len() * map_v.new.len());
-    for i in 0..map_u.new.len() {
-        for j in 0..map_v.new.len() {
-            let (si, tj) = (map_u.new[i], map_v.new[j]);
-            let s_mid = map_u.new.get(i + 1).map(|&b| 0.5 * (si + b));
-            let t_mid = map_v.new.get(j + 1).map(|&b| 0.5 * (tj + b));
-            let at = [(s_mid, Some(tj)), (Some(si), t_mid), (s_mid, t_mid)];
-            for (dir, st) in at.into_iter().enumerate() {
-                let (Some(sx), Some(ty)) = st else { continue };
-                let st = DVec2::new(sx, ty);
-                let p = new.point(st);
-                let hint = DVec2::new(old_of(&map_u, &arc_u, st.x), old_of(&map_v, &arc_v, st.y));
-                checks.push((p.distance(surface.point(hint)), dir, p, hint));
-            }
+    // ones, 2: cell centres), by key `3 × node + direction`.
+    let (nu, nv) = (map_u.new.len(), map_v.new.len());
+    let at = |key: usize| -> Option<DVec2> {
+        let (node, dir) = (key / 3, key % 3);
+        let (i, j) = (node / nv, node % nv);
+        let (si, tj) = (*map_u.new.get(i)?, *map_v.new.get(j)?);
+        let s_mid = map_u.new.get(i + 1).map(|&b| 0.5 * (si + b));
+        let t_mid = map_v.new.get(j + 1).map(|&b| 0.5 * (tj + b));
+        let (s, t) = [(s_mid, Some(tj)), (Some(si), t_mid), (s_mid, t_mid)][dir];
+        Some(DVec2::new(s?, t?))
+    };
+    // The new surface's point there, and where its projection starts on the original.
+    let point_and_start =
+        |st: DVec2| (new.point(st), DVec2::new(old_of(&map_u, &arc_u, st.x), old_of(&map_v, &arc_v, st.y)));
+    // Each point with its distance to the original's point at the start
+    // (kept small: a 400 × 400 rebuild checks half a million points).
+    let mut checks: Vec<(f64, u32)> = Vec::with_capacity(3 * nu * nv);
+    for key in 0..3 * nu * nv {
+        if let Some(st) = at(key) {
+            let (p, start) = point_and_start(st);
+            checks.push((p.distance(surface.point(start)), key as u32));
         }
     }
     // Both the projection and the start point are actual points of the
@@ -418,11 +423,11 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize) -> Result<Fit, String> {
     // the far starts go first and the rest are not projected.
     checks.sort_by(|a, b| b.0.total_cmp(&a.0));
     let mut worst = [0.0f64; 3];
-    for &(near, dir, p, hint) in &checks {
-        if near <= worst[dir] {
-            continue;
-        }
-        worst[dir] = worst[dir].max(project_to_surface(surface, p, Some(hint), &opts).distance.min(near));
+    for &(near, key) in &checks {
+        let dir = key as usize % 3;
+        let Some(st) = at(key as usize).filter(|_| near > worst[dir]) else { continue };
+        let (p, start) = point_and_start(st);
+        worst[dir] = worst[dir].max(project_to_surface(surface, p, Some(start), &opts).distance.min(near));
     }
     let (mut errors, centre) = ([worst[0], worst[1]], worst[2]);
     // A cell centre off the original is charged to the direction whose edges are worse.
