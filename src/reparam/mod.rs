@@ -228,6 +228,34 @@ impl Map1 {
     fn to_old(&self, x: f64) -> f64 {
         Self::lerp(&self.new, &self.old, x)
     }
+    /// As [`Map1::to_old`] at the nodes, and between two nodes at the old
+    /// parameter that splits their arc length (by `arc`) in the ratio `x`
+    /// splits their new parameters: where the old parameters crowd within
+    /// one interval, the straight map lands far from the point the new
+    /// surface passes, and a projection started there needs many steps.
+    fn to_old_along(&self, arc: &ArcTable, x: f64) -> f64 {
+        let n = self.new.len();
+        if n < 2 || x <= self.new[0] || x >= self.new[n - 1] {
+            return self.to_old(x);
+        }
+        let i = self.new.partition_point(|&f| f <= x).clamp(1, n - 1);
+        let (a, b) = (self.new[i - 1], self.new[i]);
+        let (u0, u1) = (self.old[i - 1], self.old[i]);
+        let w = if b > a { (x - a) / (b - a) } else { 0.0 };
+        let (l0, l1) = (Self::lerp(&arc.params, &arc.arc, u0), Self::lerp(&arc.params, &arc.arc, u1));
+        if l1 > l0 {
+            Self::lerp(&arc.arc, &arc.params, l0 + (l1 - l0) * w).clamp(u0.min(u1), u0.max(u1))
+        } else {
+            u0 + (u1 - u0) * w
+        }
+    }
+}
+
+/// Normalized arc length (mean over the iso-lines [`even_params`] measures)
+/// at dense, ascending old parameters.
+struct ArcTable {
+    params: Vec<f64>,
+    arc: Vec<f64>,
 }
 
 /// Samples along u (`along_u`) or v: paper 001 step 2's chord count
@@ -284,7 +312,7 @@ fn sample_count(surface: &FaceSurface, along_u: bool, eps: f64) -> usize {
 /// `n + 1` parameters along u (or v) spaced as evenly as possible in model
 /// space (paper 001 step 3): the normalized arc length of five iso-lines,
 /// averaged, inverted at `i / n`.
-fn even_params(surface: &FaceSurface, along_u: bool, n: usize) -> Vec<f64> {
+fn even_params(surface: &FaceSurface, along_u: bool, n: usize) -> (Vec<f64>, Option<ArcTable>) {
     let [lo, hi] = surface.domain();
     let (a0, a1) = if along_u { (lo.x, hi.x) } else { (lo.y, hi.y) };
     let dense = (16 * n).max(400);
@@ -313,12 +341,13 @@ fn even_params(surface: &FaceSurface, along_u: bool, n: usize) -> Vec<f64> {
         used += 1;
     }
     if used == 0 {
-        return (0..=n).map(|i| a0 + (a1 - a0) * i as f64 / n as f64).collect();
+        return ((0..=n).map(|i| a0 + (a1 - a0) * i as f64 / n as f64).collect(), None);
     }
     for a in &mut avg {
         *a /= used as f64;
     }
     let mut out: Vec<f64> = (0..=n).map(|i| Map1::lerp(&avg, &xs, i as f64 / n as f64)).collect();
+    let table = Some(ArcTable { params: xs, arc: avg });
     out[0] = a0;
     out[n] = a1;
     // Strictly increasing even where the surface has no length.
@@ -330,9 +359,9 @@ fn even_params(surface: &FaceSurface, along_u: bool, n: usize) -> Vec<f64> {
     }
     if out[n] > a1 {
         // Squeezed by the nudges: fall back to equal steps.
-        return (0..=n).map(|i| a0 + (a1 - a0) * i as f64 / n as f64).collect();
+        return ((0..=n).map(|i| a0 + (a1 - a0) * i as f64 / n as f64).collect(), table);
     }
-    out
+    (out, table)
 }
 
 /// The rebuilt surface with its parameter maps and the largest distance
@@ -348,8 +377,8 @@ struct Fit {
 /// `n × m` intervals: the new surface at mid-points of grid edges and cells
 /// is projected onto the original from the mapped parameters.
 fn fit_once(surface: &FaceSurface, n: usize, m: usize) -> Result<Fit, String> {
-    let us = even_params(surface, true, n);
-    let vs = even_params(surface, false, m);
+    let (us, arc_u) = even_params(surface, true, n);
+    let (vs, arc_v) = even_params(surface, false, m);
     let grid: Vec<Vec<DVec3>> =
         us.iter().map(|&u| vs.iter().map(|&v| surface.point(DVec2::new(u, v))).collect()).collect();
     let cols: Vec<Vec<DVec3>> = (0..vs.len()).map(|j| grid.iter().map(|r| r[j]).collect()).collect();
@@ -359,33 +388,48 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize) -> Result<Fit, String> {
     let map_u = Map1 { old: us, new: s };
     let map_v = Map1 { old: vs, new: t };
     let opts = ProjectionOptions { max_iterations: 12, ..ProjectionOptions::default() };
-    let mut errors = [0.0f64; 2];
-    let mut centre = 0.0f64;
-    let err_at = |st: DVec2| -> f64 {
-        let p = new.point(st);
-        let hint = DVec2::new(map_u.to_old(st.x), map_v.to_old(st.y));
-        // Both are distances to actual points of the original, so the smaller
-        // still bounds the true distance: Newton can stall where the original's
-        // parameter speed jumps, and the mapped point then bounds it instead.
-        project_to_surface(surface, p, Some(hint), &opts).distance.min(p.distance(surface.point(hint)))
+    let old_of = |map: &Map1, arc: &Option<ArcTable>, x: f64| match arc {
+        Some(a) => map.to_old_along(a, x),
+        None => map.to_old(x),
     };
-    for i in 0..map_u.new.len() {
-        for j in 0..map_v.new.len() {
-            let (si, tj) = (map_u.new[i], map_v.new[j]);
-            let s_mid = map_u.new.get(i + 1).map(|&b| 0.5 * (si + b));
-            let t_mid = map_v.new.get(j + 1).map(|&b| 0.5 * (tj + b));
-            if let Some(sm) = s_mid {
-                let e = err_at(DVec2::new(sm, tj));
-                errors[0] = errors[0].max(e);
-            }
-            if let Some(tm) = t_mid {
-                errors[1] = errors[1].max(err_at(DVec2::new(si, tm)));
-            }
-            if let (Some(sm), Some(tm)) = (s_mid, t_mid) {
-                centre = centre.max(err_at(DVec2::new(sm, tm)));
-            }
+    // The points checked, per direction (0: u-edge mid-points, 1: v-edge
+    // ones, 2: cell centres), by key `3 × node + direction`.
+    let (nu, nv) = (map_u.new.len(), map_v.new.len());
+    let at = |key: usize| -> Option<DVec2> {
+        let (node, dir) = (key / 3, key % 3);
+        let (i, j) = (node / nv, node % nv);
+        let (si, tj) = (*map_u.new.get(i)?, *map_v.new.get(j)?);
+        let s_mid = map_u.new.get(i + 1).map(|&b| 0.5 * (si + b));
+        let t_mid = map_v.new.get(j + 1).map(|&b| 0.5 * (tj + b));
+        let (s, t) = [(s_mid, Some(tj)), (Some(si), t_mid), (s_mid, t_mid)][dir];
+        Some(DVec2::new(s?, t?))
+    };
+    // The new surface's point there, and where its projection starts on the original.
+    let point_and_start =
+        |st: DVec2| (new.point(st), DVec2::new(old_of(&map_u, &arc_u, st.x), old_of(&map_v, &arc_v, st.y)));
+    // Each point with its distance to the original's point at the start
+    // (kept small: a 400 × 400 rebuild checks half a million points).
+    let mut checks: Vec<(f64, u32)> = Vec::with_capacity(3 * nu * nv);
+    for key in 0..3 * nu * nv {
+        if let Some(st) = at(key) {
+            let (p, start) = point_and_start(st);
+            checks.push((p.distance(surface.point(start)), key as u32));
         }
     }
+    // Both the projection and the start point are actual points of the
+    // original, so the smaller distance still bounds the true one (Newton
+    // can stall where the original's parameter speed jumps). A point whose
+    // start is no farther than the worst found so far cannot raise it, so
+    // the far starts go first and the rest are not projected.
+    checks.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let mut worst = [0.0f64; 3];
+    for &(near, key) in &checks {
+        let dir = key as usize % 3;
+        let Some(st) = at(key as usize).filter(|_| near > worst[dir]) else { continue };
+        let (p, start) = point_and_start(st);
+        worst[dir] = worst[dir].max(project_to_surface(surface, p, Some(start), &opts).distance.min(near));
+    }
+    let (mut errors, centre) = ([worst[0], worst[1]], worst[2]);
     // A cell centre off the original is charged to the direction whose edges are worse.
     if errors[0] >= errors[1] {
         errors[0] = errors[0].max(centre);

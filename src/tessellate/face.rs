@@ -5,28 +5,44 @@ use alloc::format;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
-use super::params::{grid_params, Limits, Region};
+use super::params::{even_demand, grid_params, Limits, Region, MAX_PARAMS};
 use super::refine::{Criteria, Outcome, WorkMesh};
 use crate::model::Face;
 use crate::nurbs::Surface;
 use crate::Error;
 
 /// A meshed face: its work mesh and what refinement measured.
-pub(crate) struct FaceResult {
+pub(crate) struct FaceResult<'a> {
     pub mesh: WorkMesh,
     pub outcome: Outcome,
+    /// The outline before its own seams were sewn (with `std`): the same
+    /// as the one `mesh_model` would make for this face and limits, so the
+    /// variant chosen need not discretize its loops and grid again.
+    pub outline: Option<Outline<'a>>,
 }
+
+/// Without `std` there is no outline (untrimmed faces mesh from their grid).
+#[cfg(not(feature = "std"))]
+pub(crate) struct Outline<'a>(core::marker::PhantomData<&'a ()>);
 
 /// Grid parameters in both directions over `[lo, hi]`, sharing the tolerance
 /// between the two directions: half each, then the whole remainder to one
 /// direction when the other turned out (nearly) straight, as on a cylinder.
 /// On a trimmed face, `loops` limits every test to the kept region.
+///
+/// `cells`: the most grid cells the caller accepts (`usize::MAX`: any). A
+/// grid twice over it is cut short, since the caller refuses it anyway: on
+/// a surface with even parameters the chord demand both directions sum to
+/// is known before any line is placed, and a direction that reaches its
+/// share of lines stops there. A grid that is not cut short is the one
+/// without `cells`.
 pub(super) fn grid(
     surface: &dyn Surface,
     lo: DVec2,
     hi: DVec2,
     lim: &Limits,
     loops: Option<&TrimRegion<'_>>,
+    cells: usize,
 ) -> (Vec<f64>, Vec<f64>) {
     #[cfg(feature = "std")]
     let pieces = |along_u: bool, s: f64| loops.map_or_else(Vec::new, |l| l.line_pieces(along_u, s));
@@ -35,14 +51,47 @@ pub(super) fn grid(
     #[cfg(not(feature = "std"))]
     let region: Option<Region<'_>> = None;
     let half = Limits { tol: lim.tol * 0.5, ..*lim };
-    let (mut pu, mut su) = grid_params(surface, lo, hi, true, &half, region);
-    let (mut pv, mut sv) = grid_params(surface, lo, hi, false, &half, region);
+    // Twice the cells accepted: what one direction's second pass saves
+    // (at most √2 of the lines, with twice the tolerance) cannot bring the grid back.
+    let over = cells.saturating_mul(2);
+    let limited = over < MAX_PARAMS;
+    let even = |along_u: bool| if limited { even_demand(surface, lo, hi, along_u, &half, region) } else { None };
+    let (du, dv) = (even(true), even(false));
+    if let (Some(du), Some(dv)) = (&du, &dv) {
+        let n = |d: &[f64]| libm::ceil(d.iter().sum::<f64>());
+        if n(du) * n(dv) > over as f64 {
+            let equal = |a: f64, b: f64, d: &[f64]| {
+                let k = (n(d) as usize).clamp(1, MAX_PARAMS);
+                (0..=k).map(|i| if i == k { b } else { a + (b - a) * i as f64 / k as f64 }).collect()
+            };
+            return (equal(lo.x, hi.x, du), equal(lo.y, hi.y, dv));
+        }
+    }
+    // A direction that reaches `cap` lines ends the grid, the other left at
+    // its two ends (or as it is): either way over `over` cells.
+    let cap = |other: usize| if limited { over / other.saturating_sub(1).max(1) + 2 } else { MAX_PARAMS };
+    let capped = |p: &[f64], c: usize| limited && p.len() >= c;
+    let ends_v = alloc::vec![lo.y, hi.y];
+    let (mut pu, mut su) = grid_params(surface, lo, hi, true, &half, region, cap(2), du);
+    if capped(&pu, cap(2)) {
+        return (pu, ends_v);
+    }
+    let (mut pv, mut sv) = grid_params(surface, lo, hi, false, &half, region, cap(pu.len()), dv);
+    if capped(&pv, cap(pu.len())) {
+        return (pu, pv);
+    }
     if sv < 0.5 * half.tol && su > sv {
         let rest = Limits { tol: (lim.tol - sv).max(half.tol), ..*lim };
-        (pu, su) = grid_params(surface, lo, hi, true, &rest, region);
+        (pu, su) = grid_params(surface, lo, hi, true, &rest, region, cap(pv.len()), None);
+        if capped(&pu, cap(pv.len())) {
+            return (pu, pv);
+        }
     } else if su < 0.5 * half.tol && sv > su {
         let rest = Limits { tol: (lim.tol - su).max(half.tol), ..*lim };
-        (pv, sv) = grid_params(surface, lo, hi, false, &rest, region);
+        (pv, sv) = grid_params(surface, lo, hi, false, &rest, region, cap(pu.len()), None);
+        if capped(&pv, cap(pu.len())) {
+            return (pu, pv);
+        }
     }
     // Where the iso-curves left most of the tolerance unused, a twist may use it.
     let room = lim.tol - su - sv;
@@ -135,25 +184,30 @@ fn split_by(p: &[f64], need: &[usize]) -> Vec<f64> {
     out
 }
 
-/// Meshes face `index` on its own within `crit`, using at most `budget`
-/// triangles, as `mesh_model` meshes it in a model (its seams within
-/// `tight`), so the two can be compared.
-pub(crate) fn mesh_face(
+/// Meshes face `index` (its `loops`: its own, or [`domain_loops`]' when it
+/// has none) on its own within `crit`, using at most `budget` triangles,
+/// as `mesh_model` meshes it in a model (its seams within `tight`), so the
+/// two can be compared.
+pub(crate) fn mesh_face<'a>(
     index: usize,
-    face: &Face,
+    face: &'a Face,
+    loops: &'a [crate::TrimLoop],
     lim: &Limits,
     crit: &Criteria,
     budget: usize,
     tight: f64,
-) -> Result<FaceResult, Error> {
+) -> Result<FaceResult<'a>, Error> {
     #[cfg(feature = "std")]
     {
-        let domain = domain_loops(face);
-        let loops = if face.loops.is_empty() { &domain } else { &face.loops };
-        let mut o = outline(index, &face.surface, loops, face.loops.is_empty(), lim)?;
+        // A grid of more cells than [`check_band_cells`] lets through need
+        // not be placed line by line (a trial on a capped rebuild can ask
+        // for millions).
+        let cells = budget.saturating_mul(2).min(MAX_BAND_CELLS).max(budget / 2);
+        let mut o = outline(index, &face.surface, loops, face.loops.is_empty(), lim, cells)?;
         // A grid [`initial_from_outline`] refuses anyway is refused before
         // sewing its many border nodes (a rebuild's trial on a folded face).
         check_band_cells(index, &o, budget)?;
+        let unsewn = o.clone();
         super::sew::unify(
             &mut [Some((&face.surface as &dyn Surface, &mut o))],
             &[],
@@ -164,14 +218,14 @@ pub(crate) fn mesh_face(
         );
         let mut wm = initial_from_outline(index, &face.surface, &o, budget)?;
         let outcome = wm.refine(&face.surface, &o.loops.curves, crit, budget);
-        Ok(FaceResult { mesh: wm, outcome })
+        Ok(FaceResult { mesh: wm, outcome, outline: Some(unsewn) })
     }
     #[cfg(not(feature = "std"))]
     {
-        let _ = tight;
+        let _ = (tight, loops);
         let (mut wm, curves) = initial_face(index, face, lim, budget)?;
         let outcome = wm.refine(&face.surface, &curves, crit, budget);
-        Ok(FaceResult { mesh: wm, outcome })
+        Ok(FaceResult { mesh: wm, outcome, outline: None })
     }
 }
 
@@ -190,7 +244,7 @@ pub(crate) fn initial_face<'a>(
     if face.loops.is_empty() {
         curves = Vec::new();
         let [lo, hi] = surface.domain();
-        let (pu, pv) = grid(surface, lo, hi, lim, None);
+        let (pu, pv) = grid(surface, lo, hi, lim, None, usize::MAX);
         check_grid(index, &pu, &pv, budget)?;
         build_full_grid(surface, &pu, &pv, &mut wm);
     } else {
@@ -203,6 +257,7 @@ pub(crate) fn initial_face<'a>(
 /// its loops discretized, the parameter box its grid covers, and per loop
 /// node its node id across the model (`u32::MAX` until sewing names it).
 #[cfg(feature = "std")]
+#[derive(Clone)]
 pub(crate) struct Outline<'a> {
     pub loops: super::trim::Loops<'a>,
     /// The grid's parameter lines.
@@ -217,7 +272,8 @@ pub(crate) struct Outline<'a> {
 /// get a node at each crossing when they are the domain's border or collapse
 /// to a point (a pole): the band then joins the grid's columns to the
 /// border one by one, as the untrimmed grid would, instead of fanning a few
-/// far nodes over many columns.
+/// far nodes over many columns. A grid of more than `cells` cells may be
+/// cut short (see [`grid`]).
 ///
 /// # Errors
 /// As `mesh_model` for bad loops, or loops outside the surface's domain.
@@ -228,9 +284,10 @@ pub(crate) fn outline<'a>(
     loops: &'a [crate::TrimLoop],
     whole: bool,
     lim: &Limits,
+    cells: usize,
 ) -> Result<Outline<'a>, Error> {
     if whole {
-        if let Some(o) = domain_outline(surface, loops, lim) {
+        if let Some(o) = domain_outline(surface, loops, lim, cells) {
             return Ok(o);
         }
     }
@@ -245,7 +302,7 @@ pub(crate) fn outline<'a>(
             message: "trim loops lie outside the surface's parameter domain".into(),
         });
     }
-    let (pu, pv) = grid(surface, lo, hi, lim, Some(&loops));
+    let (pu, pv) = grid(surface, lo, hi, lim, Some(&loops), cells);
     align_to_grid(surface, &mut loops, &pu, &pv, whole);
     let gids = loops.polys.iter().map(|p| alloc::vec![u32::MAX; p.uv.len()]).collect();
     Ok(Outline { loops, pu, pv, gids })
@@ -256,11 +313,16 @@ pub(crate) fn outline<'a>(
 /// (the grid tests its border iso-curves, so they need no chord test of
 /// their own). `None` when `loops` is not such a loop.
 #[cfg(feature = "std")]
-fn domain_outline<'a>(surface: &dyn Surface, loops: &'a [crate::TrimLoop], lim: &Limits) -> Option<Outline<'a>> {
+fn domain_outline<'a>(
+    surface: &dyn Surface,
+    loops: &'a [crate::TrimLoop],
+    lim: &Limits,
+    cells: usize,
+) -> Option<Outline<'a>> {
     use super::trim::{CurveRef, Loops, Polyline};
     let [lp] = loops else { return None };
     let [lo, hi] = surface.domain();
-    let (pu, pv) = grid(surface, lo, hi, lim, None);
+    let (pu, pv) = grid(surface, lo, hi, lim, None, cells);
     // Border nodes as the loop runs.
     let uv = rect_border(lo, hi, &pu, &pv);
     // Each node on the loop's straight pieces: curve and parameter.
@@ -711,4 +773,40 @@ fn near_loop_mask(segs: &[(DVec2, DVec2)], pu: &[f64], pv: &[f64], scale: DVec2)
         }
     }
     near
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::FaceSurface;
+    use crate::nurbs::NurbsSurface;
+
+    /// A wavy 10 × 4 bicubic sheet with even parameters (as a rebuild is).
+    fn wavy() -> FaceSurface {
+        let pts: Vec<Vec<DVec3>> = (0..8)
+            .map(|i| (0..5).map(|j| DVec3::new(i as f64, 0.6 * j as f64, ((i + j) % 2) as f64 * 0.5)).collect())
+            .collect();
+        let ku = alloc::vec![0.0, 0.0, 0.0, 0.0, 0.2, 0.4, 0.6, 0.8, 1.0, 1.0, 1.0, 1.0];
+        let kv = alloc::vec![0.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0];
+        FaceSurface::Rebuilt(NurbsSurface::try_new([3, 3], ku, kv, &pts, None).unwrap())
+    }
+
+    /// A trial's cell limit (see [`grid`]): a grid within it is the grid
+    /// without one, line for line; one far over it is cut short, still
+    /// with more cells than the limit, so the caller's budget refuses it.
+    #[test]
+    fn grid_within_a_cell_limit_is_unchanged_and_far_over_it_is_cut_short() {
+        let s = wavy();
+        let [lo, hi] = s.domain();
+        let lim = Limits { tol: 1e-3, angle: 0.5, max_edge: f64::INFINITY, min_edge: 1e-6 };
+        let (pu, pv) = grid(&s, lo, hi, &lim, None, usize::MAX);
+        let cells = (pu.len() - 1) * (pv.len() - 1);
+        assert!(cells > 400, "{} x {}", pu.len(), pv.len());
+        assert_eq!(grid(&s, lo, hi, &lim, None, cells), (pu.clone(), pv.clone()));
+        for limit in [cells / 3, cells / 20, 1] {
+            let (a, b) = grid(&s, lo, hi, &lim, None, limit);
+            assert!((a.len() - 1) * (b.len() - 1) > limit, "{limit}: {} x {}", a.len(), b.len());
+            assert!((&a, &b) != (&pu, &pv), "{limit}: not cut short");
+        }
+    }
 }

@@ -122,10 +122,15 @@ pub fn mesh_model_with_progress(
             chosen.push(None);
             continue;
         }
+        let (own, new) = (&domain_loops[index], rebuilt_domain_loops.get(index).map_or(&[][..], |l| &l[..]));
+        let loops_of = |g| face_loops(g, original, own, new);
         // A rebuilt face is meshed within what its fit error leaves of the tolerance.
         let share = if fit_error > 0.0 { ((tol - fit_error) / tol).clamp(0.5, 1.0) } else { 1.0 };
         let mut face_lim = params::Limits { tol: lim.tol * share, max_edge: lim.max_edge.min(cap), ..lim };
         let mut face_crit = refine::Criteria { tol: crit.tol * share, max_edge: crit.max_edge.min(cap), ..crit };
+        // Outlines the trials below made, each with its face and limits: the
+        // one of the variant chosen is not made again.
+        let mut made: Vec<(&crate::Face, params::Limits, face::Outline<'_>)> = Vec::new();
         if fit_error > 0.0 {
             // Paper 001's rebuild is kept where it pays: under `auto` the
             // original is meshed too and wins on more triangles or worse angles.
@@ -133,24 +138,29 @@ pub fn mesh_model_with_progress(
             // as it takes more triangles (a creased face's rebuild can take 100×).
             let budget = options.max_triangles;
             let auto = options.reparam == Reparam::Auto;
-            let orig = auto.then(|| face::mesh_face(index, original, &lim, &crit, budget, auto_tight));
+            let orig_loops = loops_of(original);
+            let mesh_original = || face::mesh_face(index, original, orig_loops, &lim, &crit, budget, auto_tight);
+            let mut orig = auto.then(mesh_original);
             let trial = match &orig {
                 Some(Ok(o)) => budget.min(o.mesh.tris.len().saturating_add(1)),
                 _ => budget,
             };
-            let fr = face::mesh_face(index, f, &face_lim, &face_crit, trial, auto_tight);
+            let f_loops = loops_of(f);
+            let mut fr = face::mesh_face(index, f, f_loops, &face_lim, &face_crit, trial, auto_tight);
             let failed = !matches!(&fr, Ok(r) if !r.mesh.tris.is_empty());
             if failed || auto {
-                let orig = orig.unwrap_or_else(|| face::mesh_face(index, original, &lim, &crit, budget, auto_tight));
+                let mut orig = orig.take().unwrap_or_else(mesh_original);
                 let mut why = rebuild_loses(&fr, &orig);
                 // The mesh shorter edges may start from: the capped one, or the free one where it failed.
+                made.extend(outline_of(&mut fr).map(|o| (f, face_lim, o)));
                 let mut start = (fr, face_lim, face_crit);
                 if why.is_some() && auto && cap.is_finite() {
                     // The edge cap follows the sharpest bend; where that bend
                     // is local, the rebuild may pay without it.
                     let l = params::Limits { max_edge: lim.max_edge, ..face_lim };
                     let c = refine::Criteria { max_edge: crit.max_edge, ..face_crit };
-                    let free = face::mesh_face(index, f, &l, &c, trial, auto_tight);
+                    let mut free = face::mesh_face(index, f, f_loops, &l, &c, trial, auto_tight);
+                    made.extend(outline_of(&mut free).map(|o| (f, l, o)));
                     if rebuild_loses(&free, &orig).is_none() {
                         (why, face_lim, face_crit) = (None, l, c);
                     } else if start.0.is_err() {
@@ -159,8 +169,11 @@ pub fn mesh_model_with_progress(
                 }
                 if why.is_some() && auto {
                     let (r, l, c) = &start;
-                    if let Some((l, c)) = shorter_edges(index, f, r, &orig, (l, c), trial, auto_tight) {
+                    if let Some((l, c, o)) = shorter_edges(index, (f, f_loops), r, &orig, (l, c), trial, auto_tight) {
                         (why, face_lim, face_crit) = (None, l, c);
+                        if let Some(o) = o {
+                            made.push((f, l, o));
+                        }
                     }
                 }
                 if let Some(why) = why {
@@ -169,15 +182,15 @@ pub fn mesh_model_with_progress(
                         r.rebuilt = false;
                     }
                     (f, fit_error, face_lim, face_crit) = (original, 0.0, lim, crit);
+                    made.extend(outline_of(&mut orig).map(|o| (original, lim, o)));
                 }
+            } else {
+                made.extend(outline_of(&mut fr).map(|o| (f, face_lim, o)));
             }
         }
-        let loops: &[crate::TrimLoop] = match (f.loops.is_empty(), core::ptr::eq(f, original)) {
-            (false, _) => &f.loops,
-            (true, true) => &domain_loops[index],
-            (true, false) => &rebuilt_domain_loops[index],
-        };
-        match Chosen::new(index, f, loops, face_lim, face_crit, fit_error) {
+        let loops = loops_of(f);
+        let ready = made.into_iter().find(|(g, l, _)| core::ptr::eq(*g, f) && l.same_as(&face_lim)).map(|(_, _, o)| o);
+        match Chosen::new(index, f, loops, face_lim, face_crit, fit_error, ready) {
             Ok(c) => chosen.push(Some(c)),
             // One face that cannot be meshed does not sink the others; a
             // model where none can is the first face's error.
@@ -420,6 +433,26 @@ fn reparameterize(model: &Model, mine: &[bool], mode: Reparam, tol: f64, report:
     out
 }
 
+/// The loops face `g` is meshed by: its own, or its domain's border (the
+/// original's `domain`, or the rebuild's `rebuilt_domain`) when it has none.
+fn face_loops<'x>(
+    g: &'x crate::Face,
+    original: &crate::Face,
+    domain: &'x [crate::TrimLoop],
+    rebuilt_domain: &'x [crate::TrimLoop],
+) -> &'x [crate::TrimLoop] {
+    match (g.loops.is_empty(), core::ptr::eq(g, original)) {
+        (false, _) => &g.loops,
+        (true, true) => domain,
+        (true, false) => rebuilt_domain,
+    }
+}
+
+/// The unsewn outline a trial mesh made, taken out of it.
+fn outline_of<'x>(r: &mut Result<face::FaceResult<'x>, Error>) -> Option<face::Outline<'x>> {
+    r.as_mut().ok().and_then(|r| r.outline.take())
+}
+
 /// Most meshes [`shorter_edges`] tries.
 const SHORTER_TRIES: usize = 6;
 
@@ -428,16 +461,16 @@ const SHORTER_TRIES: usize = 6;
 /// few long triangles) may spend the difference on shorter edges. The edge
 /// limit starts at half the longest edge and falls by √2 a try (about twice
 /// the triangles), until the mesh wins or takes more triangles than the
-/// original's; the limits of the winning mesh, if one does.
-fn shorter_edges(
+/// original's; the limits of the winning mesh, if one does, and its unsewn outline.
+fn shorter_edges<'x>(
     index: usize,
-    face: &crate::Face,
-    rebuilt: &Result<face::FaceResult, Error>,
-    original: &Result<face::FaceResult, Error>,
+    (face, loops): (&'x crate::Face, &'x [crate::TrimLoop]),
+    rebuilt: &Result<face::FaceResult<'_>, Error>,
+    original: &Result<face::FaceResult<'_>, Error>,
     (lim, crit): (&params::Limits, &refine::Criteria),
     budget: usize,
     tight: f64,
-) -> Option<(params::Limits, refine::Criteria)> {
+) -> Option<(params::Limits, refine::Criteria, Option<face::Outline<'x>>)> {
     let (Ok(new), Ok(old)) = (rebuilt, original) else { return None };
     if new.mesh.tris.is_empty() || new.mesh.tris.len() >= old.mesh.tris.len() {
         return None;
@@ -457,13 +490,13 @@ fn shorter_edges(
         }
         let l = params::Limits { max_edge: lim.max_edge.min(edge), ..*lim };
         let c = refine::Criteria { max_edge: crit.max_edge.min(edge), ..*crit };
-        let r = face::mesh_face(index, face, &l, &c, budget, tight);
+        let mut r = face::mesh_face(index, face, loops, &l, &c, budget, tight);
         match &r {
             Ok(m) if !m.mesh.tris.is_empty() && m.mesh.tris.len() <= old.mesh.tris.len() => {}
             _ => return None,
         }
         if rebuild_loses(&r, original).is_none() {
-            return Some((l, c));
+            return Some((l, c, outline_of(&mut r)));
         }
         edge *= core::f64::consts::FRAC_1_SQRT_2;
     }
@@ -474,8 +507,8 @@ fn shorter_edges(
 /// failed or is empty, is not proven where the original is, has more
 /// triangles, or a smaller 1st-percentile angle. `None` keeps the rebuild.
 fn rebuild_loses(
-    rebuilt: &Result<face::FaceResult, Error>,
-    original: &Result<face::FaceResult, Error>,
+    rebuilt: &Result<face::FaceResult<'_>, Error>,
+    original: &Result<face::FaceResult<'_>, Error>,
 ) -> Option<alloc::string::String> {
     let new = match rebuilt {
         Ok(r) if !r.mesh.tris.is_empty() => r,
@@ -560,7 +593,8 @@ struct Chosen<'a> {
 }
 
 impl<'a> Chosen<'a> {
-    /// `loops`: the face's own, or its domain's border when it has none.
+    /// `loops`: the face's own, or its domain's border when it has none;
+    /// `ready`: its outline for `lim` when a trial already made it.
     fn new(
         index: usize,
         face: &'a crate::Face,
@@ -568,11 +602,15 @@ impl<'a> Chosen<'a> {
         lim: params::Limits,
         crit: refine::Criteria,
         fit_error: f64,
+        ready: Option<face::Outline<'a>>,
     ) -> Result<Self, Error> {
         #[cfg(feature = "std")]
-        let outline = face::outline(index, &face.surface, loops, face.loops.is_empty(), &lim)?;
+        let outline = match ready {
+            Some(o) => o,
+            None => face::outline(index, &face.surface, loops, face.loops.is_empty(), &lim, usize::MAX)?,
+        };
         #[cfg(not(feature = "std"))]
-        let _ = (index, loops);
+        let _ = (index, loops, ready);
         Ok(Self {
             face,
             #[cfg(feature = "std")]

@@ -30,6 +30,14 @@ pub(crate) struct Limits {
     pub min_edge: f64,
 }
 
+impl Limits {
+    /// The same limits bit for bit (so an outline made for one serves the other).
+    pub(crate) fn same_as(&self, o: &Self) -> bool {
+        [self.tol, self.angle, self.max_edge, self.min_edge].map(f64::to_bits)
+            == [o.tol, o.angle, o.max_edge, o.min_edge].map(f64::to_bits)
+    }
+}
+
 /// Most parts one interval is split into at once, and the deepest recursion.
 const MAX_SPLIT: usize = 64;
 const MAX_DEPTH: usize = 24;
@@ -100,7 +108,7 @@ pub(crate) struct Probe<'e> {
 #[cfg(feature = "std")]
 pub(crate) fn subdivide(evals: &[&dyn Fn(f64) -> (DVec3, DVec3)], breaks: &[f64], lim: &Limits) -> (Vec<f64>, f64) {
     let probes: Vec<Probe<'_>> = evals.iter().map(|&eval| Probe { eval, inside: None }).collect();
-    subdivide_probes(&probes, breaks, lim)
+    subdivide_probes(&probes, breaks, lim, MAX_PARAMS)
 }
 
 /// Drops nodes of an accepted subdivision `ts` that the limits do not need:
@@ -177,23 +185,34 @@ pub(crate) fn coarsen(
     out
 }
 
-/// As [`subdivide`], each curve tested only on the parts of an interval where it matters.
-pub(crate) fn subdivide_probes(probes: &[Probe<'_>], breaks: &[f64], lim: &Limits) -> (Vec<f64>, f64) {
+/// As [`subdivide`], each curve tested only on the parts of an interval where
+/// it matters, splitting no more once `cap` parameters are placed.
+pub(crate) fn subdivide_probes(probes: &[Probe<'_>], breaks: &[f64], lim: &Limits, cap: usize) -> (Vec<f64>, f64) {
     let mut out: Vec<f64> = Vec::new();
     let mut worst: f64 = 0.0;
     let Some(&first) = breaks.first() else { return (out, 0.0) };
     out.push(first);
     for w in breaks.windows(2) {
         if w[1] > w[0] {
-            split_rec(probes, w[0], w[1], lim, 0, &mut out, &mut worst);
+            split_rec(probes, w[0], w[1], lim, 0, cap, &mut out, &mut worst);
         }
     }
     (out, worst)
 }
 
-fn split_rec(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits, depth: usize, out: &mut Vec<f64>, worst: &mut f64) {
+#[allow(clippy::too_many_arguments)]
+fn split_rec(
+    probes: &[Probe<'_>],
+    a: f64,
+    b: f64,
+    lim: &Limits,
+    depth: usize,
+    cap: usize,
+    out: &mut Vec<f64>,
+    worst: &mut f64,
+) {
     let (need, sag) = need_all(probes, a, b, lim);
-    if need <= 1.0 || depth >= MAX_DEPTH || out.len() >= MAX_PARAMS || b - a <= (a.abs() + b.abs()) * 1e-12 {
+    if need <= 1.0 || depth >= MAX_DEPTH || out.len() >= cap || b - a <= (a.abs() + b.abs()) * 1e-12 {
         *worst = worst.max(sag);
         out.push(b);
         return;
@@ -226,7 +245,7 @@ fn split_rec(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits, depth: usize, o
     let mut prev = a;
     for k in 1..=n {
         let t = if k == n { b } else { a + (b - a) * k as f64 / n as f64 };
-        split_rec(probes, prev, t, lim, depth + 1, out, worst);
+        split_rec(probes, prev, t, lim, depth + 1, cap, out, worst);
         prev = t;
     }
 }
@@ -275,11 +294,20 @@ const FINE: usize = 256;
 /// rounding up that one equal split per knot group costs. An interval that
 /// still fails raises the demand under it and the lines are placed again;
 /// after four rounds what fails is split as [`subdivide_probes`] splits.
-fn equidistribute(probes: &[Probe<'_>], t0: f64, t1: f64, lim: &Limits) -> (Vec<f64>, f64) {
-    let xs: Vec<f64> =
-        (0..=FINE).map(|k| if k == FINE { t1 } else { t0 + (t1 - t0) * k as f64 / FINE as f64 }).collect();
-    let mut demand: Vec<f64> =
-        xs.windows(2).map(|w| over_probes(probes, w[0], w[1], lim, interval_demand, 0.0).0).collect();
+/// Below [`MAX_PARAMS`], a `cap` the summed demand already passes returns
+/// `cap + 1` even parameters at once (and an infinite sag): a grid that
+/// many lines make is refused anyway, and placing them costs as much again.
+/// `demand`: the fine demand when [`even_demand`] already measured it.
+fn equidistribute(
+    probes: &[Probe<'_>],
+    t0: f64,
+    t1: f64,
+    lim: &Limits,
+    cap: usize,
+    demand: Option<Vec<f64>>,
+) -> (Vec<f64>, f64) {
+    let xs = fine_params(t0, t1);
+    let mut demand = demand.filter(|d| d.len() == FINE).unwrap_or_else(|| fine_demand(probes, &xs, lim));
     let gap = (t1 - t0) * 1e-9;
     for round in 0..4 {
         let mut cum = Vec::with_capacity(FINE + 1);
@@ -288,6 +316,10 @@ fn equidistribute(probes: &[Probe<'_>], t0: f64, t1: f64, lim: &Limits) -> (Vec<
             cum.push(cum.last().copied().unwrap_or(0.0) + d);
         }
         let total = cum[FINE];
+        if cap < MAX_PARAMS && total >= cap as f64 {
+            let ts = (0..=cap).map(|k| if k == cap { t1 } else { t0 + (t1 - t0) * k as f64 / cap as f64 }).collect();
+            return (ts, f64::INFINITY);
+        }
         if !(total.is_finite() && total < MAX_PARAMS as f64) {
             break;
         }
@@ -314,7 +346,7 @@ fn equidistribute(probes: &[Probe<'_>], t0: f64, t1: f64, lim: &Limits) -> (Vec<
                     worst = worst.max(sag);
                     out.push(w[1]);
                 } else {
-                    split_rec(probes, w[0], w[1], lim, 0, &mut out, &mut worst);
+                    split_rec(probes, w[0], w[1], lim, 0, cap, &mut out, &mut worst);
                 }
             }
             return (out, worst);
@@ -331,7 +363,59 @@ fn equidistribute(probes: &[Probe<'_>], t0: f64, t1: f64, lim: &Limits) -> (Vec<
             }
         }
     }
-    subdivide_probes(probes, &[t0, t1], lim)
+    subdivide_probes(probes, &[t0, t1], lim, cap)
+}
+
+/// The ends of [`FINE`] equal intervals over `[t0, t1]`.
+fn fine_params(t0: f64, t1: f64) -> Vec<f64> {
+    (0..=FINE).map(|k| if k == FINE { t1 } else { t0 + (t1 - t0) * k as f64 / FINE as f64 }).collect()
+}
+
+/// The fractional chord demand of each interval between `xs`.
+fn fine_demand(probes: &[Probe<'_>], xs: &[f64], lim: &Limits) -> Vec<f64> {
+    xs.windows(2).map(|w| over_probes(probes, w[0], w[1], lim, interval_demand, 0.0).0).collect()
+}
+
+/// The iso-curves one direction is tested on: at `lines + 1` even steps of
+/// the other parameter, each with its point-and-normal evaluator.
+#[allow(clippy::type_complexity)]
+fn iso_curves<'s>(
+    surface: &'s dyn Surface,
+    lo: DVec2,
+    hi: DVec2,
+    along_u: bool,
+    lines: usize,
+) -> Vec<(f64, impl Fn(f64) -> (DVec3, DVec3) + 's)> {
+    let (s0, s1) = if along_u { (lo.y, hi.y) } else { (lo.x, hi.x) };
+    let make = move |s: f64| {
+        move |t: f64| {
+            let uv = if along_u { DVec2::new(t, s) } else { DVec2::new(s, t) };
+            surface.point_normal(uv)
+        }
+    };
+    (0..=lines).map(|k| s0 + (s1 - s0) * k as f64 / lines as f64).map(|s| (s, make(s))).collect()
+}
+
+/// For a surface with even parameters (see [`equidistribute`]), the fine
+/// chord demand along one direction that [`grid_params`] starts from: its
+/// sum is about the lines that direction takes, known before any is placed.
+/// `None` for other surfaces.
+pub(crate) fn even_demand(
+    surface: &dyn Surface,
+    lo: DVec2,
+    hi: DVec2,
+    along_u: bool,
+    lim: &Limits,
+    region: Option<Region<'_>>,
+) -> Option<Vec<f64>> {
+    let (t0, t1) = if along_u { (lo.x, hi.x) } else { (lo.y, hi.y) };
+    if !(surface.even_parameters() && t1 > t0) {
+        return None;
+    }
+    let curves = iso_curves(surface, lo, hi, along_u, if region.is_some() { 8 } else { 4 });
+    let probes: Vec<Probe<'_>> =
+        curves.iter().map(|(s, c)| Probe { eval: c, inside: region.map(|r| r(along_u, *s)) }).collect();
+    Some(fine_demand(&probes, &fine_params(t0, t1), lim))
 }
 
 /// Initial intervals along one direction: the knot breaks inside `[lo, hi]`,
@@ -378,7 +462,10 @@ pub(crate) type Region<'r> = &'r dyn Fn(bool, f64) -> Vec<(f64, f64)>;
 /// (paper 000 §3.1.3). On a trimmed face (`region` given) each line is tested
 /// only where it runs inside the loops, and at every eighth of the rectangle:
 /// what lies outside the trim (a fold, a pole, a wild corner of the base
-/// surface) must not set the grid of the part that is kept.
+/// surface) must not set the grid of the part that is kept. Once `cap`
+/// parameters are placed no interval is split further; `demand` is
+/// [`even_demand`]'s for these limits when the caller measured it.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn grid_params(
     surface: &dyn Surface,
     lo: DVec2,
@@ -386,23 +473,19 @@ pub(crate) fn grid_params(
     along_u: bool,
     lim: &Limits,
     region: Option<Region<'_>>,
+    cap: usize,
+    demand: Option<Vec<f64>>,
 ) -> (Vec<f64>, f64) {
-    let (t0, t1, s0, s1) = if along_u { (lo.x, hi.x, lo.y, hi.y) } else { (lo.y, hi.y, lo.x, hi.x) };
-    let lines = if region.is_some() { 8 } else { 4 };
-    let make = |s: f64| {
-        move |t: f64| {
-            let uv = if along_u { DVec2::new(t, s) } else { DVec2::new(s, t) };
-            surface.point_normal(uv)
-        }
-    };
-    let curves: Vec<_> = (0..=lines).map(|k| s0 + (s1 - s0) * k as f64 / lines as f64).map(|s| (s, make(s))).collect();
+    let cap = cap.min(MAX_PARAMS);
+    let (t0, t1) = if along_u { (lo.x, hi.x) } else { (lo.y, hi.y) };
+    let curves = iso_curves(surface, lo, hi, along_u, if region.is_some() { 8 } else { 4 });
     let probes: Vec<Probe<'_>> =
         curves.iter().map(|(s, c)| Probe { eval: c, inside: region.map(|r| r(along_u, *s)) }).collect();
     if surface.even_parameters() && t1 > t0 {
-        return equidistribute(&probes, t0, t1, lim);
+        return equidistribute(&probes, t0, t1, lim, cap, demand);
     }
     let breaks = initial_breaks(&surface.breaks(along_u), t0, t1, 16);
-    subdivide_probes(&probes, &breaks, lim)
+    subdivide_probes(&probes, &breaks, lim, cap)
 }
 
 #[cfg(test)]
@@ -469,9 +552,9 @@ mod tests {
         };
         let probes = [Probe { eval: &curve, inside: None }];
         let l = lim(1e-3);
-        let (even, _) = equidistribute(&probes, 0.0, 1.0, &l);
+        let (even, _) = equidistribute(&probes, 0.0, 1.0, &l, MAX_PARAMS, None);
         let breaks: Vec<f64> = (0..=16).map(|k| k as f64 / 16.0).collect();
-        let (grouped, _) = subdivide_probes(&probes, &breaks, &l);
+        let (grouped, _) = subdivide_probes(&probes, &breaks, &l, MAX_PARAMS);
         assert!(even.len() < grouped.len(), "{} lines against {}", even.len(), grouped.len());
         assert!(even.windows(2).all(|w| w[1] > w[0]), "{even:?}");
         assert_eq!((even[0], even[even.len() - 1]), (0.0, 1.0));

@@ -104,7 +104,7 @@ impl<'a> FaceStages<'a> {
 
     /// Stage 2: the iso-parametric grid over the face's (trimmed) parameter rectangle.
     pub fn grid(&self, d: &Discretized<'_>) -> Grid {
-        let (pu, pv) = grid(self.surface(), d.lo, d.hi, &self.setup.lim, d.loops.as_ref());
+        let (pu, pv) = grid(self.surface(), d.lo, d.hi, &self.setup.lim, d.loops.as_ref(), usize::MAX);
         Grid { pu, pv }
     }
 
