@@ -358,6 +358,10 @@ pub fn mesh_model_with_progress(
         }
         mesh.face_ranges.push(FaceRange { first, count: wm.tris.len() as u32 });
     }
+    // The room the last growth left, given back before the mesh is measured.
+    mesh.positions.shrink_to_fit();
+    mesh.normals.shrink_to_fit();
+    mesh.indices.shrink_to_fit();
     report.mean_deviation = if dev_count > 0 { dev_sum / dev_count as f64 } else { 0.0 };
     report.triangles = mesh.triangle_count();
     report.vertices = mesh.positions.len();

@@ -389,6 +389,15 @@ impl WorkMesh {
         self.edges.get(&key(a, b)).map_or(0, |e| e.iter().filter(|&&t| t != NONE).count())
     }
 
+    /// Whether edge `a-b` is a border edge (one triangle), at rest as awake.
+    #[cfg(feature = "std")]
+    pub fn is_border(&self, a: u32, b: u32) -> bool {
+        if self.resting {
+            return self.rim.contains_key(&key(a, b));
+        }
+        self.edges.get(&key(a, b)).is_some_and(|e| e[0] != NONE && e[1] == NONE)
+    }
+
     /// Adds triangle `t` to edge `a-b`'s list, lowest index first (of more
     /// than two, the lowest two are kept).
     fn attach(&mut self, a: u32, b: u32, t: u32) {
