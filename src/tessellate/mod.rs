@@ -350,7 +350,7 @@ pub fn mesh_model_with_progress(
                 *slot = next;
                 next += 1;
                 mesh.positions.push(wm.pos[v]);
-                mesh.normals.push(wm.normal[v]);
+                mesh.normals.push(wm.normal_at(v));
             }
         }
         for t in &wm.tris {

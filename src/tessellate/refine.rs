@@ -5,7 +5,7 @@
 
 use crate::collections::{HashMap, PairMap};
 use alloc::vec::Vec;
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, Vec3};
 
 use super::measure::{measure_projection, measure_triangle, sample_count, TriMeasure};
 use crate::math::angle_between;
@@ -146,7 +146,9 @@ fn same_uv(a: DVec2, b: DVec2) -> bool {
 #[derive(Debug, Default)]
 pub(crate) struct WorkMesh {
     pub pos: Vec<DVec3>,
-    pub normal: Vec<DVec3>,
+    /// Per vertex: its surface normal, in `f32` (what the page draws; it
+    /// only judges how far a triangle's normal turns), half the room.
+    normal: Vec<Vec3>,
     pub tris: Vec<[u32; 3]>,
     /// Per vertex: the (u,v) the first triangle to use it gave it.
     vuv: Vec<DVec2>,
@@ -296,7 +298,7 @@ impl WorkMesh {
     fn push_vertex(&mut self, p: DVec3, n: DVec3) -> u32 {
         self.room(1, 0);
         self.pos.push(p);
-        self.normal.push(n);
+        self.normal.push(n.as_vec3());
         self.gid.push(NONE);
         self.vuv.push(DVec2::new(f64::from_bits(UV_UNSET), f64::from_bits(UV_UNSET)));
         (self.pos.len() - 1) as u32
@@ -351,6 +353,11 @@ impl WorkMesh {
         let missing = self.tris.len().saturating_sub(self.measures.len());
         room(&mut self.measures, missing);
         self.measures.resize(self.tris.len(), STALE);
+    }
+
+    /// Vertex `v`'s surface normal.
+    pub fn normal_at(&self, v: usize) -> DVec3 {
+        self.normal[v].as_dvec3()
     }
 
     /// Adds a vertex with its surface normal.
@@ -434,7 +441,7 @@ impl WorkMesh {
         let p = [self.pos[v[0] as usize], self.pos[v[1] as usize], self.pos[v[2] as usize]];
         let uv = self.uv(t);
         let m = measure_triangle(surface, &p, &uv, c.steps, &measure_projection());
-        let mut n = [self.normal[v[0] as usize], self.normal[v[1] as usize], self.normal[v[2] as usize]];
+        let mut n = v.map(|x| self.normal_at(x as usize));
         let turn_of =
             |n: &[DVec3; 3]| angle_between(n[0], n[1]).max(angle_between(n[1], n[2])).max(angle_between(n[2], n[0]));
         let mut turn = turn_of(&n);

@@ -182,10 +182,10 @@ impl WorkMesh {
         let area = |w: [DVec2; 3]| (w[1] - w[0]).perp_dot(w[2] - w[0]);
         let signs: Vec<f64> = ring.iter().map(|&t| area(self.uv(t as usize))).collect();
         let sense = signs.iter().sum::<f64>();
-        let (old_p, old_n) = (self.pos[x as usize], self.normal[x as usize]);
+        let (old_p, old_n) = (self.pos[x as usize], self.normal_at(x as usize));
         let set = |m: &mut Self, q: DVec2, p: DVec3, nn: DVec3| {
             m.pos[x as usize] = p;
-            m.normal[x as usize] = nn;
+            m.normal[x as usize] = nn.as_vec3();
             m.move_uv(x, &ring, q);
         };
         set(self, new_uv, surface.point(new_uv), surface.normal(new_uv));
