@@ -115,6 +115,11 @@ fn border_uses(faces: &[FaceWork<'_>]) -> Uses {
             }
         }
     }
+    // Most edges have two uses: lists of exactly their size are held
+    // through refinement, not room for four.
+    for list in uses.values_mut() {
+        list.shrink_to_fit();
+    }
     uses
 }
 
@@ -340,6 +345,8 @@ pub(crate) fn refine_all(
                     queue.push_back(j);
                 }
             }
+            lo_side.shrink_to_fit();
+            hi_side.shrink_to_fit();
             uses.insert(node_key(ga, g), lo_side);
             uses.insert(node_key(g, gb), hi_side);
         }
