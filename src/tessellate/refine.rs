@@ -356,9 +356,15 @@ impl WorkMesh {
         self.measures.resize(self.tris.len(), STALE);
     }
 
-    /// Vertex `v`'s surface normal.
+    /// Vertex `v`'s surface normal, of unit length again after the rounding to `f32`.
     pub fn normal_at(&self, v: usize) -> DVec3 {
-        self.normal[v].as_dvec3()
+        let n = self.normal[v].as_dvec3();
+        let l = n.length();
+        if l > 0.0 {
+            n / l
+        } else {
+            n
+        }
     }
 
     /// Adds a vertex with its surface normal.
