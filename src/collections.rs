@@ -166,11 +166,6 @@ impl<V: Copy> PairMap<V> {
         &mut self.slots[i].1
     }
 
-    /// Sets the value of `k`.
-    pub fn insert(&mut self, k: (u32, u32), v: V) {
-        *self.get_or_insert(k, v) = v;
-    }
-
     /// Removes `k`, returning its value; later entries of its probe run
     /// move back, so no tombstones are left.
     pub fn remove(&mut self, k: &(u32, u32)) -> Option<V> {
@@ -202,17 +197,6 @@ impl<V: Copy> PairMap<V> {
         self.slots.iter().filter(|s| s.0 != FREE).map(|(k, v)| (((k >> 32) as u32, *k as u32), v))
     }
 
-    /// Gives back the room past a quarter more than the entries need (a
-    /// face refinement has finished with keeps its table until assembly).
-    pub fn shrink(&mut self) {
-        let n = (self.len + self.len / 4).max(8);
-        if self.slots.len() > n + n / 8 {
-            if let Some(&(_, fill)) = self.slots.first() {
-                self.rebuild(n, fill);
-            }
-        }
-    }
-
     /// A table a quarter larger (at least 8 slots), entries moved over;
     /// `fill` stands in the empty slots' values.
     fn grow(&mut self, fill: V) {
@@ -240,7 +224,7 @@ mod tests {
     use alloc::vec::Vec;
 
     /// Against a [`HashMap`] through a long run of inserts, updates,
-    /// removals (which move probe runs back) and shrinks: the same entries
+    /// removals (which move probe runs back): the same entries
     /// every step.
     #[test]
     fn pair_map_agrees_with_a_hash_map() {
@@ -272,9 +256,6 @@ mod tests {
                         v[0] ^= 1;
                     }
                 }
-            }
-            if step % 1999 == 0 {
-                ours.shrink();
             }
             assert_eq!(ours.len(), theirs.len());
             if step % 997 == 0 {

@@ -3,7 +3,7 @@
 use alloc::vec::Vec;
 use glam::DVec3;
 
-use super::{weld_positions, Mesh};
+use super::{weld::weld_positions_compact, Mesh};
 
 /// Edge census after welding coincident vertices.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -32,7 +32,7 @@ pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
 /// crack only next to another border of its own body, so parts of an
 /// assembly that touch are counted each on its own.
 pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol: f64) -> EdgeCounts {
-    let (mut map, mut nverts) = weld_positions(&mesh.positions, weld_tol);
+    let (mut map, mut nverts) = weld_positions_compact(&mesh.positions, weld_tol);
     let face_of = face_lookup(mesh);
     let body_of_face = |f: u32| crate::model::body_of(bodies, f as usize);
     if !bodies.is_empty() {
@@ -45,49 +45,93 @@ pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol
                 }
             }
         }
-        let mut ids: crate::collections::HashMap<(u32, u32), u32> = crate::collections::HashMap::default();
+        // A welded vertex splits by body: one keeps its id (the body of
+        // its first position), the few that touch another body get new ones.
+        let mut home = alloc::vec![u32::MAX; nverts];
+        let mut extra: crate::collections::HashMap<(u32, u32), u32> = crate::collections::HashMap::default();
         for (v, m) in map.iter_mut().enumerate() {
-            let next = ids.len() as u32;
-            *m = *ids.entry((*m, body_of_vertex[v])).or_insert(next);
+            let b = body_of_vertex[v];
+            let h = &mut home[*m as usize];
+            if *h == u32::MAX {
+                *h = b;
+            } else if *h != b {
+                let next = (nverts + extra.len()) as u32;
+                *m = *extra.entry((*m, b)).or_insert(next);
+            }
         }
-        nverts = ids.len();
+        nverts += extra.len();
     }
-    // Representative position of each welded vertex.
-    let mut pos = alloc::vec![DVec3::ZERO; nverts];
+    // Each welded vertex's last position stands for it.
+    let mut rep = alloc::vec![0u32; nverts];
     for (i, &m) in map.iter().enumerate() {
-        pos[m as usize] = mesh.positions[i];
+        rep[m as usize] = i as u32;
     }
-    // Per undirected pair: the triangles running it low to high, high to
-    // low, and the face of the last one; room for a closed mesh's edges
-    // from the start (this is the largest table of the whole run).
-    let mut edges: crate::collections::PairMap<[u32; 3]> =
-        crate::collections::PairMap::with_capacity(mesh.indices.len() / 2 + 16, [0; 3]);
-    for (ti, t) in mesh.indices.chunks_exact(3).enumerate() {
-        let v = [map[t[0] as usize], map[t[1] as usize], map[t[2] as usize]];
-        if v[0] == v[1] || v[1] == v[2] || v[2] == v[0] {
-            continue; // collapsed by welding (pole)
-        }
-        for k in 0..3 {
-            let (a, b) = (v[k], v[(k + 1) % 3]);
-            let e = edges.get_or_insert((a.min(b), a.max(b)), [0; 3]);
-            e[usize::from(a > b)] += 1;
-            e[2] = face_of(ti);
+    let pos = |m: u32| mesh.positions[rep[m as usize] as usize];
+    // The triangles at each welded vertex (offsets, then the list): 16
+    // bytes a triangle where a table of the edges took 40.
+    let tri = |ti: usize| {
+        let t = &mesh.indices[3 * ti..3 * ti + 3];
+        [map[t[0] as usize], map[t[1] as usize], map[t[2] as usize]]
+    };
+    let count = mesh.indices.len() / 3;
+    let live = |v: &[u32; 3]| v[0] != v[1] && v[1] != v[2] && v[2] != v[0]; // not collapsed by welding (pole)
+    let mut start = alloc::vec![0u32; nverts + 1];
+    for ti in 0..count {
+        let v = tri(ti);
+        if live(&v) {
+            for x in v {
+                start[x as usize + 1] += 1;
+            }
         }
     }
+    for i in 0..nverts {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut at = alloc::vec![0u32; start[nverts] as usize];
+    for ti in 0..count {
+        let v = tri(ti);
+        if live(&v) {
+            for x in v {
+                at[fill[x as usize] as usize] = ti as u32;
+                fill[x as usize] += 1;
+            }
+        }
+    }
+    drop(fill);
     let mut out = EdgeCounts::default();
     let mut free: Vec<(u32, u32, u32)> = Vec::new();
-    for (k, &[f, r, owner]) in edges.iter() {
-        match f + r {
-            1 => free.push((k.0, k.1, owner)),
-            2 => {
-                if f != 1 {
-                    out.misoriented_edges += 1;
+    // Each edge from its lower end: the higher end, whether a triangle runs
+    // it high to low, and the triangle.
+    let mut around: Vec<(u32, bool, u32)> = Vec::new();
+    for a in 0..nverts as u32 {
+        around.clear();
+        for &ti in &at[start[a as usize] as usize..start[a as usize + 1] as usize] {
+            let v = tri(ti as usize);
+            for k in 0..3 {
+                let (p, q) = (v[k], v[(k + 1) % 3]);
+                if p == a && q > a {
+                    around.push((q, false, ti));
+                } else if q == a && p > a {
+                    around.push((p, true, ti));
                 }
             }
-            _ => out.nonmanifold_edges += 1,
+        }
+        around.sort_unstable();
+        for run in around.chunk_by(|x, y| x.0 == y.0) {
+            let back = run.iter().filter(|x| x.1).count();
+            match run.len() {
+                1 => free.push((a, run[0].0, face_of(run[0].2 as usize))),
+                2 => {
+                    if back != 1 {
+                        out.misoriented_edges += 1;
+                    }
+                }
+                _ => out.nonmanifold_edges += 1,
+            }
         }
     }
-    drop(edges);
+    drop((at, start, around));
     out.boundary_edges = free.len();
     out.free_edges = count_cracks(&free, &pos, sew_tol, &body_of_face);
     out
@@ -104,7 +148,7 @@ fn face_lookup(mesh: &Mesh) -> impl Fn(usize) -> u32 + '_ {
 /// A free edge is a crack when a vertex or midpoint of a free edge of another
 /// face of its body lies within `sew` (and within a fifth of the edge's
 /// length) of its quarter, half or three-quarter point.
-fn count_cracks(free: &[(u32, u32, u32)], pos: &[DVec3], sew: f64, body: &dyn Fn(u32) -> u32) -> usize {
+fn count_cracks(free: &[(u32, u32, u32)], pos: &dyn Fn(u32) -> DVec3, sew: f64, body: &dyn Fn(u32) -> u32) -> usize {
     if free.is_empty() || !(sew > 0.0 && sew.is_finite()) {
         return 0;
     }
@@ -119,16 +163,16 @@ fn count_cracks(free: &[(u32, u32, u32)], pos: &[DVec3], sew: f64, body: &dyn Fn
     for &(a, b, f) in free {
         for v in [a, b] {
             if seen.insert((v, f)) {
-                let p = pos[v as usize];
+                let p = pos(v);
                 grid.insert(p, (p, Tag::Vertex(v), f));
             }
         }
-        let m = (pos[a as usize] + pos[b as usize]) * 0.5;
+        let m = (pos(a) + pos(b)) * 0.5;
         grid.insert(m, (m, Tag::Mid, f));
     }
     let mut cracks = 0;
     for &(a, b, face) in free {
-        let (pa, pb) = (pos[a as usize], pos[b as usize]);
+        let (pa, pb) = (pos(a), pos(b));
         // Relative to the edge too: an open border's own neighbours sit half an edge away.
         let reach = sew.min(0.2 * pa.distance(pb));
         let hit = [0.25, 0.5, 0.75].iter().any(|&f| {

@@ -80,10 +80,8 @@ fn remove_flaps(faces: &mut [FaceWork<'_>], width: f64) -> usize {
             // Corner k is the apex: sides k-1→k and k→k+1 on the border.
             for k in 0..3 {
                 let (prev, apex, next) = (v[(k + 2) % 3], v[k], v[(k + 1) % 3]);
-                if m.edge_triangles(prev, next) != 2
-                    || m.edge_triangles(prev, apex) != 1
-                    || m.edge_triangles(apex, next) != 1
-                {
+                // The border sides first: at rest an inner side is counted by a walk.
+                if !m.is_border(prev, apex) || !m.is_border(apex, next) || m.edge_triangles(prev, next) != 2 {
                     continue;
                 }
                 let (u1, u2) = (used(m, prev, apex), used(m, apex, next));
@@ -116,7 +114,7 @@ fn each_border_side(faces: &[FaceWork<'_>], mut visit: impl FnMut(Side)) {
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 let (ga, gb) = (m.gid[a as usize], m.gid[b as usize]);
-                if ga == NONE || gb == NONE || ga == gb || m.edge_triangles(a, b) != 1 {
+                if ga == NONE || gb == NONE || ga == gb || !m.is_border(a, b) {
                     continue;
                 }
                 visit(Side { face: fi as u32, a, b, ga, gb });

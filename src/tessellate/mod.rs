@@ -230,8 +230,9 @@ pub fn mesh_model_with_progress(
         };
         let budget = options.max_triangles.saturating_sub(used);
         let why = match c.initial(index, budget) {
-            Ok((mesh, curves)) => {
+            Ok((mut mesh, curves)) => {
                 used += mesh.tris.len();
+                mesh.rest();
                 works.push(sew::FaceWork { surface: &c.face.surface, curves, mesh, crit: c.crit });
                 fit_errors.push(c.fit_error);
                 continue;
@@ -270,6 +271,7 @@ pub fn mesh_model_with_progress(
     for w in works.iter_mut() {
         let (changed, left) = w.mesh.repair_inverted(w.surface, &w.crit);
         w.mesh.forget(&changed);
+        w.mesh.rest();
         folded.push(left);
     }
     if folded.iter().any(|f| !f.is_empty()) {
@@ -279,12 +281,16 @@ pub fn mesh_model_with_progress(
                 w.mesh.forget(moved);
                 let (changed, _) = w.mesh.repair_inverted(w.surface, &w.crit);
                 w.mesh.forget(&changed);
+                w.mesh.rest();
             }
         }
     }
     // Three faces' corners that sewing left apart: a sliver between them.
     #[cfg(feature = "std")]
     fill::close_slivers(&mut works, tol);
+    for w in works.iter_mut() {
+        w.mesh.rest();
+    }
     let (mut dev_sum, mut dev_count) = (0.0, 0u64);
     for (index, (w, fit_error)) in works.iter_mut().zip(&fit_errors).enumerate() {
         let out = w.mesh.outcome(w.surface, &w.crit);
@@ -328,21 +334,14 @@ pub fn mesh_model_with_progress(
             ));
         }
     }
-    // The model's mesh, each face's working mesh freed once it is copied:
-    // wasm memory never shrinks, so the peak is what a page keeps.
+    // The model's mesh, each face's working state freed as soon as it is
+    // copied, the mesh growing by what each face adds: presized in full,
+    // it sat next to every face's full working state (wasm memory never
+    // shrinks, so the peak is what a page keeps).
     drop((places, folded, settled));
+    let mut mesh = Mesh { face_ranges: Vec::with_capacity(works.len()), ..Mesh::default() };
     for w in &mut works {
-        w.mesh.keep_only_triangles();
-    }
-    let (nv, nt) = works.iter().fold((0, 0), |(v, t), w| (v + w.mesh.pos.len(), t + w.mesh.tris.len()));
-    let mut mesh = Mesh {
-        positions: Vec::with_capacity(nv),
-        normals: Vec::with_capacity(nv),
-        indices: Vec::with_capacity(3 * nt),
-        face_ranges: Vec::with_capacity(works.len()),
-    };
-    for w in works {
-        let wm = w.mesh;
+        let wm = core::mem::take(&mut w.mesh);
         let first = mesh.triangle_count() as u32;
         let base = mesh.positions.len() as u32;
         // Vertices no triangle kept (a removed flap's corner, a collapsed
@@ -354,13 +353,17 @@ pub fn mesh_model_with_progress(
                 index[v as usize] = 0;
             }
         }
+        let kept = index.iter().filter(|&&x| x == 0).count();
+        grow(&mut mesh.positions, kept);
+        grow(&mut mesh.normals, kept);
+        grow(&mut mesh.indices, 3 * wm.tris.len());
         let mut next = base;
         for (v, slot) in index.iter_mut().enumerate() {
             if *slot == 0 {
                 *slot = next;
                 next += 1;
                 mesh.positions.push(wm.pos[v]);
-                mesh.normals.push(wm.normal[v]);
+                mesh.normals.push(wm.normal_at(v));
             }
         }
         for t in &wm.tris {
@@ -368,6 +371,10 @@ pub fn mesh_model_with_progress(
         }
         mesh.face_ranges.push(FaceRange { first, count: wm.tris.len() as u32 });
     }
+    // The room the last growth left, given back before the mesh is measured.
+    mesh.positions.shrink_to_fit();
+    mesh.normals.shrink_to_fit();
+    mesh.indices.shrink_to_fit();
     report.mean_deviation = if dev_count > 0 { dev_sum / dev_count as f64 } else { 0.0 };
     report.triangles = mesh.triangle_count();
     report.vertices = mesh.positions.len();
@@ -379,6 +386,15 @@ pub fn mesh_model_with_progress(
     report.min_angle_deg = angles.min_deg;
     report.p1_angle_deg = angles.p1_deg;
     Ok(MeshResult { mesh, report })
+}
+
+/// Makes room for `extra` more elements, growing by an eighth: the model's
+/// mesh grows face by face as the faces' working state is freed, and the
+/// slack of doubling would be up to half of it.
+fn grow<T>(v: &mut Vec<T>, extra: usize) {
+    if v.capacity() - v.len() < extra {
+        v.reserve_exact(v.len() / 8 + extra);
+    }
 }
 
 /// Runs paper 001's ratio test on every face of the share `mine` (unless `mode` is off) and

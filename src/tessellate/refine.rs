@@ -5,7 +5,7 @@
 
 use crate::collections::{HashMap, PairMap};
 use alloc::vec::Vec;
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, Vec3};
 
 use super::measure::{measure_projection, measure_triangle, sample_count, TriMeasure};
 use crate::math::angle_between;
@@ -15,9 +15,115 @@ mod mend;
 
 const NONE: u32 = u32::MAX;
 
+/// A triangle's cached measure in 12 bytes: the largest distance and the
+/// normal turn rounded up to `f32` (a cached triangle never looks better than
+/// it measured, and the report never understates), the distance sum to the
+/// nearest. Every face's cache is held until the model is assembled.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Packed {
+    max: f32,
+    sum: f32,
+    turn: f32,
+}
+
 /// A measure cache slot to be filled: a measured largest distance is never
 /// NaN (it starts at 0 and `f64::max` passes over NaN samples).
-const STALE: (TriMeasure, f64) = (TriMeasure { max: f64::NAN, sum: 0.0 }, 0.0);
+const STALE: Packed = Packed { max: f32::NAN, sum: 0.0, turn: 0.0 };
+
+/// The least `f32` not below `x`.
+fn up(x: f64) -> f32 {
+    let y = x as f32;
+    if f64::from(y) >= x || y.is_nan() {
+        return y;
+    }
+    // The next f32 towards +inf (`f32::next_up` is newer than the MSRV).
+    if y == 0.0 {
+        f32::from_bits(1)
+    } else if y > 0.0 {
+        f32::from_bits(y.to_bits() + 1)
+    } else {
+        f32::from_bits(y.to_bits() - 1)
+    }
+}
+
+impl Packed {
+    fn pack(m: TriMeasure, turn: f64) -> Self {
+        Self { max: up(m.max), sum: m.sum as f32, turn: up(turn) }
+    }
+
+    fn unpack(self) -> (TriMeasure, f64) {
+        (TriMeasure { max: f64::from(self.max), sum: f64::from(self.sum) }, f64::from(self.turn))
+    }
+}
+
+/// Edges with a value each, sorted by their key: a binary search finds one,
+/// and the list holds exactly its entries (a hash table ran a quarter empty
+/// with at least 8 slots a face, and every face is held until assembly).
+#[derive(Debug, Clone)]
+pub(crate) struct EdgeList<V>(Vec<((u32, u32), V)>);
+
+impl<V> Default for EdgeList<V> {
+    fn default() -> Self {
+        Self(Vec::new())
+    }
+}
+
+impl<V: Copy> EdgeList<V> {
+    fn find(&self, k: &(u32, u32)) -> Result<usize, usize> {
+        self.0.binary_search_by(|e| e.0.cmp(k))
+    }
+
+    pub fn get(&self, k: &(u32, u32)) -> Option<&V> {
+        self.find(k).ok().map(|i| &self.0[i].1)
+    }
+
+    fn get_mut(&mut self, k: &(u32, u32)) -> Option<&mut V> {
+        self.find(k).ok().map(|i| &mut self.0[i].1)
+    }
+
+    pub fn contains_key(&self, k: &(u32, u32)) -> bool {
+        self.find(k).is_ok()
+    }
+
+    /// Sets the value of `k`.
+    pub fn insert(&mut self, k: (u32, u32), v: V) {
+        match self.find(&k) {
+            Ok(i) => self.0[i].1 = v,
+            Err(i) => {
+                room(&mut self.0, 1);
+                self.0.insert(i, (k, v));
+            }
+        }
+    }
+
+    /// Removes `k`, returning its value.
+    pub fn remove(&mut self, k: &(u32, u32)) -> Option<V> {
+        self.find(k).ok().map(|i| self.0.remove(i).1)
+    }
+
+    /// The keys, in order.
+    pub fn keys(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.0.iter().map(|e| e.0)
+    }
+
+    /// The list of `items`, sorted (the last of a repeated key wins).
+    pub fn from_unsorted(mut items: Vec<((u32, u32), V)>) -> Self {
+        items.sort_by_key(|e| e.0);
+        items.dedup_by(|later, earlier| {
+            let same = later.0 == earlier.0;
+            if same {
+                earlier.1 = later.1;
+            }
+            same
+        });
+        items.shrink_to_fit();
+        Self(items)
+    }
+
+    fn shrink(&mut self) {
+        self.0.shrink_to_fit();
+    }
+}
 
 /// A trim edge: the curve it follows and the parameters at its lower- and
 /// higher-numbered vertex.
@@ -46,27 +152,36 @@ fn same_uv(a: DVec2, b: DVec2) -> bool {
 #[derive(Debug, Default)]
 pub(crate) struct WorkMesh {
     pub pos: Vec<DVec3>,
-    pub normal: Vec<DVec3>,
+    /// Per vertex: its surface normal, in `f32` (what the page draws; it
+    /// only judges how far a triangle's normal turns), half the room.
+    normal: Vec<Vec3>,
     pub tris: Vec<[u32; 3]>,
     /// Per vertex: the (u,v) the first triangle to use it gave it.
     vuv: Vec<DVec2>,
     /// The corner (u,v)s of triangles where one differs from its vertex's.
     odd_uv: HashMap<u32, [DVec2; 3]>,
+    /// The triangles on each edge, in the order they were attached, while awake.
     edges: PairMap<[u32; 2]>,
-    trim: PairMap<TrimEdge>,
+    /// Whether the face is at rest ([`WorkMesh::rest`]): no edge table, only
+    /// its border edges in `rim`.
+    resting: bool,
+    /// At rest: each border edge (one triangle) and its triangle; what a
+    /// neighbour's split of a shared edge and the border walks need.
+    rim: EdgeList<u32>,
+    trim: EdgeList<TrimEdge>,
     /// Per vertex: its node id across the model (`NONE` for inner vertices),
     /// so that borders of different faces can name the same node.
     pub gid: Vec<u32>,
     /// Border edges another face (or another stretch of this face's border,
     /// across a seam) shares: a split of one must be made in the other.
-    pub shared: PairMap<()>,
+    pub shared: EdgeList<()>,
     /// Shared edges refinement split, as `(a, b, new vertex)`, for the caller
     /// to make the same split where the edge is shared.
     pub events: Vec<(u32, u32, u32)>,
     /// Cached measure and normal turn of each triangle; [`STALE`] (a NaN
     /// distance) marks one changed since measured, which saves an `Option`'s
-    /// tag, and the sample count follows from the grid: 24 bytes a triangle.
-    measures: Vec<(TriMeasure, f64)>,
+    /// tag, and the sample count follows from the grid: 12 bytes a triangle.
+    measures: Vec<Packed>,
 }
 
 /// One triangle of an edge being split: the triangle, its corners and their
@@ -188,38 +303,56 @@ impl WorkMesh {
     fn push_vertex(&mut self, p: DVec3, n: DVec3) -> u32 {
         self.room(1, 0);
         self.pos.push(p);
-        self.normal.push(n);
+        self.normal.push(n.as_vec3());
         self.gid.push(NONE);
         self.vuv.push(DVec2::new(f64::from_bits(UV_UNSET), f64::from_bits(UV_UNSET)));
         (self.pos.len() - 1) as u32
     }
 
-    /// Frees all but the vertices, normals and triangles, once nothing more
-    /// is refined or repaired: the model's mesh is copied from those alone.
-    pub fn keep_only_triangles(&mut self) {
-        self.vuv = Vec::new();
-        self.odd_uv = HashMap::default();
-        self.edges = PairMap::default();
-        self.trim = PairMap::default();
-        self.gid = Vec::new();
-        self.shared = Default::default();
-        self.events = Vec::new();
-        self.measures = Vec::new();
-    }
-
-    /// Gives back the room kept for growth, once refinement is done with
-    /// the face for now: every face is held until the model is assembled,
-    /// and a later split here grows it again.
-    pub fn shrink(&mut self) {
+    /// Puts the face at rest once refinement is done with it for now: the
+    /// edge table (the largest part of a face's working state) is dropped,
+    /// only the border edges kept, and the room kept for growth is given
+    /// back. Every face is held until the model is assembled; a neighbour's
+    /// split of a shared border edge works at rest, anything else wakes the
+    /// face ([`WorkMesh::wake`]) first.
+    pub fn rest(&mut self) {
+        if !self.resting {
+            let rim = self.edges.iter().filter(|(_, t)| t[1] == NONE).map(|(k, t)| (k, t[0])).collect();
+            self.edges = PairMap::default();
+            self.rim = EdgeList::from_unsorted(rim);
+            self.resting = true;
+        }
         self.pos.shrink_to_fit();
         self.normal.shrink_to_fit();
         self.gid.shrink_to_fit();
         self.vuv.shrink_to_fit();
         self.tris.shrink_to_fit();
         self.measures.shrink_to_fit();
-        self.edges.shrink();
+        self.events.shrink_to_fit();
+        self.rim.shrink();
         self.trim.shrink();
         self.shared.shrink();
+    }
+
+    /// Rebuilds the edge table of a face at rest from its triangles, in
+    /// index order, so an edge's triangles come lowest first where the table
+    /// kept up lists them as attached (that order picks which side's (u,v)
+    /// places a split's point). Keeping them lowest first throughout cost the
+    /// corpus survey four more folded triangles; attach order as before did not.
+    pub fn wake(&mut self) {
+        if !self.resting {
+            return;
+        }
+        self.resting = false;
+        let n = (3 * self.tris.len() + self.rim.0.len()) / 2;
+        self.rim = EdgeList::default();
+        self.edges = PairMap::with_capacity(n, [NONE, NONE]);
+        for t in 0..self.tris.len() {
+            let v = self.tris[t];
+            for k in 0..3 {
+                self.attach(v[k], v[(k + 1) % 3], t as u32);
+            }
+        }
     }
 
     /// A slot in the measure cache per triangle.
@@ -229,6 +362,17 @@ impl WorkMesh {
         self.measures.resize(self.tris.len(), STALE);
     }
 
+    /// Vertex `v`'s surface normal, of unit length again after the rounding to `f32`.
+    pub fn normal_at(&self, v: usize) -> DVec3 {
+        let n = self.normal[v].as_dvec3();
+        let l = n.length();
+        if l > 0.0 {
+            n / l
+        } else {
+            n
+        }
+    }
+
     /// Adds a vertex with its surface normal.
     pub fn add_vertex(&mut self, p: DVec3, n: DVec3) -> u32 {
         self.push_vertex(p, n)
@@ -236,6 +380,7 @@ impl WorkMesh {
 
     /// Adds a triangle (counter-clockwise in (u,v)).
     pub fn add_triangle(&mut self, v: [u32; 3], uv: [DVec2; 3]) {
+        self.wake();
         let t = self.tris.len() as u32;
         self.room(0, 1);
         self.tris.push(v);
@@ -251,13 +396,32 @@ impl WorkMesh {
         self.trim.insert(key(a, b), TrimEdge { curve, t_lo, t_hi });
     }
 
-    /// How many triangles use edge `a-b`.
+    /// How many triangles use edge `a-b` (at most two; at rest an inner
+    /// edge is counted by a walk over the triangles).
     #[cfg(feature = "std")]
     pub fn edge_triangles(&self, a: u32, b: u32) -> usize {
+        if self.resting {
+            if self.rim.contains_key(&key(a, b)) {
+                return 1;
+            }
+            return self.tris.iter().filter(|t| t.contains(&a) && t.contains(&b) && a != b).take(2).count();
+        }
         self.edges.get(&key(a, b)).map_or(0, |e| e.iter().filter(|&&t| t != NONE).count())
     }
 
+    /// Whether edge `a-b` is a border edge (one triangle), at rest as awake.
+    #[cfg(feature = "std")]
+    pub fn is_border(&self, a: u32, b: u32) -> bool {
+        if self.resting {
+            return self.rim.contains_key(&key(a, b));
+        }
+        self.edges.get(&key(a, b)).is_some_and(|e| e[0] != NONE && e[1] == NONE)
+    }
+
     fn attach(&mut self, a: u32, b: u32, t: u32) {
+        if self.resting {
+            return;
+        }
         let e = self.edges.get_or_insert(key(a, b), [NONE, NONE]);
         if e[0] == NONE {
             e[0] = t;
@@ -267,6 +431,9 @@ impl WorkMesh {
     }
 
     fn detach(&mut self, a: u32, b: u32, t: u32) {
+        if self.resting {
+            return;
+        }
         if let Some(e) = self.edges.get_mut(&key(a, b)) {
             if e[0] == t {
                 e[0] = e[1];
@@ -285,7 +452,7 @@ impl WorkMesh {
         let p = [self.pos[v[0] as usize], self.pos[v[1] as usize], self.pos[v[2] as usize]];
         let uv = self.uv(t);
         let m = measure_triangle(surface, &p, &uv, c.steps, &measure_projection());
-        let mut n = [self.normal[v[0] as usize], self.normal[v[1] as usize], self.normal[v[2] as usize]];
+        let mut n = v.map(|x| self.normal_at(x as usize));
         let turn_of =
             |n: &[DVec3; 3]| angle_between(n[0], n[1]).max(angle_between(n[1], n[2])).max(angle_between(n[2], n[0]));
         let mut turn = turn_of(&n);
@@ -394,8 +561,7 @@ impl WorkMesh {
             let uv = c.point(ta + (tb - ta) * frac).truncate();
             return Some((uv, surface.point(uv)));
         }
-        let adj = self.edges.get(&key(a, b))?;
-        let t = adj[0];
+        let t = self.first_on(a, b)?;
         let tv = self.tris.get(t as usize)?;
         let i = (0..3).find(|&k| key(tv[k], tv[(k + 1) % 3]) == key(a, b))?;
         let tuv = self.uv(t as usize);
@@ -404,8 +570,24 @@ impl WorkMesh {
         Some((uv, surface.point(uv)))
     }
 
+    /// The lowest-numbered triangle on edge `a-b` (at rest, of an inner
+    /// edge, by a walk over the triangles).
+    fn first_on(&self, a: u32, b: u32) -> Option<u32> {
+        if !self.resting {
+            return self.edges.get(&key(a, b)).map(|e| e[0]);
+        }
+        if let Some(&t) = self.rim.get(&key(a, b)) {
+            return Some(t);
+        }
+        let on = |t: &[u32; 3]| a != b && t.contains(&a) && t.contains(&b);
+        self.tris.iter().position(on).map(|t| t as u32)
+    }
+
     /// Edges used by exactly one triangle.
     pub fn boundary_edges(&self) -> Vec<(u32, u32)> {
+        if self.resting {
+            return self.rim.keys().collect();
+        }
         let mut out: Vec<(u32, u32)> = self.edges.iter().filter(|(_, t)| t[1] == NONE).map(|(k, _)| k).collect();
         out.sort_unstable();
         out
@@ -425,7 +607,15 @@ impl WorkMesh {
         target: Option<DVec3>,
         out: &mut Vec<u32>,
     ) -> Option<u32> {
-        let adj = *self.edges.get(&key(a, b))?;
+        // At rest a border edge is split with the rim alone; any other wakes the face.
+        let on_rim = if self.resting { self.rim.get(&key(a, b)).copied() } else { None };
+        if on_rim.is_none() {
+            self.wake();
+        }
+        let adj = match on_rim {
+            Some(t) => [t, NONE],
+            None => *self.edges.get(&key(a, b))?,
+        };
         let trim = self.trim.get(&key(a, b)).copied();
         let mut trim_at = None;
         if let Some(te) = trim {
@@ -542,6 +732,16 @@ impl WorkMesh {
             self.attach(m, x1, t2);
             self.attach(x1, x2, t2);
             self.attach(x2, m, t2);
+            if self.resting {
+                // A border edge's one triangle: its two halves are border
+                // edges, and its side x1-x2 moved to the new triangle.
+                self.rim.remove(&key(a, b));
+                self.rim.insert(key(x0, m), t);
+                self.rim.insert(key(m, x1), t2);
+                if let Some(r) = self.rim.get_mut(&key(x1, x2)).filter(|r| **r == t) {
+                    *r = t2;
+                }
+            }
             out.push(t);
             out.push(t2);
         }
@@ -578,6 +778,7 @@ impl WorkMesh {
         budget: usize,
         mut todo: Vec<u32>,
     ) -> bool {
+        self.wake();
         let mut budget_hit = false;
         todo.reverse();
         let mut stack = todo;
@@ -619,12 +820,13 @@ impl WorkMesh {
     /// must already hold a slot per triangle).
     fn cached_measure(&mut self, surface: &dyn Surface, t: usize, c: &Criteria) -> (TriMeasure, f64) {
         let x = self.measures[t];
-        if !x.0.max.is_nan() {
-            return x;
+        if !x.max.is_nan() {
+            return x.unpack();
         }
-        let x = self.measure(surface, t, c);
+        let (m, turn) = self.measure(surface, t, c);
+        let x = Packed::pack(m, turn);
         self.measures[t] = x;
-        x
+        x.unpack()
     }
 
     /// Drops the cached measures of triangles `ts` (they changed).
@@ -706,6 +908,72 @@ mod tests {
             assert_eq!(m.tris.len(), 1);
             assert_eq!(bits(m.uv(0)), bits(c));
         }
+    }
+
+    /// A 4×4 grid of squares on the plane, two triangles each.
+    fn grid() -> WorkMesh {
+        let mut m = WorkMesh::default();
+        for j in 0..5 {
+            for i in 0..5 {
+                m.add_vertex(DVec3::new(i as f64, j as f64, 0.0), DVec3::Z);
+            }
+        }
+        let v = |i: u32, j: u32| 5 * j + i;
+        let w = |i: u32, j: u32| at(f64::from(i), f64::from(j));
+        for j in 0..4 {
+            for i in 0..4 {
+                m.add_triangle([v(i, j), v(i + 1, j), v(i + 1, j + 1)], [w(i, j), w(i + 1, j), w(i + 1, j + 1)]);
+                m.add_triangle([v(i, j), v(i + 1, j + 1), v(i, j + 1)], [w(i, j), w(i + 1, j + 1), w(i, j + 1)]);
+            }
+        }
+        m
+    }
+
+    /// Each edge with its triangles (lowest first).
+    fn edge_table(m: &WorkMesh) -> Vec<((u32, u32), [u32; 2])> {
+        let mut e: Vec<_> = m.edges.iter().map(|(k, t)| (k, [t[0].min(t[1]), t[0].max(t[1])])).collect();
+        e.sort_unstable();
+        e
+    }
+
+    /// A face at rest splits border edges (a neighbour's shared split) by
+    /// its border list alone; woken, it has the triangles, border and edges
+    /// of the same face split awake, and refines to the same mesh.
+    #[test]
+    fn a_face_split_at_rest_wakes_as_if_it_never_slept() {
+        let s = plane();
+        let (mut awake, mut rested) = (grid(), grid());
+        rested.rest();
+        assert!(rested.edges.iter().next().is_none());
+        assert_eq!(rested.boundary_edges(), awake.boundary_edges());
+        let mut out = Vec::new();
+        for (a, b, frac) in [(0, 1, 0.5), (4, 9, 0.25), (25, 1, 0.5), (24, 23, 0.7)] {
+            let x = awake.split_edge_at(&s, &[], a, b, frac, None, &mut out);
+            let y = rested.split_edge_at(&s, &[], a, b, frac, None, &mut out);
+            assert_eq!(x, y, "edge {a}-{b}");
+            assert_eq!(rested.boundary_edges(), awake.boundary_edges());
+        }
+        assert!(rested.resting, "border splits leave the face at rest");
+        assert_eq!(rested.tris, awake.tris);
+        rested.wake();
+        assert_eq!(edge_table(&rested), edge_table(&awake));
+        let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 0.3, min_edge: 0.0, steps: 2 };
+        awake.refine(&s, &[], &c, 100_000);
+        rested.refine(&s, &[], &c, 100_000);
+        assert!(awake.tris.len() > 400);
+        assert_eq!(rested.tris, awake.tris);
+    }
+
+    /// A cached measure reads back no smaller than measured (rounded up to
+    /// `f32`), and within an `f32` step of it.
+    #[test]
+    fn packed_measures_never_understate() {
+        for x in [0.0, 1e-300, 0.1, 1.0 / 3.0, 0.249_999_999_9, 7e12, -1e-300, -0.1] {
+            let (m, turn) = Packed::pack(TriMeasure { max: x, sum: x }, x).unpack();
+            assert!(m.max >= x && turn >= x, "{x}");
+            assert!(m.max - x <= x.abs() * 1.2e-7 + 2e-45, "{x}");
+        }
+        assert!(STALE.max.is_nan());
     }
 
     /// Through the splits of refinement every corner's (u,v) stays the

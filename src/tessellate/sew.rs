@@ -16,7 +16,7 @@ use crate::collections::HashMap;
 use alloc::vec::Vec;
 use glam::DVec3;
 
-use super::refine::{Criteria, WorkMesh};
+use super::refine::{Criteria, EdgeList, WorkMesh};
 use crate::nurbs::{NurbsCurve, Surface};
 use crate::Error;
 
@@ -114,6 +114,11 @@ fn border_uses(faces: &[FaceWork<'_>]) -> Uses {
                 uses.entry(node_key(ga, gb)).or_default().push((fi as u32, a, b));
             }
         }
+    }
+    // Most edges have two uses: lists of exactly their size are held
+    // through refinement, not room for four.
+    for list in uses.values_mut() {
+        list.shrink_to_fit();
     }
     uses
 }
@@ -273,10 +278,14 @@ pub(crate) fn refine_all(
 ) -> Result<bool, Error> {
     close_t_junctions(faces, sew);
     let mut uses = border_uses(faces);
+    let mut shared: Vec<Vec<((u32, u32), ())>> = alloc::vec![Vec::new(); faces.len()];
     for list in uses.values().filter(|l| l.len() > 1) {
         for &(fi, a, b) in list {
-            faces[fi as usize].mesh.shared.insert((a.min(b), a.max(b)), ());
+            shared[fi as usize].push(((a.min(b), a.max(b)), ()));
         }
+    }
+    for (f, s) in faces.iter_mut().zip(shared) {
+        f.mesh.shared = EdgeList::from_unsorted(s);
     }
     let mut total: usize = faces.iter().map(|f| f.mesh.tris.len()).sum();
     let mut pending: Vec<Vec<u32>> = faces.iter().map(|f| (0..f.mesh.tris.len() as u32).collect()).collect();
@@ -293,7 +302,7 @@ pub(crate) fn refine_all(
         let before = f.mesh.tris.len();
         let room = budget.saturating_sub(total - before);
         budget_hit |= f.mesh.refine_from(f.surface, &f.curves, &f.crit, room, todo);
-        f.mesh.shrink();
+        f.mesh.rest();
         total = total - before + f.mesh.tris.len();
         let events = core::mem::take(&mut f.mesh.events);
         for (a, b, m) in events {
@@ -336,6 +345,8 @@ pub(crate) fn refine_all(
                     queue.push_back(j);
                 }
             }
+            lo_side.shrink_to_fit();
+            hi_side.shrink_to_fit();
             uses.insert(node_key(ga, g), lo_side);
             uses.insert(node_key(g, gb), hi_side);
         }

@@ -27,6 +27,7 @@ impl WorkMesh {
         if todo.is_empty() {
             return (changed, todo);
         }
+        self.wake();
         for _ in 0..8 {
             let mut next = Vec::new();
             let mut flipped = false;
@@ -181,10 +182,10 @@ impl WorkMesh {
         let area = |w: [DVec2; 3]| (w[1] - w[0]).perp_dot(w[2] - w[0]);
         let signs: Vec<f64> = ring.iter().map(|&t| area(self.uv(t as usize))).collect();
         let sense = signs.iter().sum::<f64>();
-        let (old_p, old_n) = (self.pos[x as usize], self.normal[x as usize]);
+        let (old_p, old_n) = (self.pos[x as usize], self.normal_at(x as usize));
         let set = |m: &mut Self, q: DVec2, p: DVec3, nn: DVec3| {
             m.pos[x as usize] = p;
-            m.normal[x as usize] = nn;
+            m.normal[x as usize] = nn.as_vec3();
             m.move_uv(x, &ring, q);
         };
         set(self, new_uv, surface.point(new_uv), surface.normal(new_uv));
@@ -246,6 +247,7 @@ impl WorkMesh {
     /// leaves the mesh as it was. Returns whether it closed it.
     #[cfg(feature = "std")]
     pub fn close_beside(&mut self, surface: &dyn Surface, c: &Criteria, a: u32, b: u32, p: DVec3, gid: u32) -> bool {
+        self.wake();
         let Some(t) = self.edges.get(&key(a, b)).filter(|e| e[1] == NONE).map(|e| e[0] as usize) else {
             return false;
         };
@@ -288,6 +290,7 @@ impl WorkMesh {
     /// Takes back the last triangle added.
     #[cfg(feature = "std")]
     fn pop_triangle(&mut self) {
+        self.wake();
         let Some(&v) = self.tris.last() else { return };
         let t = (self.tris.len() - 1) as u32;
         for k in 0..3 {
@@ -315,6 +318,7 @@ impl WorkMesh {
     /// surface's way and pass the limits; otherwise the mesh stays as it was.
     #[cfg(feature = "std")]
     pub fn split_border_at(&mut self, surface: &dyn Surface, c: &Criteria, a: u32, b: u32, p: DVec3, gid: u32) -> bool {
+        self.wake();
         let Some(t) = self.edges.get(&key(a, b)).filter(|e| e[1] == NONE).map(|e| e[0] as usize) else {
             return false;
         };
@@ -376,6 +380,7 @@ impl WorkMesh {
         if t >= self.tris.len() {
             return;
         }
+        self.wake();
         let last = self.tris.len() - 1;
         for k in 0..3 {
             self.detach(self.tris[t][k], self.tris[t][(k + 1) % 3], t as u32);
