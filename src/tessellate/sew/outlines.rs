@@ -314,8 +314,6 @@ fn insertions(
     // What only the gap estimates needed goes before the additions are
     // made: this was the peak of the whole mesh phase on large assemblies.
     drop((nearest_face, pair_sew));
-    cands.retain(|c| c.1 >= 0.0);
-    cands.shrink_to_fit();
     let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
     let mut adds: Additions =
         pos.iter().map(|f| f.iter().map(|p| alloc::vec![Vec::new(); p.len()]).collect()).collect();
