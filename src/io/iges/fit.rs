@@ -271,9 +271,7 @@ impl Track {
         let [lo, hi] = surface.domain();
         (hermite_curve(&ts, &ws, &ms, lo, hi), met)
     }
-}
 
-impl Track {
     /// On a plane, a model-space curve's native coordinates are the curve
     /// under the plane's affine inverse: the same knots and weights with
     /// mapped control points, exact, where a fitted cubic needs dozens of

@@ -86,14 +86,14 @@ fn positions(faces: &[Option<(&dyn Surface, &mut Outline<'_>)>]) -> PerNode<DVec
         .collect()
 }
 
-/// Each node's reach: `sew`, at most 0.3 of its shortest loop segment.
-/// Segments along a pole, and those shorter than a thousandth of `tight`
-/// (a trim edge far below any weld: its ends are one point), do not count.
 /// One `fill` per node of `pos`.
 fn per_node<T: Clone>(pos: &PerNode<DVec3>, fill: T) -> PerNode<T> {
     pos.iter().map(|f| f.iter().map(|p| alloc::vec![fill.clone(); p.len()]).collect()).collect()
 }
 
+/// Each node's reach: `sew`, at most 0.3 of its shortest loop segment.
+/// Segments along a pole, and those shorter than a thousandth of `tight`
+/// (a trim edge far below any weld: its ends are one point), do not count.
 fn radii(pos: &PerNode<DVec3>, sew: f64, tight: f64) -> PerNode<f64> {
     radii_each(pos, &|_| sew, tight)
 }
@@ -315,8 +315,7 @@ fn insertions(
     // made: this was the peak of the whole mesh phase on large assemblies.
     drop((nearest_face, pair_sew));
     let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
-    let mut adds: Additions =
-        pos.iter().map(|f| f.iter().map(|p| alloc::vec![Vec::new(); p.len()]).collect()).collect();
+    let mut adds: Additions = per_node(pos, Vec::new());
     cands.sort_by(|x, y| x.3.total_cmp(&y.3));
     for &(seg, s, t, d, q) in &cands {
         let (fi, k, i) = (seg.0 as usize, seg.1 as usize, seg.2 as usize);
@@ -503,8 +502,8 @@ fn name_nodes(
 ) -> u32 {
     let pos = positions(faces);
     // Reach after insertion: a new node has its twin's, an old one keeps its own.
-    let mut radius: PerNode<f64> = pos.iter().map(|f| f.iter().map(|p| alloc::vec![0.0; p.len()]).collect()).collect();
-    let mut index: PerNode<u32> = pos.iter().map(|f| f.iter().map(|p| alloc::vec![0; p.len()]).collect()).collect();
+    let mut radius: PerNode<f64> = per_node(&pos, 0.0);
+    let mut index: PerNode<u32> = per_node(&pos, 0);
     let mut flat: Vec<(u32, DVec3)> = Vec::new();
     for (fi, item) in faces.iter().enumerate() {
         let Some((_, o)) = item else { continue };
