@@ -3,7 +3,7 @@
 use alloc::vec::Vec;
 use glam::DVec3;
 
-use super::{weld::weld_positions_compact, Mesh};
+use super::{weld::weld_positions, Mesh};
 
 /// Edge census after welding coincident vertices.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -32,7 +32,7 @@ pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
 /// crack only next to another border of its own body, so parts of an
 /// assembly that touch are counted each on its own.
 pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol: f64) -> EdgeCounts {
-    let (mut map, mut nverts) = weld_positions_compact(&mesh.positions, weld_tol);
+    let (mut map, mut nverts) = weld_positions(&mesh.positions, weld_tol);
     let face_of = face_lookup(mesh);
     let body_of_face = |f: u32| crate::model::body_of(bodies, f as usize);
     if !bodies.is_empty() {

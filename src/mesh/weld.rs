@@ -4,34 +4,13 @@ use alloc::vec::Vec;
 use glam::DVec3;
 
 /// Maps each position to a representative index so that positions closer than
-/// `tol` share one (spatial hashing, cells of size `tol`). Returns `(map, count)`.
+/// `tol` share one: the first earlier representative found in the 27 cubes of
+/// size `tol` about it (x outer, z inner). Returns `(map, count)`. The
+/// positions grouped by a hash of their cube (each group in index order) and
+/// a table from hash to where its group starts stand in for a hash grid of
+/// cells, which took about 60 bytes a vertex and set the peak of a model's
+/// edge census.
 pub fn weld_positions(positions: &[DVec3], tol: f64) -> (Vec<u32>, usize) {
-    let tol = if tol > 0.0 && tol.is_finite() { tol } else { 1e-12 };
-    let mut cells = crate::collections::CellGrid::new(1.0 / tol);
-    let mut map = Vec::with_capacity(positions.len());
-    let mut reps: Vec<DVec3> = Vec::new();
-    for &p in positions {
-        let found = cells.near(p).copied().find(|&r| reps[r as usize].distance_squared(p) <= tol * tol);
-        let id = match found {
-            Some(r) => r,
-            None => {
-                let r = reps.len() as u32;
-                reps.push(p);
-                cells.insert(p, r);
-                r
-            }
-        };
-        map.push(id);
-    }
-    (map, reps.len())
-}
-
-/// As [`weld_positions`] (the same map), in about a third of the memory:
-/// the positions grouped by a hash of their cube (each group in index
-/// order) and a table from hash to where its group starts stand in for the
-/// hash grid, which took about 60 bytes a vertex and set the peak of a
-/// model's edge census.
-pub(crate) fn weld_positions_compact(positions: &[DVec3], tol: f64) -> (Vec<u32>, usize) {
     let tol = if tol > 0.0 && tol.is_finite() { tol } else { 1e-12 };
     let inv = 1.0 / tol;
     let cube = |p: DVec3| {
@@ -119,11 +98,34 @@ pub fn weld_mesh(mesh: &super::Mesh, tol: f64) -> super::Mesh {
 mod tests {
     use super::*;
 
-    /// The compact weld gives the hash grid's map, representatives and all,
+    /// The weld by a hash grid of cells (what [`weld_positions`] replaced),
+    /// as the oracle: the same map, representatives and all.
+    fn grid_weld(positions: &[DVec3], tol: f64) -> (Vec<u32>, usize) {
+        let tol = if tol > 0.0 && tol.is_finite() { tol } else { 1e-12 };
+        let mut cells = crate::collections::CellGrid::new(1.0 / tol);
+        let mut map = Vec::with_capacity(positions.len());
+        let mut reps: Vec<DVec3> = Vec::new();
+        for &p in positions {
+            let found = cells.near(p).copied().find(|&r| reps[r as usize].distance_squared(p) <= tol * tol);
+            let id = match found {
+                Some(r) => r,
+                None => {
+                    let r = reps.len() as u32;
+                    reps.push(p);
+                    cells.insert(p, r);
+                    r
+                }
+            };
+            map.push(id);
+        }
+        (map, reps.len())
+    }
+
+    /// The weld gives the hash grid's map, representatives and all,
     /// on clusters that chain (a, b within the tolerance, b, c within it, a,
     /// c not), points on cube corners, and repeats.
     #[test]
-    fn compact_weld_matches_the_grid() {
+    fn weld_matches_the_hash_grid() {
         let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
         let mut next = move || {
             x ^= x << 13;
@@ -143,9 +145,9 @@ mod tests {
         pts.push(DVec3::new(1.0, 1.0, 1.0));
         pts.push(DVec3::new(1.0 - 1e-9, 1.0, 1.0));
         for tol in [0.01, 0.005, 1e-12] {
-            let (a, n) = weld_positions(&pts, tol);
+            let (a, n) = grid_weld(&pts, tol);
             assert!(n < pts.len() || tol < 1e-9);
-            assert_eq!(weld_positions_compact(&pts, tol), (a, n), "tol {tol}");
+            assert_eq!(weld_positions(&pts, tol), (a, n), "tol {tol}");
         }
     }
 }
