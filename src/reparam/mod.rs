@@ -309,15 +309,31 @@ fn sample_count(surface: &FaceSurface, along_u: bool, eps: f64) -> usize {
     (libm::ceil(n) as usize).clamp(3, MAX_SAMPLES)
 }
 
+/// How [`even_params`] joins the spacing of its five iso-lines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Spacing {
+    /// Their normalized arc lengths averaged (paper 001).
+    Mean,
+    /// The geometric mean of their parameter speeds (normalized): where one
+    /// line's stretch is ten times shorter than the others' (a hull's
+    /// stern, where the keel's bend closes up), the mean leaves that line's
+    /// steps seven times uneven and its cubic slows to a near cusp; the
+    /// geometric mean splits the unevenness, about √10 each way.
+    Geometric,
+}
+
 /// `n + 1` parameters along u (or v) spaced as evenly as possible in model
-/// space (paper 001 step 3): the normalized arc length of five iso-lines,
-/// averaged, inverted at `i / n`.
-fn even_params(surface: &FaceSurface, along_u: bool, n: usize) -> (Vec<f64>, Option<ArcTable>) {
+/// space (paper 001 step 3) over five iso-lines joined by `spacing`,
+/// inverted at `i / n`.
+fn even_params(surface: &FaceSurface, along_u: bool, n: usize, spacing: Spacing) -> (Vec<f64>, Option<ArcTable>) {
     let [lo, hi] = surface.domain();
     let (a0, a1) = if along_u { (lo.x, hi.x) } else { (lo.y, hi.y) };
     let dense = (16 * n).max(400);
     let xs: Vec<f64> = (0..=dense).map(|k| a0 + (a1 - a0) * k as f64 / dense as f64).collect();
     let mut avg = vec![0.0; dense + 1];
+    // Per dense interval, the sum over the lines of the log of its share of
+    // the line's length (relative to an even share).
+    let mut log_speed = vec![0.0; dense];
     let mut used = 0usize;
     for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
         let pts: Vec<DVec3> = xs
@@ -335,16 +351,34 @@ fn even_params(surface: &FaceSurface, along_u: bool, n: usize) -> (Vec<f64>, Opt
         if !(total > 0.0 && total.is_finite()) {
             continue;
         }
-        for (a, t) in avg.iter_mut().zip(chord_params(&lengths)) {
-            *a += t;
+        match spacing {
+            Spacing::Mean => {
+                for (a, t) in avg.iter_mut().zip(chord_params(&lengths)) {
+                    *a += t;
+                }
+            }
+            Spacing::Geometric => {
+                let even = total / dense as f64;
+                for (d, l) in log_speed.iter_mut().zip(&lengths) {
+                    *d += libm::log((l / even).max(SPEED_FLOOR));
+                }
+            }
         }
         used += 1;
     }
     if used == 0 {
         return ((0..=n).map(|i| a0 + (a1 - a0) * i as f64 / n as f64).collect(), None);
     }
-    for a in &mut avg {
-        *a /= used as f64;
+    match spacing {
+        Spacing::Mean => {
+            for a in &mut avg {
+                *a /= used as f64;
+            }
+        }
+        Spacing::Geometric => {
+            let speed: Vec<f64> = log_speed.iter().map(|d| libm::exp(d / used as f64)).collect();
+            avg = chord_params(&speed);
+        }
     }
     let mut out: Vec<f64> = (0..=n).map(|i| Map1::lerp(&avg, &xs, i as f64 / n as f64)).collect();
     let table = Some(ArcTable { params: xs, arc: avg });
@@ -364,54 +398,116 @@ fn even_params(surface: &FaceSurface, along_u: bool, n: usize) -> (Vec<f64>, Opt
     (out, table)
 }
 
+/// Normal turn (radians) between the rebuilt surface and the original at
+/// one checked point above which the rebuild folds: a cubic through few
+/// samples across a bend far tighter than their spacing (a hull's keel
+/// closing up at the stern) can loop back within the distance check, and
+/// the mesher then splits the loop's flipped triangles down to a tenth of
+/// the tolerance (180 of them on one hull face).
+const FOLD: f64 = 0.5;
+
+/// Smallest share of an even step one dense interval of a line counts as
+/// under [`Spacing::Geometric`] (a line that stops, at a pole or a
+/// collapsed stretch, would otherwise zero the mean).
+const SPEED_FLOOR: f64 = 1e-3;
+
+/// Most times a fit within the goal that folds is sampled 1.5× denser in
+/// both directions to unfold it (5× at most: the hull's keel took 4×), and
+/// the most samples it may grow to: a fold that more samples do not undo
+/// (one found where the original itself turns sharply) costs little.
+const UNFOLD_STEPS: usize = 4;
+const UNFOLD_SAMPLES: usize = 4096;
+
 /// The rebuilt surface with its parameter maps and the largest distance
 /// found from it to the original, split by direction (`[along u, along v]`).
 struct Fit {
     surface: crate::nurbs::NurbsSurface,
     map_u: Map1,
     map_v: Map1,
+    /// The arc-length tables the samples were spaced by, per direction.
+    arc_u: Option<ArcTable>,
+    arc_v: Option<ArcTable>,
     errors: [f64; 2],
+}
+
+impl Fit {
+    /// Checked point `key` in new parameters, by key `3 × node + direction`
+    /// (0: u-edge mid-points, 1: v-edge ones, 2: cell centres).
+    fn check_point(&self, key: usize) -> Option<DVec2> {
+        let (nu, nv) = (self.map_u.new.len(), self.map_v.new.len());
+        let (node, dir) = (key / 3, key % 3);
+        if node >= nu * nv {
+            return None;
+        }
+        let (i, j) = (node / nv, node % nv);
+        let (si, tj) = (*self.map_u.new.get(i)?, *self.map_v.new.get(j)?);
+        let s_mid = self.map_u.new.get(i + 1).map(|&b| 0.5 * (si + b));
+        let t_mid = self.map_v.new.get(j + 1).map(|&b| 0.5 * (tj + b));
+        let (s, t) = [(s_mid, Some(tj)), (Some(si), t_mid), (s_mid, t_mid)][dir];
+        Some(DVec2::new(s?, t?))
+    }
+
+    /// The number of keys [`Fit::check_point`] takes.
+    fn check_keys(&self) -> usize {
+        3 * self.map_u.new.len() * self.map_v.new.len()
+    }
+
+    /// The original's parameters mapped from new ones `st` (where a
+    /// projection onto the original starts).
+    fn old_uv(&self, st: DVec2) -> DVec2 {
+        let old_of = |map: &Map1, arc: &Option<ArcTable>, x: f64| match arc {
+            Some(a) => map.to_old_along(a, x),
+            None => map.to_old(x),
+        };
+        DVec2::new(old_of(&self.map_u, &self.arc_u, st.x), old_of(&self.map_v, &self.arc_v, st.y))
+    }
+
+    /// Whether the new surface's normal turns more than [`FOLD`] from the
+    /// original's at an edge mid-point (a cell centre folds with its edges).
+    /// A start whose normal is off is checked again at the projection, since
+    /// across a tight bend the mapped start can lie past it.
+    fn folds(&self, old: &FaceSurface) -> bool {
+        let opts = ProjectionOptions { max_iterations: 12, ..ProjectionOptions::default() };
+        (0..self.check_keys()).filter(|k| k % 3 < 2).filter_map(|k| self.check_point(k)).any(|st| {
+            let start = self.old_uv(st);
+            let n = self.surface.normal(st);
+            if crate::math::angle_between(n, old.normal(start)) <= FOLD {
+                return false;
+            }
+            let at = project_to_surface(old, self.surface.point(st), Some(start), &opts).uv;
+            crate::math::angle_between(n, old.normal(at)) > FOLD
+        })
+    }
 }
 
 /// Samples, interpolates (paper 001 steps 3–4) and checks one rebuild at
 /// `n × m` intervals: the new surface at mid-points of grid edges and cells
 /// is projected onto the original from the mapped parameters.
-fn fit_once(surface: &FaceSurface, n: usize, m: usize) -> Result<Fit, String> {
-    let (us, arc_u) = even_params(surface, true, n);
-    let (vs, arc_v) = even_params(surface, false, m);
+fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Result<Fit, String> {
+    let (us, arc_u) = even_params(surface, true, n, spacing);
+    let (vs, arc_v) = even_params(surface, false, m, spacing);
     let grid: Vec<Vec<DVec3>> =
         us.iter().map(|&u| vs.iter().map(|&v| surface.point(DVec2::new(u, v))).collect()).collect();
     let cols: Vec<Vec<DVec3>> = (0..vs.len()).map(|j| grid.iter().map(|r| r[j]).collect()).collect();
     let s = interp::averaged_params(cols.iter().map(Vec::as_slice), us.len());
     let t = interp::averaged_params(grid.iter().map(Vec::as_slice), vs.len());
     let new = interpolate_surface(&grid, &s, &t).map_err(|e| format!("{e}"))?;
-    let map_u = Map1 { old: us, new: s };
-    let map_v = Map1 { old: vs, new: t };
+    let mut fit = Fit {
+        surface: new,
+        map_u: Map1 { old: us, new: s },
+        map_v: Map1 { old: vs, new: t },
+        arc_u,
+        arc_v,
+        errors: [0.0; 2],
+    };
     let opts = ProjectionOptions { max_iterations: 12, ..ProjectionOptions::default() };
-    let old_of = |map: &Map1, arc: &Option<ArcTable>, x: f64| match arc {
-        Some(a) => map.to_old_along(a, x),
-        None => map.to_old(x),
-    };
-    // The points checked, per direction (0: u-edge mid-points, 1: v-edge
-    // ones, 2: cell centres), by key `3 × node + direction`.
-    let (nu, nv) = (map_u.new.len(), map_v.new.len());
-    let at = |key: usize| -> Option<DVec2> {
-        let (node, dir) = (key / 3, key % 3);
-        let (i, j) = (node / nv, node % nv);
-        let (si, tj) = (*map_u.new.get(i)?, *map_v.new.get(j)?);
-        let s_mid = map_u.new.get(i + 1).map(|&b| 0.5 * (si + b));
-        let t_mid = map_v.new.get(j + 1).map(|&b| 0.5 * (tj + b));
-        let (s, t) = [(s_mid, Some(tj)), (Some(si), t_mid), (s_mid, t_mid)][dir];
-        Some(DVec2::new(s?, t?))
-    };
     // The new surface's point there, and where its projection starts on the original.
-    let point_and_start =
-        |st: DVec2| (new.point(st), DVec2::new(old_of(&map_u, &arc_u, st.x), old_of(&map_v, &arc_v, st.y)));
+    let point_and_start = |st: DVec2| (fit.surface.point(st), fit.old_uv(st));
     // Each point with its distance to the original's point at the start
     // (kept small: a 400 × 400 rebuild checks half a million points).
-    let mut checks: Vec<(f64, u32)> = Vec::with_capacity(3 * nu * nv);
-    for key in 0..3 * nu * nv {
-        if let Some(st) = at(key) {
+    let mut checks: Vec<(f64, u32)> = Vec::with_capacity(fit.check_keys());
+    for key in 0..fit.check_keys() {
+        if let Some(st) = fit.check_point(key) {
             let (p, start) = point_and_start(st);
             checks.push((p.distance(surface.point(start)), key as u32));
         }
@@ -425,7 +521,7 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize) -> Result<Fit, String> {
     let mut worst = [0.0f64; 3];
     for &(near, key) in &checks {
         let dir = key as usize % 3;
-        let Some(st) = at(key as usize).filter(|_| near > worst[dir]) else { continue };
+        let Some(st) = fit.check_point(key as usize).filter(|_| near > worst[dir]) else { continue };
         let (p, start) = point_and_start(st);
         worst[dir] = worst[dir].max(project_to_surface(surface, p, Some(start), &opts).distance.min(near));
     }
@@ -439,29 +535,40 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize) -> Result<Fit, String> {
     if !(errors[0].is_finite() && errors[1].is_finite()) {
         return Err("the rebuilt surface is not finite".into());
     }
-    Ok(Fit { surface: new, map_u, map_v, errors })
+    fit.errors = errors;
+    Ok(fit)
 }
 
-/// Rebuilds `face` (paper 001 steps 2–5) so that the new face lies within
-/// `tol · FIT_SHARE` of the original (at worst `tol · FIT_LIMIT`, when more
-/// samples stop helping): sample counts from the chord bound, grown in the
-/// direction whose check fails, up to 400 per direction.
-///
-/// # Errors
-/// A reason (for the report's warning) when the interpolation is singular,
-/// the check cannot be met within the sample limits, or a trim curve cannot be
-/// re-expressed; the caller then meshes the original face.
-pub fn rebuild_face(face: &Face, tol: f64) -> Result<Rebuilt, String> {
+/// Paper 001 steps 3–4 with `spacing`, sampled until the fit is within
+/// `tol · FIT_SHARE` of `surface` (see [`rebuild_face`]).
+fn fit_within(surface: &FaceSurface, tol: f64, spacing: Spacing) -> Result<Fit, String> {
     let goal = FIT_SHARE * tol;
     let limit = FIT_LIMIT * tol;
-    let mut n = sample_count(&face.surface, true, tol);
-    let mut m = sample_count(&face.surface, false, tol);
+    let mut n = sample_count(surface, true, tol);
+    let mut m = sample_count(surface, false, tol);
     let mut best: Option<Fit> = None;
+    // The first fit within the goal that folds, kept while more samples try
+    // to unfold it; if they cannot, it is used (the mesh trial judges it).
+    let mut folded: Option<Fit> = None;
+    let mut unfold_steps = 0;
     let fit = loop {
-        let fit = fit_once(&face.surface, n, m)?;
+        let fit = fit_once(surface, n, m, spacing)?;
         let [eu, ev] = fit.errors;
         if eu <= goal && ev <= goal {
-            break fit;
+            if !fit.folds(surface) {
+                break fit;
+            }
+            let first = folded.take().unwrap_or(fit);
+            if unfold_steps >= UNFOLD_STEPS || n.saturating_mul(m) >= UNFOLD_SAMPLES || spacing == Spacing::Geometric {
+                break first;
+            }
+            folded = Some(first);
+            // A fold found on edges of one direction may come of too few
+            // samples in either: both grow.
+            unfold_steps += 1;
+            n = (n + n.div_ceil(2)).min(MAX_SAMPLES);
+            m = (m + m.div_ceil(2)).min(MAX_SAMPLES);
+            continue;
         }
         // At the sample limit (a feature far smaller than the samples, such as
         // the sharp bend an abrupt change of knot spacing leaves, makes the
@@ -472,8 +579,9 @@ pub fn rebuild_face(face: &Face, tol: f64) -> Result<Rebuilt, String> {
             best = Some(fit);
         }
         if (eu > goal && n >= MAX_SAMPLES) || (ev > goal && m >= MAX_SAMPLES) {
-            match best {
-                Some(b) if b.errors[0].max(b.errors[1]) <= limit => break b,
+            match (folded, best) {
+                (Some(f), _) => break f,
+                (None, Some(b)) if b.errors[0].max(b.errors[1]) <= limit => break b,
                 _ => {
                     return Err(format!(
                         "the rebuilt surface stays {err:.3e} from the original at {n} × {m} samples (limit {limit:.3e})"
@@ -493,6 +601,32 @@ pub fn rebuild_face(face: &Face, tol: f64) -> Result<Rebuilt, String> {
             m = grow(m, ev);
         }
     };
+    Ok(fit)
+}
+
+/// Rebuilds `face` (paper 001 steps 2–5) so that the new face lies within
+/// `tol · FIT_SHARE` of the original (at worst `tol · FIT_LIMIT`, when more
+/// samples stop helping): sample counts from the chord bound, grown in the
+/// direction whose check fails, up to 400 per direction.
+///
+/// # Errors
+/// A reason (for the report's warning) when the interpolation is singular,
+/// the check cannot be met within the sample limits, or a trim curve cannot be
+/// re-expressed; the caller then meshes the original face.
+pub fn rebuild_face(face: &Face, tol: f64) -> Result<Rebuilt, String> {
+    let limit = FIT_LIMIT * tol;
+    let mut fit = fit_within(&face.surface, tol, Spacing::Mean)?;
+    // Beyond the paper: a rebuild that is itself poorly parameterized (one
+    // iso-line's samples bunched where the others' are not) tries the
+    // geometric spacing, and the evener of the two is kept.
+    let ratio = step_ratio(&fit.surface);
+    if ratio > RATIO_LIMIT {
+        if let Ok(g) = fit_within(&face.surface, tol, Spacing::Geometric) {
+            if step_ratio(&g.surface) < ratio {
+                fit = g;
+            }
+        }
+    }
     let (n, m) = (fit.map_u.new.len() - 1, fit.map_v.new.len() - 1);
     let mut fit_error = fit.errors[0].max(fit.errors[1]);
     let new_surface = FaceSurface::Rebuilt(fit.surface.clone());

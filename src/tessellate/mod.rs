@@ -163,7 +163,8 @@ pub fn mesh_model_with_progress(
                     made.extend(outline_of(&mut free).map(|o| (f, l, o)));
                     if rebuild_loses(&free, &orig).is_none() {
                         (why, face_lim, face_crit) = (None, l, c);
-                    } else if start.0.is_err() {
+                    } else if tris_of(&free) < tris_of(&start.0) {
+                        // Shorter edges start from the lighter of the two meshes.
                         start = (free, l, c);
                     }
                 }
@@ -467,6 +468,11 @@ fn face_loops<'x>(
 /// The unsewn outline a trial mesh made, taken out of it.
 fn outline_of<'x>(r: &mut Result<face::FaceResult<'x>, Error>) -> Option<face::Outline<'x>> {
     r.as_mut().ok().and_then(|r| r.outline.take())
+}
+
+/// The triangles of a trial mesh (`usize::MAX` when it failed).
+fn tris_of(r: &Result<face::FaceResult<'_>, Error>) -> usize {
+    r.as_ref().map_or(usize::MAX, |r| r.mesh.tris.len())
 }
 
 /// Most meshes [`shorter_edges`] tries.

@@ -6,9 +6,9 @@ use glam::DVec3;
 
 use crate::shapes::{unit_circle, CIRCLE_KNOTS};
 use surfmesh::{
-    measure_mesh, mesh_model, read_iges, read_json, reparameterize_model, step_ratio, write_iges, Face, FaceSurface,
-    MeasureOptions, MeshOptions, MeshResult, Model, NurbsCurve, NurbsSurface, Reparam, Surface, Tolerance, TrimLoop,
-    FIT_LIMIT, RATIO_LIMIT,
+    measure_mesh, mesh_model, read_iges, read_json, read_model, reparameterize_model, step_ratio, write_iges, Face,
+    FaceSurface, Format, MeasureOptions, MeshOptions, MeshResult, Model, NurbsCurve, NurbsSurface, Reparam, Surface,
+    Tolerance, TrimLoop, FIT_LIMIT, RATIO_LIMIT,
 };
 
 /// A wavy sheet whose u parameter crowds: the first 80% of the u range (8 of
@@ -311,7 +311,7 @@ fn reparam_command_writes_iges() {
 fn corpus(name: &str) -> Option<Model> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus").join(name);
     let bytes = std::fs::read(path).ok()?;
-    Some(read_iges(&bytes).unwrap())
+    Some(read_model(&bytes, Format::detect(&bytes).unwrap()).unwrap())
 }
 
 /// Face `index` of `m` as a model of its own, checked to be one the ratio test flags.
@@ -339,14 +339,25 @@ fn reparam_flagged_corpus_faces_win() {
     rows.extend((0..8).map(|f| ("asmo_car.igs", f, 1e-2)));
     // Face 0 at 1e-3: the rebuild takes fewer triangles, but few long ones on a thin face.
     rows.extend([0, 1, 3, 4, 5, 6, 7].map(|f| ("asmo_car.igs", f, 1e-3)));
+    // A hull whose keel closes up at the stern: its rebuild folded at 1e-2
+    // and slowed to a near cusp at 1e-3 (see `fit_within` and `Spacing`).
+    rows.extend([("ship_kcs.igs", 17, 1e-2), ("ship_kcs.igs", 17, 1e-3)]);
+    // STEP faces: a fuselage skin, a rod's end, two of a part's blends.
+    for rel in [1e-2, 1e-3] {
+        rows.extend([("bug28366_fuselage.stp", 4, rel), ("linkrods.step", 26, rel)]);
+    }
+    rows.extend([("trj6_pm4-ec-203.stp", 801, 1e-2), ("trj6_pm4-ec-203.stp", 653, 1e-3)]);
     let mut tols = std::collections::HashMap::new();
+    let mut models = std::collections::HashMap::new();
     for (file, index, rel) in rows {
-        let Some(m) = corpus(file) else {
+        let Some(m) = models.entry(file).or_insert_with(|| corpus(file)).as_ref() else {
             println!("{file}: corpus not found, skipped");
             continue;
         };
-        let tol = *tols.entry((file, rel.to_bits())).or_insert_with(|| mesh(&m, rel, Reparam::Off).report.tolerance);
-        let one = flagged_face(&m, file, index);
+        let tol = *tols
+            .entry((file, rel.to_bits()))
+            .or_insert_with(|| reparameterize_model(m, Reparam::Off, Tolerance::Relative(rel)).unwrap().tolerance);
+        let one = flagged_face(m, file, index);
         let run = |mode| mesh_model(&one, &MeshOptions::default().with_tolerance(tol).with_reparam(mode)).unwrap();
         let (off, auto) = (run(Reparam::Off), run(Reparam::Auto));
         let (o, a) = (&off.report, &auto.report);
@@ -409,15 +420,18 @@ fn reparam_auto_sews_rebuilt_faces_to_their_neighbours() {
     }
 }
 
-/// The flagged corpus faces whose rebuild cannot win, each meshed on its
-/// own at its model's tolerance: `auto` falls back to the original with a
+/// Flagged corpus faces whose rebuild does not win, each meshed on its own
+/// at its model's tolerance: `auto` falls back to the original with a
 /// warning and meshes exactly what `off` does. asmo_car's face 2 at 1e-3
 /// is a thin quad that both mesh in 2 triangles on the same 4 corners, so
-/// the angles tie; ship_kcs's face 17 folds, and its rebuild's grid takes
-/// more triangles than the original's whole mesh.
+/// the angles tie; the other two rebuilds' grids (the sharpest curvature
+/// sets a rebuilt face's edge cap) take more triangles than the originals'
+/// whole meshes.
 #[test]
 fn reparam_losing_corpus_faces_mesh_as_off() {
-    for (file, index, rel) in [("asmo_car.igs", 2, 1e-3), ("ship_kcs.igs", 17, 1e-2), ("ship_kcs.igs", 17, 1e-3)] {
+    for (file, index, rel) in
+        [("asmo_car.igs", 2, 1e-3), ("trj6_pm4-ec-203.stp", 387, 1e-3), ("linkrods.step", 25, 1e-3)]
+    {
         let Some(m) = corpus(file) else {
             println!("{file}: corpus not found, skipped");
             continue;
