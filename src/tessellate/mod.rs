@@ -481,7 +481,7 @@ const SHORTER_TRIES: usize = 6;
 /// Beyond paper 001: a rebuilt face whose mesh `rebuilt` takes fewer
 /// triangles than the original's but loses on shape (a thin face meshed by
 /// few long triangles) may spend the difference on shorter edges. The edge
-/// limit starts at half the longest edge and falls by √2 a try (about twice
+/// limit starts at the longest edge over √2 and falls by √2 a try (about twice
 /// the triangles), until the mesh wins or takes more triangles than the
 /// original's; the limits of the winning mesh, if one does, and its unsewn outline.
 fn shorter_edges<'x>(
@@ -505,7 +505,7 @@ fn shorter_edges<'x>(
         .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
         .map(|(a, b)| pos(a).distance(pos(b)))
         .fold(0.0f64, f64::max);
-    let mut edge = 0.5 * longest;
+    let mut edge = core::f64::consts::FRAC_1_SQRT_2 * longest;
     for _ in 0..SHORTER_TRIES {
         if !(edge > crit.min_edge && edge.is_finite()) {
             return None;
