@@ -616,11 +616,12 @@ fn fit_within(surface: &FaceSurface, tol: f64, spacing: Spacing) -> Result<Fit, 
 pub fn rebuild_face(face: &Face, tol: f64) -> Result<Rebuilt, String> {
     let limit = FIT_LIMIT * tol;
     let mut fit = fit_within(&face.surface, tol, Spacing::Mean)?;
-    // Beyond the paper: a rebuild that is itself poorly parameterized (one
-    // iso-line's samples bunched where the others' are not) tries the
-    // geometric spacing, and the evener of the two is kept.
+    // Beyond the paper: a rebuild that is itself poorly parameterized, and
+    // worse than the original (one iso-line's samples bunched where the
+    // others' are not), tries the geometric spacing, and the evener of the
+    // two is kept.
     let ratio = step_ratio(&fit.surface);
-    if ratio > RATIO_LIMIT {
+    if ratio > RATIO_LIMIT && ratio > step_ratio(&face.surface) {
         if let Ok(g) = fit_within(&face.surface, tol, Spacing::Geometric) {
             if step_ratio(&g.surface) < ratio {
                 fit = g;

@@ -151,9 +151,9 @@ pub fn mesh_model_with_progress(
             if failed || auto {
                 let mut orig = orig.take().unwrap_or_else(mesh_original);
                 let mut why = rebuild_loses(&fr, &orig);
-                // The mesh shorter edges may start from: the capped one, or the free one where it failed.
                 made.extend(outline_of(&mut fr).map(|o| (f, face_lim, o)));
-                let mut start = (fr, face_lim, face_crit);
+                let capped = (fr, face_lim, face_crit);
+                let mut free_run = None;
                 if why.is_some() && auto && cap.is_finite() {
                     // The edge cap follows the sharpest bend; where that bend
                     // is local, the rebuild may pay without it.
@@ -163,17 +163,28 @@ pub fn mesh_model_with_progress(
                     made.extend(outline_of(&mut free).map(|o| (f, l, o)));
                     if rebuild_loses(&free, &orig).is_none() {
                         (why, face_lim, face_crit) = (None, l, c);
-                    } else if tris_of(&free) < tris_of(&start.0) {
-                        // Shorter edges start from the lighter of the two meshes.
-                        start = (free, l, c);
+                    } else {
+                        free_run = Some((free, l, c));
                     }
                 }
                 if why.is_some() && auto {
-                    let (r, l, c) = &start;
-                    if let Some((l, c, o)) = shorter_edges(index, (f, f_loops), r, &orig, (l, c), trial, auto_tight) {
-                        (why, face_lim, face_crit) = (None, l, c);
-                        if let Some(o) = o {
-                            made.push((f, l, o));
+                    // Shorter edges start from the capped mesh (the free one
+                    // where it failed) at half its longest edge, then from
+                    // the lighter of the two one step nearer its longest edge.
+                    let first = match (&capped.0, &free_run) {
+                        (Err(_), Some(free)) => free,
+                        _ => &capped,
+                    };
+                    let lighter = match &free_run {
+                        Some(free) if tris_of(&free.0) < tris_of(&capped.0) => free,
+                        _ => &capped,
+                    };
+                    for ((r, l, c), k) in [(first, 0.5), (lighter, core::f64::consts::FRAC_1_SQRT_2)] {
+                        let won = shorter_edges(index, (f, f_loops), r, &orig, (l, c, k), trial, auto_tight);
+                        if let Some((l, c, o)) = won {
+                            (why, face_lim, face_crit) = (None, l, c);
+                            made.extend(o.map(|o| (f, l, o)));
+                            break;
                         }
                     }
                 }
@@ -481,7 +492,7 @@ const SHORTER_TRIES: usize = 6;
 /// Beyond paper 001: a rebuilt face whose mesh `rebuilt` takes fewer
 /// triangles than the original's but loses on shape (a thin face meshed by
 /// few long triangles) may spend the difference on shorter edges. The edge
-/// limit starts at the longest edge over √2 and falls by √2 a try (about twice
+/// limit starts at `first` times the longest edge and falls by √2 a try (about twice
 /// the triangles), until the mesh wins or takes more triangles than the
 /// original's; the limits of the winning mesh, if one does, and its unsewn outline.
 fn shorter_edges<'x>(
@@ -489,7 +500,7 @@ fn shorter_edges<'x>(
     (face, loops): (&'x crate::Face, &'x [crate::TrimLoop]),
     rebuilt: &Result<face::FaceResult<'_>, Error>,
     original: &Result<face::FaceResult<'_>, Error>,
-    (lim, crit): (&params::Limits, &refine::Criteria),
+    (lim, crit, first): (&params::Limits, &refine::Criteria, f64),
     budget: usize,
     tight: f64,
 ) -> Option<(params::Limits, refine::Criteria, Option<face::Outline<'x>>)> {
@@ -505,7 +516,7 @@ fn shorter_edges<'x>(
         .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
         .map(|(a, b)| pos(a).distance(pos(b)))
         .fold(0.0f64, f64::max);
-    let mut edge = core::f64::consts::FRAC_1_SQRT_2 * longest;
+    let mut edge = first * longest;
     for _ in 0..SHORTER_TRIES {
         if !(edge > crit.min_edge && edge.is_finite()) {
             return None;
