@@ -171,6 +171,8 @@ pub fn mesh_model_with_progress(
                     // Shorter edges start from the capped mesh (the free one
                     // where it failed) at half its longest edge, then from
                     // the lighter of the two one step nearer its longest edge.
+                    // When that is the same mesh, all but its first try
+                    // repeat the tries that already failed.
                     let first = match (&capped.0, &free_run) {
                         (Err(_), Some(free)) => free,
                         _ => &capped,
@@ -179,8 +181,10 @@ pub fn mesh_model_with_progress(
                         Some(free) if tris_of(&free.0) < tris_of(&capped.0) => free,
                         _ => &capped,
                     };
-                    for ((r, l, c), k) in [(first, 0.5), (lighter, core::f64::consts::FRAC_1_SQRT_2)] {
-                        let won = shorter_edges(index, (f, f_loops), r, &orig, (l, c, k), trial, auto_tight);
+                    let again = if core::ptr::eq(first, lighter) { 1 } else { SHORTER_TRIES };
+                    let starts = [(first, 0.5, SHORTER_TRIES), (lighter, core::f64::consts::FRAC_1_SQRT_2, again)];
+                    for ((r, l, c), k, tries) in starts {
+                        let won = shorter_edges(index, (f, f_loops), r, &orig, (l, c, k, tries), trial, auto_tight);
                         if let Some((l, c, o)) = won {
                             (why, face_lim, face_crit) = (None, l, c);
                             made.extend(o.map(|o| (f, l, o)));
@@ -493,14 +497,15 @@ const SHORTER_TRIES: usize = 6;
 /// triangles than the original's but loses on shape (a thin face meshed by
 /// few long triangles) may spend the difference on shorter edges. The edge
 /// limit starts at `first` times the longest edge and falls by √2 a try (about twice
-/// the triangles), until the mesh wins or takes more triangles than the
-/// original's; the limits of the winning mesh, if one does, and its unsewn outline.
+/// the triangles), for at most `tries` tries, until the mesh wins or takes
+/// more triangles than the original's; the limits of the winning mesh, if
+/// one does, and its unsewn outline.
 fn shorter_edges<'x>(
     index: usize,
     (face, loops): (&'x crate::Face, &'x [crate::TrimLoop]),
     rebuilt: &Result<face::FaceResult<'_>, Error>,
     original: &Result<face::FaceResult<'_>, Error>,
-    (lim, crit, first): (&params::Limits, &refine::Criteria, f64),
+    (lim, crit, first, tries): (&params::Limits, &refine::Criteria, f64, usize),
     budget: usize,
     tight: f64,
 ) -> Option<(params::Limits, refine::Criteria, Option<face::Outline<'x>>)> {
@@ -517,7 +522,7 @@ fn shorter_edges<'x>(
         .map(|(a, b)| pos(a).distance(pos(b)))
         .fold(0.0f64, f64::max);
     let mut edge = first * longest;
-    for _ in 0..SHORTER_TRIES {
+    for _ in 0..tries {
         if !(edge > crit.min_edge && edge.is_finite()) {
             return None;
         }
