@@ -467,7 +467,7 @@ impl Fit {
     /// A start whose normal is off is checked again at the projection, since
     /// across a tight bend the mapped start can lie past it.
     fn folds(&self, old: &FaceSurface) -> bool {
-        let opts = ProjectionOptions { max_iterations: 12, ..ProjectionOptions::default() };
+        let opts = projection();
         (0..self.check_keys()).filter(|k| k % 3 < 2).filter_map(|k| self.check_point(k)).any(|st| {
             let start = self.old_uv(st);
             let n = self.surface.normal(st);
@@ -478,6 +478,13 @@ impl Fit {
             crate::math::angle_between(n, old.normal(at)) > FOLD
         })
     }
+}
+
+/// How points are projected between a rebuild and its original (the fit
+/// check, the fold check, the trim curves): started close, so 12 Newton
+/// steps are plenty.
+fn projection() -> ProjectionOptions {
+    ProjectionOptions { max_iterations: 12, ..ProjectionOptions::default() }
 }
 
 /// Samples, interpolates (paper 001 steps 3–4) and checks one rebuild at
@@ -500,7 +507,7 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Resu
         arc_v,
         errors: [0.0; 2],
     };
-    let opts = ProjectionOptions { max_iterations: 12, ..ProjectionOptions::default() };
+    let opts = projection();
     // The new surface's point there, and where its projection starts on the original.
     let point_and_start = |st: DVec2| (fit.surface.point(st), fit.old_uv(st));
     // Each point with its distance to the original's point at the start
@@ -559,6 +566,8 @@ fn fit_within(surface: &FaceSurface, tol: f64, spacing: Spacing) -> Result<Fit, 
                 break fit;
             }
             let first = folded.take().unwrap_or(fit);
+            // The geometric spacing is a second try after the mean's: its
+            // folds are left to the mesh trial, not sampled away.
             if unfold_steps >= UNFOLD_STEPS || n.saturating_mul(m) >= UNFOLD_SAMPLES || spacing == Spacing::Geometric {
                 break first;
             }
@@ -747,7 +756,7 @@ fn rebuild_loop(
     goal: f64,
 ) -> Result<(Vec<NurbsCurve>, f64), String> {
     let map = |uv: DVec2| DVec2::new(fit.map_u.to_new(uv.x), fit.map_v.to_new(uv.y));
-    let opts = ProjectionOptions { max_iterations: 12, ..ProjectionOptions::default() };
+    let opts = projection();
     let cell = DVec2::new(1.0 / (fit.map_u.new.len().max(2) - 1) as f64, 1.0 / (fit.map_v.new.len().max(2) - 1) as f64);
     let [lo, hi] = old.domain();
     let edge = |x: f64, a: f64, b: f64| (x - a).abs() <= 1e-9 * (b - a) || (b - x).abs() <= 1e-9 * (b - a);

@@ -396,6 +396,23 @@ fn iso_curves<'s>(
     (0..=lines).map(|k| s0 + (s1 - s0) * k as f64 / lines as f64).map(|s| (s, make(s))).collect()
 }
 
+/// `f` of the probes one direction is tested on (see [`grid_params`]): the
+/// iso-curves at every quarter of the rectangle, or every eighth on a
+/// trimmed face, each limited to where it runs inside `region`.
+fn with_probes<R>(
+    surface: &dyn Surface,
+    lo: DVec2,
+    hi: DVec2,
+    along_u: bool,
+    region: Option<Region<'_>>,
+    f: impl FnOnce(&[Probe<'_>]) -> R,
+) -> R {
+    let curves = iso_curves(surface, lo, hi, along_u, if region.is_some() { 8 } else { 4 });
+    let probes: Vec<Probe<'_>> =
+        curves.iter().map(|(s, c)| Probe { eval: c, inside: region.map(|r| r(along_u, *s)) }).collect();
+    f(&probes)
+}
+
 /// For a surface with even parameters (see [`equidistribute`]), the fine
 /// chord demand along one direction that [`grid_params`] starts from: its
 /// sum is about the lines that direction takes, known before any is placed.
@@ -412,10 +429,7 @@ pub(crate) fn even_demand(
     if !(surface.even_parameters() && t1 > t0) {
         return None;
     }
-    let curves = iso_curves(surface, lo, hi, along_u, if region.is_some() { 8 } else { 4 });
-    let probes: Vec<Probe<'_>> =
-        curves.iter().map(|(s, c)| Probe { eval: c, inside: region.map(|r| r(along_u, *s)) }).collect();
-    Some(fine_demand(&probes, &fine_params(t0, t1), lim))
+    Some(with_probes(surface, lo, hi, along_u, region, |probes| fine_demand(probes, &fine_params(t0, t1), lim)))
 }
 
 /// Initial intervals along one direction: the knot breaks inside `[lo, hi]`,
@@ -478,14 +492,13 @@ pub(crate) fn grid_params(
 ) -> (Vec<f64>, f64) {
     let cap = cap.min(MAX_PARAMS);
     let (t0, t1) = if along_u { (lo.x, hi.x) } else { (lo.y, hi.y) };
-    let curves = iso_curves(surface, lo, hi, along_u, if region.is_some() { 8 } else { 4 });
-    let probes: Vec<Probe<'_>> =
-        curves.iter().map(|(s, c)| Probe { eval: c, inside: region.map(|r| r(along_u, *s)) }).collect();
-    if surface.even_parameters() && t1 > t0 {
-        return equidistribute(&probes, t0, t1, lim, cap, demand);
-    }
-    let breaks = initial_breaks(&surface.breaks(along_u), t0, t1, 16);
-    subdivide_probes(&probes, &breaks, lim, cap)
+    with_probes(surface, lo, hi, along_u, region, |probes| {
+        if surface.even_parameters() && t1 > t0 {
+            return equidistribute(probes, t0, t1, lim, cap, demand);
+        }
+        let breaks = initial_breaks(&surface.breaks(along_u), t0, t1, 16);
+        subdivide_probes(probes, &breaks, lim, cap)
+    })
 }
 
 #[cfg(test)]
