@@ -1,0 +1,429 @@
+//! The rebuilt surface itself (paper 001 steps 2–4): sample counts, samples
+//! spaced evenly in model space, the bicubic interpolation, and its check
+//! against the original (distance, folds), grown until it holds.
+
+use alloc::format;
+use alloc::string::String;
+use alloc::vec;
+use alloc::vec::Vec;
+use glam::{DVec2, DVec3};
+
+use super::interp::{self, chord_params, interpolate_surface};
+use super::{FIT_LIMIT, FIT_SHARE, MAX_SAMPLES};
+use crate::model::FaceSurface;
+use crate::nurbs::{project_to_surface, ProjectionOptions, Surface};
+
+/// Piecewise-linear monotone map between the original parameters of the
+/// grid nodes and the new ones (`s_i ↔ u_i`), both ascending.
+pub(super) struct Map1 {
+    pub(super) old: Vec<f64>,
+    pub(super) new: Vec<f64>,
+}
+
+impl Map1 {
+    pub(super) fn lerp(from: &[f64], to: &[f64], x: f64) -> f64 {
+        let n = from.len();
+        if n == 0 {
+            return x;
+        }
+        if x <= from[0] {
+            return to[0];
+        }
+        if x >= from[n - 1] {
+            return to[n - 1];
+        }
+        let i = from.partition_point(|&f| f <= x).clamp(1, n - 1);
+        let (a, b) = (from[i - 1], from[i]);
+        let w = if b > a { (x - a) / (b - a) } else { 0.0 };
+        to[i - 1] + (to[i] - to[i - 1]) * w
+    }
+    pub(super) fn to_new(&self, x: f64) -> f64 {
+        Self::lerp(&self.old, &self.new, x)
+    }
+    fn to_old(&self, x: f64) -> f64 {
+        Self::lerp(&self.new, &self.old, x)
+    }
+    /// As [`Map1::to_old`] at the nodes, and between two nodes at the old
+    /// parameter that splits their arc length (by `arc`) in the ratio `x`
+    /// splits their new parameters: where the old parameters crowd within
+    /// one interval, the straight map lands far from the point the new
+    /// surface passes, and a projection started there needs many steps.
+    fn to_old_along(&self, arc: &ArcTable, x: f64) -> f64 {
+        let n = self.new.len();
+        if n < 2 || x <= self.new[0] || x >= self.new[n - 1] {
+            return self.to_old(x);
+        }
+        let i = self.new.partition_point(|&f| f <= x).clamp(1, n - 1);
+        let (a, b) = (self.new[i - 1], self.new[i]);
+        let (u0, u1) = (self.old[i - 1], self.old[i]);
+        let w = if b > a { (x - a) / (b - a) } else { 0.0 };
+        let (l0, l1) = (Self::lerp(&arc.params, &arc.arc, u0), Self::lerp(&arc.params, &arc.arc, u1));
+        if l1 > l0 {
+            Self::lerp(&arc.arc, &arc.params, l0 + (l1 - l0) * w).clamp(u0.min(u1), u0.max(u1))
+        } else {
+            u0 + (u1 - u0) * w
+        }
+    }
+}
+
+/// Normalized arc length (mean over the iso-lines [`even_params`] measures)
+/// at dense, ascending old parameters.
+struct ArcTable {
+    params: Vec<f64>,
+    arc: Vec<f64>,
+}
+
+/// Samples along u (`along_u`) or v: paper 001 step 2's chord count
+/// `n = (b − a)·sqrt(sup‖S''‖ / 8ε)` taken in the arc-length parameter the
+/// samples are spaced in (so `b − a` is the iso-line's length and `‖S''‖` its
+/// curvature), averaged over five iso-lines; `(control points − degree)·3`
+/// for a B-spline of degree ≤ 2 in that direction.
+fn sample_count(surface: &FaceSurface, along_u: bool, eps: f64) -> usize {
+    if let FaceSurface::Nurbs(n) = surface {
+        let (deg, count) = if along_u { (n.degree()[0], n.counts()[0]) } else { (n.degree()[1], n.counts()[1]) };
+        if deg <= 2 {
+            return ((count - deg) * 3).clamp(3, MAX_SAMPLES);
+        }
+    }
+    let [lo, hi] = surface.domain();
+    let (mut sum, mut used) = (0.0, 0usize);
+    for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
+        let mut length = 0.0;
+        let mut kappa = 0.0f64;
+        let mut prev: Option<DVec3> = None;
+        for k in 0..=100 {
+            let a = k as f64 / 100.0;
+            let uv = if along_u {
+                DVec2::new(lo.x + (hi.x - lo.x) * a, lo.y + (hi.y - lo.y) * f)
+            } else {
+                DVec2::new(lo.x + (hi.x - lo.x) * f, lo.y + (hi.y - lo.y) * a)
+            };
+            let d = surface.derivs(uv);
+            let (d1, d2) = if along_u { (d.su, d.suu) } else { (d.sv, d.svv) };
+            let speed = d1.length();
+            if speed > 1e-12 {
+                let k = d1.cross(d2).length() / (speed * speed * speed);
+                if k.is_finite() {
+                    kappa = kappa.max(k);
+                }
+            }
+            if let Some(q) = prev {
+                length += d.point.distance(q);
+            }
+            prev = Some(d.point);
+        }
+        if length > 0.0 && length.is_finite() {
+            sum += length * libm::sqrt(kappa / (8.0 * eps));
+            used += 1;
+        }
+    }
+    let n = if used > 0 { sum / used as f64 } else { 3.0 };
+    if !n.is_finite() {
+        return MAX_SAMPLES;
+    }
+    (libm::ceil(n) as usize).clamp(3, MAX_SAMPLES)
+}
+
+/// How [`even_params`] joins the spacing of its five iso-lines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Spacing {
+    /// Their normalized arc lengths averaged (paper 001).
+    Mean,
+    /// The geometric mean of their parameter speeds (normalized): where one
+    /// line's stretch is ten times shorter than the others' (a hull's
+    /// stern, where the keel's bend closes up), the mean leaves that line's
+    /// steps seven times uneven and its cubic slows to a near cusp; the
+    /// geometric mean splits the unevenness, about √10 each way.
+    Geometric,
+}
+
+/// `n + 1` parameters along u (or v) spaced as evenly as possible in model
+/// space (paper 001 step 3) over five iso-lines joined by `spacing`,
+/// inverted at `i / n`.
+fn even_params(surface: &FaceSurface, along_u: bool, n: usize, spacing: Spacing) -> (Vec<f64>, Option<ArcTable>) {
+    let [lo, hi] = surface.domain();
+    let (a0, a1) = if along_u { (lo.x, hi.x) } else { (lo.y, hi.y) };
+    let dense = (16 * n).max(400);
+    let xs: Vec<f64> = (0..=dense).map(|k| a0 + (a1 - a0) * k as f64 / dense as f64).collect();
+    let mut avg = vec![0.0; dense + 1];
+    // Per dense interval, the sum over the lines of the log of its share of
+    // the line's length (relative to an even share).
+    let mut log_speed = vec![0.0; dense];
+    let mut used = 0usize;
+    for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
+        let pts: Vec<DVec3> = xs
+            .iter()
+            .map(|&x| {
+                surface.point(if along_u {
+                    DVec2::new(x, lo.y + (hi.y - lo.y) * f)
+                } else {
+                    DVec2::new(lo.x + (hi.x - lo.x) * f, x)
+                })
+            })
+            .collect();
+        let lengths: Vec<f64> = pts.windows(2).map(|w| w[0].distance(w[1])).collect();
+        let total: f64 = lengths.iter().sum();
+        if !(total > 0.0 && total.is_finite()) {
+            continue;
+        }
+        match spacing {
+            Spacing::Mean => {
+                for (a, t) in avg.iter_mut().zip(chord_params(&lengths)) {
+                    *a += t;
+                }
+            }
+            Spacing::Geometric => {
+                let even = total / dense as f64;
+                for (d, l) in log_speed.iter_mut().zip(&lengths) {
+                    *d += libm::log((l / even).max(SPEED_FLOOR));
+                }
+            }
+        }
+        used += 1;
+    }
+    if used == 0 {
+        return ((0..=n).map(|i| a0 + (a1 - a0) * i as f64 / n as f64).collect(), None);
+    }
+    match spacing {
+        Spacing::Mean => {
+            for a in &mut avg {
+                *a /= used as f64;
+            }
+        }
+        Spacing::Geometric => {
+            let speed: Vec<f64> = log_speed.iter().map(|d| libm::exp(d / used as f64)).collect();
+            avg = chord_params(&speed);
+        }
+    }
+    let mut out: Vec<f64> = (0..=n).map(|i| Map1::lerp(&avg, &xs, i as f64 / n as f64)).collect();
+    let table = Some(ArcTable { params: xs, arc: avg });
+    out[0] = a0;
+    out[n] = a1;
+    // Strictly increasing even where the surface has no length.
+    let min_gap = (a1 - a0) * 1e-9;
+    for i in 1..=n {
+        if out[i] <= out[i - 1] + min_gap {
+            out[i] = out[i - 1] + min_gap;
+        }
+    }
+    if out[n] > a1 {
+        // Squeezed by the nudges: fall back to equal steps.
+        return ((0..=n).map(|i| a0 + (a1 - a0) * i as f64 / n as f64).collect(), table);
+    }
+    (out, table)
+}
+
+/// Normal turn (radians) between the rebuilt surface and the original at
+/// one checked point above which the rebuild folds: a cubic through few
+/// samples across a bend far tighter than their spacing (a hull's keel
+/// closing up at the stern) can loop back within the distance check, and
+/// the mesher then splits the loop's flipped triangles down to a tenth of
+/// the tolerance (180 of them on one hull face).
+const FOLD: f64 = 0.5;
+
+/// Smallest share of an even step one dense interval of a line counts as
+/// under [`Spacing::Geometric`] (a line that stops, at a pole or a
+/// collapsed stretch, would otherwise zero the mean).
+const SPEED_FLOOR: f64 = 1e-3;
+
+/// Most times a fit within the goal that folds is sampled 1.5× denser in
+/// both directions to unfold it (5× at most: the hull's keel took 4×), and
+/// the most samples it may grow to: a fold that more samples do not undo
+/// (one found where the original itself turns sharply) costs little.
+const UNFOLD_STEPS: usize = 4;
+const UNFOLD_SAMPLES: usize = 4096;
+
+/// The rebuilt surface with its parameter maps and the largest distance
+/// found from it to the original, split by direction (`[along u, along v]`).
+pub(super) struct Fit {
+    pub(super) surface: crate::nurbs::NurbsSurface,
+    pub(super) map_u: Map1,
+    pub(super) map_v: Map1,
+    /// The arc-length tables the samples were spaced by, per direction.
+    arc_u: Option<ArcTable>,
+    arc_v: Option<ArcTable>,
+    pub(super) errors: [f64; 2],
+}
+
+impl Fit {
+    /// Checked point `key` in new parameters, by key `3 × node + direction`
+    /// (0: u-edge mid-points, 1: v-edge ones, 2: cell centres).
+    fn check_point(&self, key: usize) -> Option<DVec2> {
+        let (nu, nv) = (self.map_u.new.len(), self.map_v.new.len());
+        let (node, dir) = (key / 3, key % 3);
+        if node >= nu * nv {
+            return None;
+        }
+        let (i, j) = (node / nv, node % nv);
+        let (si, tj) = (*self.map_u.new.get(i)?, *self.map_v.new.get(j)?);
+        let s_mid = self.map_u.new.get(i + 1).map(|&b| 0.5 * (si + b));
+        let t_mid = self.map_v.new.get(j + 1).map(|&b| 0.5 * (tj + b));
+        let (s, t) = [(s_mid, Some(tj)), (Some(si), t_mid), (s_mid, t_mid)][dir];
+        Some(DVec2::new(s?, t?))
+    }
+
+    /// The number of keys [`Fit::check_point`] takes.
+    fn check_keys(&self) -> usize {
+        3 * self.map_u.new.len() * self.map_v.new.len()
+    }
+
+    /// The original's parameters mapped from new ones `st` (where a
+    /// projection onto the original starts).
+    fn old_uv(&self, st: DVec2) -> DVec2 {
+        let old_of = |map: &Map1, arc: &Option<ArcTable>, x: f64| match arc {
+            Some(a) => map.to_old_along(a, x),
+            None => map.to_old(x),
+        };
+        DVec2::new(old_of(&self.map_u, &self.arc_u, st.x), old_of(&self.map_v, &self.arc_v, st.y))
+    }
+
+    /// Whether the new surface's normal turns more than [`FOLD`] from the
+    /// original's at an edge mid-point (a cell centre folds with its edges).
+    /// A start whose normal is off is checked again at the projection, since
+    /// across a tight bend the mapped start can lie past it.
+    fn folds(&self, old: &FaceSurface) -> bool {
+        let opts = projection();
+        (0..self.check_keys()).filter(|k| k % 3 < 2).filter_map(|k| self.check_point(k)).any(|st| {
+            let start = self.old_uv(st);
+            let n = self.surface.normal(st);
+            if crate::math::angle_between(n, old.normal(start)) <= FOLD {
+                return false;
+            }
+            let at = project_to_surface(old, self.surface.point(st), Some(start), &opts).uv;
+            crate::math::angle_between(n, old.normal(at)) > FOLD
+        })
+    }
+}
+
+/// How points are projected between a rebuild and its original (the fit
+/// check, the fold check, the trim curves): started close, so 12 Newton
+/// steps are plenty.
+pub(super) fn projection() -> ProjectionOptions {
+    ProjectionOptions { max_iterations: 12, ..ProjectionOptions::default() }
+}
+
+/// Samples, interpolates (paper 001 steps 3–4) and checks one rebuild at
+/// `n × m` intervals: the new surface at mid-points of grid edges and cells
+/// is projected onto the original from the mapped parameters.
+fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Result<Fit, String> {
+    let (us, arc_u) = even_params(surface, true, n, spacing);
+    let (vs, arc_v) = even_params(surface, false, m, spacing);
+    let grid: Vec<Vec<DVec3>> =
+        us.iter().map(|&u| vs.iter().map(|&v| surface.point(DVec2::new(u, v))).collect()).collect();
+    let cols: Vec<Vec<DVec3>> = (0..vs.len()).map(|j| grid.iter().map(|r| r[j]).collect()).collect();
+    let s = interp::averaged_params(cols.iter().map(Vec::as_slice), us.len());
+    let t = interp::averaged_params(grid.iter().map(Vec::as_slice), vs.len());
+    let new = interpolate_surface(&grid, &s, &t).map_err(|e| format!("{e}"))?;
+    let mut fit = Fit {
+        surface: new,
+        map_u: Map1 { old: us, new: s },
+        map_v: Map1 { old: vs, new: t },
+        arc_u,
+        arc_v,
+        errors: [0.0; 2],
+    };
+    let opts = projection();
+    // The new surface's point there, and where its projection starts on the original.
+    let point_and_start = |st: DVec2| (fit.surface.point(st), fit.old_uv(st));
+    // Each point with its distance to the original's point at the start
+    // (kept small: a 400 × 400 rebuild checks half a million points).
+    let mut checks: Vec<(f64, u32)> = Vec::with_capacity(fit.check_keys());
+    for key in 0..fit.check_keys() {
+        if let Some(st) = fit.check_point(key) {
+            let (p, start) = point_and_start(st);
+            checks.push((p.distance(surface.point(start)), key as u32));
+        }
+    }
+    // Both the projection and the start point are actual points of the
+    // original, so the smaller distance still bounds the true one (Newton
+    // can stall where the original's parameter speed jumps). A point whose
+    // start is no farther than the worst found so far cannot raise it, so
+    // the far starts go first and the rest are not projected.
+    checks.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let mut worst = [0.0f64; 3];
+    for &(near, key) in &checks {
+        let dir = key as usize % 3;
+        let Some(st) = fit.check_point(key as usize).filter(|_| near > worst[dir]) else { continue };
+        let (p, start) = point_and_start(st);
+        worst[dir] = worst[dir].max(project_to_surface(surface, p, Some(start), &opts).distance.min(near));
+    }
+    let (mut errors, centre) = ([worst[0], worst[1]], worst[2]);
+    // A cell centre off the original is charged to the direction whose edges are worse.
+    if errors[0] >= errors[1] {
+        errors[0] = errors[0].max(centre);
+    } else {
+        errors[1] = errors[1].max(centre);
+    }
+    if !(errors[0].is_finite() && errors[1].is_finite()) {
+        return Err("the rebuilt surface is not finite".into());
+    }
+    fit.errors = errors;
+    Ok(fit)
+}
+
+/// Paper 001 steps 3–4 with `spacing`, sampled until the fit is within
+/// `tol · FIT_SHARE` of `surface` (see [`super::rebuild_face`]).
+pub(super) fn fit_within(surface: &FaceSurface, tol: f64, spacing: Spacing) -> Result<Fit, String> {
+    let goal = FIT_SHARE * tol;
+    let limit = FIT_LIMIT * tol;
+    let mut n = sample_count(surface, true, tol);
+    let mut m = sample_count(surface, false, tol);
+    let mut best: Option<Fit> = None;
+    // The first fit within the goal that folds, kept while more samples try
+    // to unfold it; if they cannot, it is used (the mesh trial judges it).
+    let mut folded: Option<Fit> = None;
+    let mut unfold_steps = 0;
+    let fit = loop {
+        let fit = fit_once(surface, n, m, spacing)?;
+        let [eu, ev] = fit.errors;
+        if eu <= goal && ev <= goal {
+            if !fit.folds(surface) {
+                break fit;
+            }
+            let first = folded.take().unwrap_or(fit);
+            // The geometric spacing is a second try after the mean's: its
+            // folds are left to the mesh trial, not sampled away.
+            if unfold_steps >= UNFOLD_STEPS || n.saturating_mul(m) >= UNFOLD_SAMPLES || spacing == Spacing::Geometric {
+                break first;
+            }
+            folded = Some(first);
+            // A fold found on edges of one direction may come of too few
+            // samples in either: both grow.
+            unfold_steps += 1;
+            n = (n + n.div_ceil(2)).min(MAX_SAMPLES);
+            m = (m + m.div_ceil(2)).min(MAX_SAMPLES);
+            continue;
+        }
+        // At the sample limit (a feature far smaller than the samples, such as
+        // the sharp bend an abrupt change of knot spacing leaves, makes the
+        // error fall slowly and unevenly) keep the best fit if it is within
+        // the hard limit, the mesher getting what it leaves.
+        let err = eu.max(ev);
+        if best.as_ref().is_none_or(|b| err < b.errors[0].max(b.errors[1])) {
+            best = Some(fit);
+        }
+        if (eu > goal && n >= MAX_SAMPLES) || (ev > goal && m >= MAX_SAMPLES) {
+            match (folded, best) {
+                (Some(f), _) => break f,
+                (None, Some(b)) if b.errors[0].max(b.errors[1]) <= limit => break b,
+                _ => {
+                    return Err(format!(
+                        "the rebuilt surface stays {err:.3e} from the original at {n} × {m} samples (limit {limit:.3e})"
+                    ))
+                }
+            }
+        }
+        // Interpolation error falls as h⁴: grow by the fourth root of the excess, at least 1.25×.
+        let grow = |k: usize, e: f64| {
+            let f = libm::pow(e / goal, 0.25).clamp(1.25, 4.0);
+            (libm::ceil(k as f64 * f) as usize).min(MAX_SAMPLES)
+        };
+        if eu > goal {
+            n = grow(n, eu);
+        }
+        if ev > goal {
+            m = grow(m, ev);
+        }
+    };
+    Ok(fit)
+}
