@@ -11,7 +11,7 @@ use glam::{DVec2, DVec3};
 use super::interp::{self, chord_params, interpolate_surface};
 use super::{FIT_LIMIT, FIT_SHARE, MAX_SAMPLES};
 use crate::model::FaceSurface;
-use crate::nurbs::{project_to_surface, ProjectionOptions, Surface};
+use crate::nurbs::{project_to_surface, ProjectionOptions, Surface, SurfaceDerivs};
 
 /// Piecewise-linear monotone map between the original parameters of the
 /// grid nodes and the new ones (`s_i ↔ u_i`), both ascending.
@@ -73,6 +73,22 @@ struct ArcTable {
     arc: Vec<f64>,
 }
 
+/// The parameters at fraction `a` along the iso-line at fraction `f` across
+/// the domain `[lo, hi]`, running along u (`along_u`) or v.
+pub(super) fn iso_uv([lo, hi]: [DVec2; 2], along_u: bool, f: f64, a: f64) -> DVec2 {
+    let (x, y) = if along_u { (a, f) } else { (f, a) };
+    DVec2::new(lo.x + (hi.x - lo.x) * x, lo.y + (hi.y - lo.y) * y)
+}
+
+/// Curvature of the iso-line along u (`along_u`) or v at `d`; `None` where
+/// the line stops (a pole) or the value is not finite.
+pub(super) fn iso_curvature(d: &SurfaceDerivs, along_u: bool) -> Option<f64> {
+    let (d1, d2) = if along_u { (d.su, d.suu) } else { (d.sv, d.svv) };
+    let speed = d1.length();
+    let k = d1.cross(d2).length() / (speed * speed * speed);
+    (speed > 1e-12 && k.is_finite()).then_some(k)
+}
+
 /// Samples along u (`along_u`) or v: paper 001 step 2's chord count
 /// `n = (b − a)·sqrt(sup‖S''‖ / 8ε)` taken in the arc-length parameter the
 /// samples are spaced in (so `b − a` is the iso-line's length and `‖S''‖` its
@@ -85,27 +101,16 @@ fn sample_count(surface: &FaceSurface, along_u: bool, eps: f64) -> usize {
             return ((count - deg) * 3).clamp(3, MAX_SAMPLES);
         }
     }
-    let [lo, hi] = surface.domain();
+    let domain = surface.domain();
     let (mut sum, mut used) = (0.0, 0usize);
     for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
         let mut length = 0.0;
         let mut kappa = 0.0f64;
         let mut prev: Option<DVec3> = None;
         for k in 0..=100 {
-            let a = k as f64 / 100.0;
-            let uv = if along_u {
-                DVec2::new(lo.x + (hi.x - lo.x) * a, lo.y + (hi.y - lo.y) * f)
-            } else {
-                DVec2::new(lo.x + (hi.x - lo.x) * f, lo.y + (hi.y - lo.y) * a)
-            };
-            let d = surface.derivs(uv);
-            let (d1, d2) = if along_u { (d.su, d.suu) } else { (d.sv, d.svv) };
-            let speed = d1.length();
-            if speed > 1e-12 {
-                let k = d1.cross(d2).length() / (speed * speed * speed);
-                if k.is_finite() {
-                    kappa = kappa.max(k);
-                }
+            let d = surface.derivs(iso_uv(domain, along_u, f, k as f64 / 100.0));
+            if let Some(k) = iso_curvature(&d, along_u) {
+                kappa = kappa.max(k);
             }
             if let Some(q) = prev {
                 length += d.point.distance(q);

@@ -7,7 +7,7 @@
 mod fit;
 mod interp;
 
-use fit::{fit_within, projection, Fit, Map1, Spacing};
+use fit::{fit_within, iso_curvature, iso_uv, projection, Fit, Map1, Spacing};
 
 use alloc::format;
 use alloc::string::String;
@@ -250,25 +250,13 @@ pub fn rebuild_face(face: &Face, tol: f64) -> Result<Rebuilt, String> {
 /// surface, a chord of length `h` sags `κh²/8`, and the grid gives each
 /// direction about 0.4 of the tolerance, so `h = sqrt(3.2·tol/κ)`.
 fn edge_cap(surface: &FaceSurface, tol: f64) -> f64 {
-    let [lo, hi] = surface.domain();
+    let domain = surface.domain();
     let mut kappa = 0.0f64;
     for along_u in [true, false] {
         for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
             for k in 0..=64 {
-                let a = k as f64 / 64.0;
-                let uv = if along_u {
-                    DVec2::new(lo.x + (hi.x - lo.x) * a, lo.y + (hi.y - lo.y) * f)
-                } else {
-                    DVec2::new(lo.x + (hi.x - lo.x) * f, lo.y + (hi.y - lo.y) * a)
-                };
-                let d = surface.derivs(uv);
-                let (d1, d2) = if along_u { (d.su, d.suu) } else { (d.sv, d.svv) };
-                let speed = d1.length();
-                if speed > 1e-12 {
-                    let c = d1.cross(d2).length() / (speed * speed * speed);
-                    if c.is_finite() {
-                        kappa = kappa.max(c);
-                    }
+                if let Some(c) = iso_curvature(&surface.derivs(iso_uv(domain, along_u, f, k as f64 / 64.0)), along_u) {
+                    kappa = kappa.max(c);
                 }
             }
         }
