@@ -231,9 +231,9 @@ const FOLD: f64 = 0.5;
 /// collapsed stretch, would otherwise zero the mean).
 const SPEED_FLOOR: f64 = 1e-3;
 
-/// Most times a fit within the goal that folds is sampled 1.5× denser in
-/// both directions to unfold it (5× at most: the hull's keel took 4×), and
-/// the most samples it may grow to: a fold that more samples do not undo
+/// Most times a fit within the goal that folds is sampled 1.5× denser to
+/// unfold it, in the directions [`Fit::folds`] and the errors pick (5× at
+/// most: the hull's keel took 4×), and the most samples it may grow to: a fold that more samples do not undo
 /// (one found where the original itself turns sharply) costs little.
 const UNFOLD_STEPS: usize = 4;
 const UNFOLD_SAMPLES: usize = 4096;
@@ -282,21 +282,26 @@ impl Fit {
         DVec2::new(old_of(&self.map_u, &self.arc_u, st.x), old_of(&self.map_v, &self.arc_v, st.y))
     }
 
-    /// Whether the new surface's normal turns more than [`FOLD`] from the
-    /// original's at an edge mid-point (a cell centre folds with its edges).
-    /// A start whose normal is off is checked again at the projection, since
-    /// across a tight bend the mapped start can lie past it.
-    fn folds(&self, old: &FaceSurface) -> bool {
+    /// Per direction (`[along u, along v]`), whether the new surface's
+    /// normal turns more than [`FOLD`] from the original's at the mid-point
+    /// of an edge along it (a cell centre folds with its edges). A start
+    /// whose normal is off is checked again at the projection, since across
+    /// a tight bend the mapped start can lie past it.
+    fn folds(&self, old: &FaceSurface) -> [bool; 2] {
         let opts = projection();
-        (0..self.check_keys()).filter(|k| k % 3 < 2).filter_map(|k| self.check_point(k)).any(|st| {
+        let mut out = [false; 2];
+        for k in (0..self.check_keys()).filter(|k| k % 3 < 2) {
+            let dir = k % 3;
+            let Some(st) = self.check_point(k).filter(|_| !out[dir]) else { continue };
             let start = self.old_uv(st);
             let n = self.surface.normal(st);
             if crate::math::angle_between(n, old.normal(start)) <= FOLD {
-                return false;
+                continue;
             }
             let at = project_to_surface(old, self.surface.point(st), Some(start), &opts).uv;
-            crate::math::angle_between(n, old.normal(at)) > FOLD
-        })
+            out[dir] = crate::math::angle_between(n, old.normal(at)) > FOLD;
+        }
+        out
     }
 }
 
@@ -382,7 +387,8 @@ pub(super) fn fit_within(surface: &FaceSurface, tol: f64, spacing: Spacing) -> R
         let fit = fit_once(surface, n, m, spacing)?;
         let [eu, ev] = fit.errors;
         if eu <= goal && ev <= goal {
-            if !fit.folds(surface) {
+            let folds = fit.folds(surface);
+            if folds == [false; 2] {
                 break fit;
             }
             let first = folded.take().unwrap_or(fit);
@@ -391,12 +397,24 @@ pub(super) fn fit_within(surface: &FaceSurface, tol: f64, spacing: Spacing) -> R
             if unfold_steps >= UNFOLD_STEPS || n.saturating_mul(m) >= UNFOLD_SAMPLES || spacing == Spacing::Geometric {
                 break first;
             }
-            folded = Some(first);
             // A fold found on edges of one direction may come of too few
-            // samples in either: both grow.
+            // samples in either: the direction it is found along grows, and
+            // so does the other unless its fit is already far within the
+            // goal (a sixteenth: 1.5× the samples gain about 5×).
+            let grow = |k: usize, fold: bool, e: f64| {
+                if fold || e > goal / 16.0 {
+                    (k + k.div_ceil(2)).min(MAX_SAMPLES)
+                } else {
+                    k
+                }
+            };
+            let (n2, m2) = (grow(n, folds[0], eu), grow(m, folds[1], ev));
+            if (n2, m2) == (n, m) {
+                break first;
+            }
+            (n, m) = (n2, m2);
+            folded = Some(first);
             unfold_steps += 1;
-            n = (n + n.div_ceil(2)).min(MAX_SAMPLES);
-            m = (m + m.div_ceil(2)).min(MAX_SAMPLES);
             continue;
         }
         // At the sample limit (a feature far smaller than the samples, such as
