@@ -1,0 +1,134 @@
+//! Tests of the work mesh and its refinement.
+
+use super::*;
+
+/// The plane z = 0 over [-10, 10]², u = x and v = y.
+fn plane() -> crate::nurbs::NurbsSurface {
+    crate::nurbs::analytic::xy_plane(10.0)
+}
+
+fn at(x: f64, y: f64) -> DVec2 {
+    DVec2::new(x, y)
+}
+
+/// Corner (u,v)s are stored per vertex with a side table for triangles
+/// whose corners differ: each reads back exactly what was written, also
+/// a seam vertex's second (u,v), -0.0 against 0.0, and a triangle moved
+/// into a removed one's slot.
+#[test]
+fn corner_uvs_read_back_as_written() {
+    let mut m = WorkMesh::default();
+    for p in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (-1.0, 0.0)] {
+        m.add_vertex(DVec3::new(p.0, p.1, 0.0), DVec3::Z);
+    }
+    let a = [at(0.0, 0.0), at(1.0, 0.0), at(0.0, 1.0)];
+    let b = [at(-0.0, 0.0), at(0.0, 1.0), at(-1.0, 0.0)];
+    let c = [at(7.0, 0.0), at(0.0, 1.0), at(-1.0, 0.0)];
+    m.add_triangle([0, 1, 2], a);
+    m.add_triangle([0, 2, 3], b);
+    m.add_triangle([0, 2, 3], c);
+    let bits = |w: [DVec2; 3]| w.map(|q| (q.x.to_bits(), q.y.to_bits()));
+    assert_eq!(bits(m.uv(0)), bits(a));
+    assert_eq!(bits(m.uv(1)), bits(b));
+    assert_eq!(bits(m.uv(2)), bits(c));
+    m.set_uv(1, a.map(|q| q + at(0.0, 0.0)));
+    m.set_uv(1, b);
+    assert_eq!(bits(m.uv(1)), bits(b));
+    #[cfg(feature = "std")]
+    {
+        m.remove_triangle(0);
+        assert_eq!(bits(m.uv(0)), bits(c));
+        assert_eq!(bits(m.uv(1)), bits(b));
+        m.remove_triangle(1);
+        assert_eq!(m.tris.len(), 1);
+        assert_eq!(bits(m.uv(0)), bits(c));
+    }
+}
+
+/// A 4×4 grid of squares on the plane, two triangles each.
+fn grid() -> WorkMesh {
+    let mut m = WorkMesh::default();
+    for j in 0..5 {
+        for i in 0..5 {
+            m.add_vertex(DVec3::new(i as f64, j as f64, 0.0), DVec3::Z);
+        }
+    }
+    let v = |i: u32, j: u32| 5 * j + i;
+    let w = |i: u32, j: u32| at(f64::from(i), f64::from(j));
+    for j in 0..4 {
+        for i in 0..4 {
+            m.add_triangle([v(i, j), v(i + 1, j), v(i + 1, j + 1)], [w(i, j), w(i + 1, j), w(i + 1, j + 1)]);
+            m.add_triangle([v(i, j), v(i + 1, j + 1), v(i, j + 1)], [w(i, j), w(i + 1, j + 1), w(i, j + 1)]);
+        }
+    }
+    m
+}
+
+/// Each edge with its triangles (lowest first).
+fn edge_table(m: &WorkMesh) -> Vec<((u32, u32), [u32; 2])> {
+    let mut e: Vec<_> = m.edges.iter().map(|(k, t)| (k, [t[0].min(t[1]), t[0].max(t[1])])).collect();
+    e.sort_unstable();
+    e
+}
+
+/// A face at rest splits border edges (a neighbour's shared split) by
+/// its border list alone; woken, it has the triangles, border and edges
+/// of the same face split awake, and refines to the same mesh.
+#[test]
+fn a_face_split_at_rest_wakes_as_if_it_never_slept() {
+    let s = plane();
+    let (mut awake, mut rested) = (grid(), grid());
+    rested.rest();
+    assert!(rested.edges.iter().next().is_none());
+    assert_eq!(rested.boundary_edges(), awake.boundary_edges());
+    let mut out = Vec::new();
+    for (a, b, frac) in [(0, 1, 0.5), (4, 9, 0.25), (25, 1, 0.5), (24, 23, 0.7)] {
+        let x = awake.split_edge_at(&s, &[], a, b, frac, None, &mut out);
+        let y = rested.split_edge_at(&s, &[], a, b, frac, None, &mut out);
+        assert_eq!(x, y, "edge {a}-{b}");
+        assert_eq!(rested.boundary_edges(), awake.boundary_edges());
+    }
+    assert!(rested.resting, "border splits leave the face at rest");
+    assert_eq!(rested.tris, awake.tris);
+    rested.wake();
+    assert_eq!(edge_table(&rested), edge_table(&awake));
+    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 0.3, min_edge: 0.0, steps: 2 };
+    awake.refine(&s, &[], &c, 100_000);
+    rested.refine(&s, &[], &c, 100_000);
+    assert!(awake.tris.len() > 400);
+    assert_eq!(rested.tris, awake.tris);
+}
+
+/// A cached measure reads back no smaller than measured (rounded up to
+/// `f32`), and within an `f32` step of it.
+#[test]
+fn packed_measures_never_understate() {
+    for x in [0.0, 1e-300, 0.1, 1.0 / 3.0, 0.249_999_999_9, 7e12, -1e-300, -0.1] {
+        let (m, turn) = Packed::pack(TriMeasure { max: x, sum: x }, x).unpack();
+        assert!(m.max >= x && turn >= x, "{x}");
+        assert!(m.max - x <= x.abs() * 1.2e-7 + 2e-45, "{x}");
+    }
+    assert!(STALE.max.is_nan());
+}
+
+/// Through the splits of refinement every corner's (u,v) stays the
+/// surface point of its vertex (on the plane: its x and y).
+#[test]
+fn refined_corners_keep_their_vertices_uv() {
+    let s = plane();
+    let mut m = WorkMesh::default();
+    for p in [(-8.0, -8.0), (8.0, -8.0), (8.0, 8.0), (-8.0, 8.0)] {
+        m.add_vertex(DVec3::new(p.0, p.1, 0.0), DVec3::Z);
+    }
+    m.add_triangle([0, 1, 2], [at(-8.0, -8.0), at(8.0, -8.0), at(8.0, 8.0)]);
+    m.add_triangle([0, 2, 3], [at(-8.0, -8.0), at(8.0, 8.0), at(-8.0, 8.0)]);
+    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 1.0, min_edge: 0.0, steps: 2 };
+    m.refine(&s, &[], &c, 100_000);
+    assert!(m.tris.len() > 500);
+    for t in 0..m.tris.len() {
+        for (k, &v) in m.tris[t].iter().enumerate() {
+            let p = m.pos[v as usize];
+            assert!(m.uv(t)[k].distance(at(p.x, p.y)) < 1e-12, "triangle {t} corner {k}");
+        }
+    }
+}
