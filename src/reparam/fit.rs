@@ -11,8 +11,7 @@ use glam::{DVec2, DVec3};
 use super::interp::{self, chord_params, interpolate_surface};
 use super::{FIT_LIMIT, FIT_SHARE, MAX_SAMPLES};
 use crate::model::FaceSurface;
-use crate::nurbs::NurbsSurface;
-use crate::nurbs::{project_to_surface, ProjectionOptions, Surface, SurfaceDerivs};
+use crate::nurbs::{project_to_surface, NurbsSurface, ProjectionOptions, Surface, SurfaceDerivs};
 
 /// Piecewise-linear monotone map between the original parameters of the
 /// grid nodes and the new ones (`s_i ↔ u_i`), both ascending.
@@ -234,8 +233,9 @@ const SPEED_FLOOR: f64 = 1e-3;
 
 /// Most times a fit within the goal that folds is sampled 1.5× denser to
 /// unfold it, in the directions [`Fit::folds`] and the errors pick (5× at
-/// most: the hull's keel took 4×), and the most samples it may grow to: a fold that more samples do not undo
-/// (one found where the original itself turns sharply) costs little.
+/// most: the hull's keel took 4×), and the most samples it may grow to: a
+/// fold that more samples do not undo (one found where the original itself
+/// turns sharply) costs little.
 const UNFOLD_STEPS: usize = 4;
 const UNFOLD_SAMPLES: usize = 4096;
 

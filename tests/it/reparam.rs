@@ -382,19 +382,33 @@ fn reparam_flagged_corpus_faces_win() {
     }
 }
 
-/// asmo_car's rebuilt faces and the faces around them: a rebuilt face's
-/// border lies up to its fit error from where the file put it, and sewing
-/// must reach that far. With `auto` they stay as watertight as with `off`
+/// Rebuilt faces and the faces around them (asmo_car's, and trj6's corner
+/// blends): a rebuilt face's border lies up to its fit error from where the
+/// file put it, and sewing must reach that far. With `auto` they stay as watertight as with `off`
 /// (without the fit error in the sewing distance: 5 free edges at 1e-3
 /// where face 13's corner missed rebuilt face 5, 6 at 1e-2 where rebuilt
 /// faces 0 and 3 met face 11, and faces 4 and 7 met 13 and 20).
 #[test]
 fn reparam_auto_sews_rebuilt_faces_to_their_neighbours() {
-    let Some(m) = corpus("asmo_car.igs") else {
-        println!("asmo_car.igs: corpus not found, skipped");
-        return;
-    };
-    let faces = [0, 3, 4, 5, 7, 11, 13, 16, 20];
+    // (file, faces of a part, rebuilt faces at least): asmo_car's flagged
+    // faces with their neighbours; trj6's corner blends 387 and 397, whose
+    // short borders were turned at a corner (see `unreverse_corners`), with theirs.
+    let parts: [(&str, &[usize], usize); 2] = [
+        ("asmo_car.igs", &[0, 3, 4, 5, 7, 11, 13, 16, 20], 4),
+        ("trj6_pm4-ec-203.stp", &[312, 386, 387, 388, 396, 397, 398], 2),
+    ];
+    for (file, faces, least) in parts {
+        let Some(m) = corpus(file) else {
+            println!("{file}: corpus not found, skipped");
+            continue;
+        };
+        sews_part(&m, faces, least);
+    }
+}
+
+/// [`reparam_auto_sews_rebuilt_faces_to_their_neighbours`] for the faces
+/// `faces` of `m`, at least `least` of them rebuilt.
+fn sews_part(m: &Model, faces: &[usize], least: usize) {
     let part = Model {
         units: m.units.clone(),
         faces: faces.iter().map(|&f| m.faces[f].clone()).collect(),
@@ -404,7 +418,7 @@ fn reparam_auto_sews_rebuilt_faces_to_their_neighbours() {
     };
     for rel in [1e-2, 1e-3] {
         // The whole model's tolerance, as these faces get it there.
-        let tol = reparameterize_model(&m, Reparam::Off, Tolerance::Relative(rel)).unwrap().tolerance;
+        let tol = reparameterize_model(m, Reparam::Off, Tolerance::Relative(rel)).unwrap().tolerance;
         let run = |mode| mesh_model(&part, &MeshOptions::default().with_tolerance(tol).with_reparam(mode)).unwrap();
         let (off, auto) = (run(Reparam::Off), run(Reparam::Auto));
         let (o, a) = (&off.report, &auto.report);
@@ -413,7 +427,7 @@ fn reparam_auto_sews_rebuilt_faces_to_their_neighbours() {
             "rel {rel}: off {} tris {} free, auto {} tris {} free ({rebuilt} rebuilt)",
             o.triangles, o.free_edges, a.triangles, a.free_edges
         );
-        assert!(rebuilt >= 4, "rel {rel}: {:?}", a.warnings);
+        assert!(rebuilt >= least, "rel {rel}: {:?}", a.warnings);
         assert_eq!(o.free_edges, 0, "rel {rel}: off");
         assert_eq!(a.free_edges, 0, "rel {rel}: auto");
         assert!(a.nonmanifold_edges <= o.nonmanifold_edges, "rel {rel}");
@@ -427,8 +441,8 @@ fn reparam_auto_sews_rebuilt_faces_to_their_neighbours() {
 /// at its model's tolerance: `auto` falls back to the original with a
 /// warning and meshes exactly what `off` does. asmo_car's face 2 at 1e-3
 /// is a thin quad that both mesh in 2 triangles on the same 4 corners, so
-/// the angles tie; trj6's face 387, a small blend, needs a grid of more
-/// triangles than the original's whole mesh, and face 774's rebuild runs
+/// the angles tie; trj6's face 309 is a tip where the original's own
+/// normal swings, whose rebuild meshes lighter but with slivers, and face 774's rebuild runs
 /// out of the original's triangles before it is within tolerance.
 #[test]
 fn reparam_losing_corpus_faces_mesh_as_off() {
