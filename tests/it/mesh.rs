@@ -534,3 +534,56 @@ fn mesh_closes_the_sliver_where_three_corners_miss() {
     let wide = mesh_model(&missed_corner(3.0 * tol), &MeshOptions::default().with_tolerance(tol)).expect("meshes");
     assert!(wide.report.boundary_edges > outer, "a miss of 3 tolerances was closed");
 }
+
+/// A quarter of a torus tube (spine radius 20, tube radius 1, a quarter turn
+/// each way) trimmed by a slanted quadrilateral: a fillet. The angle limit
+/// sets the cells across it, the tolerance or the angle those along it; the
+/// CDT of the trimmed band, laid along the grid, must stay near that grid
+/// (it fanned across the tube and took 375 triangles at 1e-2, 7.8× the grid).
+#[test]
+fn mesh_trimmed_fillet_stays_near_the_grid_its_bends_need() {
+    use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_2};
+    let (big, small) = (20.0, 1.0);
+    let w = FRAC_1_SQRT_2;
+    let around = [((1.0, 0.0), 1.0), ((1.0, 1.0), w), ((0.0, 1.0), 1.0)];
+    let profile = [((big + small, 0.0), 1.0), ((big + small, small), w), ((big, small), 1.0)];
+    let points: Vec<Vec<DVec3>> = around
+        .iter()
+        .map(|&((cx, cy), _)| profile.iter().map(|&((rho, z), _)| DVec3::new(rho * cx, rho * cy, z)).collect())
+        .collect();
+    let weights: Vec<Vec<f64>> =
+        around.iter().map(|&(_, wa)| profile.iter().map(|&(_, wp)| wa * wp).collect()).collect();
+    let knots = vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0];
+    let surface = NurbsSurface::try_new([2, 2], knots.clone(), knots, &points, Some(&weights)).expect("surface");
+    let corners = [DVec2::new(0.02, 0.03), DVec2::new(0.97, 0.01), DVec2::new(0.95, 0.98), DVec2::new(0.03, 0.97)];
+    let curves = (0..4)
+        .map(|i| {
+            let (a, b) = (corners[i], corners[(i + 1) % 4]);
+            NurbsCurve::try_new(1, vec![0.0, 0.0, 1.0, 1.0], vec![a.extend(0.0), b.extend(0.0)], None).expect("line")
+        })
+        .collect();
+    let model = Model {
+        faces: vec![Face { name: None, surface: FaceSurface::Nurbs(surface), loops: vec![TrimLoop { curves }] }],
+        ..Model::default()
+    };
+    let torus = |p: DVec3| ((DVec2::new(p.x, p.y).length() - big).hypot(p.z) - small).abs();
+    for rel in [1e-2, 3e-3] {
+        let options = MeshOptions::default().with_relative_tolerance(rel);
+        let r = mesh_model(&model, &options).expect("meshes");
+        let rep = &r.report;
+        check_common("fillet", &r, rel);
+        assert!(exact_deviation(&r.mesh, torus) <= rep.tolerance, "rel {rel}: exact deviation");
+        // The grid the bends need: a quarter turn each way at the angle
+        // limit, and the spine's chord at the tolerance the mesher aims at.
+        let aim = rep.tolerance * options.safety;
+        let across = (FRAC_PI_2 / rep.angle).ceil();
+        let chord = (8.0 * (big + small) * aim).sqrt();
+        let along = (FRAC_PI_2 / rep.angle).max(FRAC_PI_2 * (big + small) / chord).ceil();
+        let grid = 2.0 * across * along;
+        assert!(
+            (rep.triangles as f64) <= 2.0 * grid,
+            "rel {rel}: {} triangles where the bends need a grid of {grid}",
+            rep.triangles
+        );
+    }
+}
