@@ -248,14 +248,21 @@ pub fn rebuild_face(face: &Face, tol: f64) -> Result<Rebuilt, String> {
 /// [`ASPECT_CAP`] times the shortest chord the mesher's grid will use: with
 /// `κ` the largest iso-line curvature found on the (evenly parameterized) new
 /// surface, a chord of length `h` sags `κh²/8`, and the grid gives each
-/// direction about 0.4 of the tolerance, so `h = sqrt(3.2·tol/κ)`.
+/// direction about 0.4 of the tolerance, so `h = sqrt(3.2·tol/κ)`. An
+/// iso-line shorter than the tolerance (a pole's) needs no chord at all: the
+/// curvature of what is left of it sets nothing.
 fn edge_cap(surface: &FaceSurface, tol: f64) -> f64 {
     let domain = surface.domain();
     let mut kappa = 0.0f64;
     for along_u in [true, false] {
         for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
-            for k in 0..=64 {
-                if let Some(c) = iso_curvature(&surface.derivs(iso_uv(domain, along_u, f, k as f64 / 64.0)), along_u) {
+            let line: Vec<_> = (0..=64).map(|k| surface.derivs(iso_uv(domain, along_u, f, k as f64 / 64.0))).collect();
+            let length: f64 = line.windows(2).map(|w| w[0].point.distance(w[1].point)).sum();
+            if length.is_nan() || length <= tol {
+                continue;
+            }
+            for d in &line {
+                if let Some(c) = iso_curvature(d, along_u) {
                     kappa = kappa.max(c);
                 }
             }
@@ -548,6 +555,34 @@ mod tests {
         };
         let m = crate::mesh_model(&model, &crate::MeshOptions::default().with_tolerance(0.01)).unwrap();
         assert!(m.report.triangles > 0 && m.report.faces_skipped == 0, "{:?}", m.report.warnings);
+    }
+
+    /// A quarter disc whose centre is a pole that is not quite one (its
+    /// control points 1e-8 apart, as trj6's corner blends): the pole's line
+    /// has no length to chord, so the edge cap follows the real bends (the
+    /// sampled arc nearest the pole has radius 1/4). Its 1e-8 speed made the
+    /// cap 1e-4 here, and trj6 face 309's forced rebuild 1.4 million triangles.
+    #[test]
+    fn edge_cap_is_not_set_by_a_pole() {
+        let pts: Vec<Vec<DVec3>> = (0..4)
+            .map(|i| {
+                (0..4)
+                    .map(|j| {
+                        let a = core::f64::consts::FRAC_PI_2 * j as f64 / 3.0;
+                        let r = i as f64 / 3.0;
+                        let r = r.max(1e-8);
+                        DVec3::new(r * libm::cos(a), r * libm::sin(a), 0.0)
+                    })
+                    .collect()
+            })
+            .collect();
+        let k = vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        let fan = FaceSurface::Rebuilt(NurbsSurface::try_new([3, 3], k.clone(), k, &pts, None).unwrap());
+        let tol = 0.01;
+        // The sharpest bend off the pole: the arc of radius 1/4 (curvature 4).
+        let fair = ASPECT_CAP * libm::sqrt(3.2 * tol / 4.0);
+        let cap = edge_cap(&fan, tol);
+        assert!(cap > 0.5 * fair && cap < f64::INFINITY, "cap {cap} against {fair}");
     }
 
     #[test]
