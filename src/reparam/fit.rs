@@ -75,18 +75,38 @@ struct ArcTable {
 
 /// The parameters at fraction `a` along the iso-line at fraction `f` across
 /// the domain `[lo, hi]`, running along u (`along_u`) or v.
-pub(super) fn iso_uv([lo, hi]: [DVec2; 2], along_u: bool, f: f64, a: f64) -> DVec2 {
+fn iso_uv([lo, hi]: [DVec2; 2], along_u: bool, f: f64, a: f64) -> DVec2 {
     let (x, y) = if along_u { (a, f) } else { (f, a) };
     DVec2::new(lo.x + (hi.x - lo.x) * x, lo.y + (hi.y - lo.y) * y)
 }
 
 /// Curvature of the iso-line along u (`along_u`) or v at `d`; `None` where
 /// the line stops (a pole) or the value is not finite.
-pub(super) fn iso_curvature(d: &SurfaceDerivs, along_u: bool) -> Option<f64> {
+fn iso_curvature(d: &SurfaceDerivs, along_u: bool) -> Option<f64> {
     let (d1, d2) = if along_u { (d.su, d.suu) } else { (d.sv, d.svv) };
     let speed = d1.length();
     let k = d1.cross(d2).length() / (speed * speed * speed);
     (speed > 1e-12 && k.is_finite()).then_some(k)
+}
+
+/// Length and largest curvature of the iso-line at fraction `f` across the
+/// domain, running along u (`along_u`) or v, over `steps` equal parameter
+/// steps (points where the line stops, at a pole, give no curvature).
+pub(super) fn iso_line(surface: &FaceSurface, along_u: bool, f: f64, steps: usize) -> (f64, f64) {
+    let domain = surface.domain();
+    let (mut length, mut kappa) = (0.0, 0.0f64);
+    let mut prev: Option<DVec3> = None;
+    for k in 0..=steps {
+        let d = surface.derivs(iso_uv(domain, along_u, f, k as f64 / steps as f64));
+        if let Some(c) = iso_curvature(&d, along_u) {
+            kappa = kappa.max(c);
+        }
+        if let Some(q) = prev {
+            length += d.point.distance(q);
+        }
+        prev = Some(d.point);
+    }
+    (length, kappa)
 }
 
 /// Samples along u (`along_u`) or v: paper 001 step 2's chord count
@@ -101,22 +121,9 @@ fn sample_count(surface: &FaceSurface, along_u: bool, eps: f64) -> usize {
             return ((count - deg) * 3).clamp(3, MAX_SAMPLES);
         }
     }
-    let domain = surface.domain();
     let (mut sum, mut used) = (0.0, 0usize);
     for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
-        let mut length = 0.0;
-        let mut kappa = 0.0f64;
-        let mut prev: Option<DVec3> = None;
-        for k in 0..=100 {
-            let d = surface.derivs(iso_uv(domain, along_u, f, k as f64 / 100.0));
-            if let Some(k) = iso_curvature(&d, along_u) {
-                kappa = kappa.max(k);
-            }
-            if let Some(q) = prev {
-                length += d.point.distance(q);
-            }
-            prev = Some(d.point);
-        }
+        let (length, kappa) = iso_line(surface, along_u, f, 100);
         if length > 0.0 && length.is_finite() {
             sum += length * libm::sqrt(kappa / (8.0 * eps));
             used += 1;
@@ -346,7 +353,7 @@ fn unreverse_corners(new: &NurbsSurface, old: &FaceSurface, us: &[f64], vs: &[f6
         // The original's border directions leaving the corner: chords to its
         // points a [`CORNER_STEP`] of the first intervals along.
         let (cu, cv) = (if i == 0 { u0 } else { u1 }, if j == 0 { v0 } else { v1 });
-        let (nu1, nv1) = (if i == 0 { us[1] } else { us[us.len() - 2] }, if j == 0 { vs[1] } else { vs[vs.len() - 2] });
+        let (nu1, nv1) = (if i == 0 { us[1] } else { us[nu - 2] }, if j == 0 { vs[1] } else { vs[nv - 2] });
         let corner = old.point(DVec2::new(cu, cv));
         let su = old.point(DVec2::new(cu + (nu1 - cu) * CORNER_STEP, cv)) - corner;
         let sv = old.point(DVec2::new(cu, cv + (nv1 - cv) * CORNER_STEP)) - corner;

@@ -7,7 +7,7 @@
 mod fit;
 mod interp;
 
-use fit::{fit_within, iso_curvature, iso_uv, projection, Fit, Map1, Spacing};
+use fit::{fit_within, iso_line, projection, Fit, Map1, Spacing};
 
 use alloc::format;
 use alloc::string::String;
@@ -252,19 +252,12 @@ pub fn rebuild_face(face: &Face, tol: f64) -> Result<Rebuilt, String> {
 /// iso-line shorter than the tolerance (a pole's) needs no chord at all: the
 /// curvature of what is left of it sets nothing.
 fn edge_cap(surface: &FaceSurface, tol: f64) -> f64 {
-    let domain = surface.domain();
     let mut kappa = 0.0f64;
     for along_u in [true, false] {
         for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
-            let line: Vec<_> = (0..=64).map(|k| surface.derivs(iso_uv(domain, along_u, f, k as f64 / 64.0))).collect();
-            let length: f64 = line.windows(2).map(|w| w[0].point.distance(w[1].point)).sum();
-            if length.is_nan() || length <= tol {
-                continue;
-            }
-            for d in &line {
-                if let Some(c) = iso_curvature(d, along_u) {
-                    kappa = kappa.max(c);
-                }
+            let (length, k) = iso_line(surface, along_u, f, 64);
+            if length > tol {
+                kappa = kappa.max(k);
             }
         }
     }
