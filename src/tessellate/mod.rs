@@ -2,6 +2,7 @@
 
 #[cfg(feature = "std")]
 mod cdt;
+mod collapse;
 mod face;
 #[cfg(feature = "std")]
 mod fill;
@@ -357,7 +358,8 @@ pub fn mesh_model_with_progress(
     drop((places, folded, settled));
     let mut mesh = Mesh { face_ranges: Vec::with_capacity(works.len()), ..Mesh::default() };
     for w in &mut works {
-        let wm = core::mem::take(&mut w.mesh);
+        let mut wm = core::mem::take(&mut w.mesh);
+        collapse::collapse_point_edges(&wm.pos, &mut wm.tris);
         let first = mesh.triangle_count() as u32;
         let base = mesh.positions.len() as u32;
         // Vertices no triangle kept (a removed flap's corner, a collapsed
