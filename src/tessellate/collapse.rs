@@ -14,7 +14,7 @@ use crate::collections::HashMap;
 
 /// Whether `a` and `b` are one point up to rounding (as [`super::face`]'s
 /// band judges a loop segment's two ends).
-fn one_point(a: DVec3, b: DVec3) -> bool {
+pub(crate) fn one_point(a: DVec3, b: DVec3) -> bool {
     a.distance(b) <= 1e-12 * a.abs().max(b.abs()).max_element().max(1.0)
 }
 
@@ -25,11 +25,17 @@ fn one_point(a: DVec3, b: DVec3) -> bool {
 /// lie on the border while the edge does not). Returns the triangles dropped.
 pub(crate) fn collapse_point_edges(pos: &[DVec3], tris: &mut Vec<[u32; 3]>) -> usize {
     let at = |v: u32| pos.get(v as usize).copied();
+    collapse_edges(tris, |a, b| matches!((at(a), at(b)), (Some(p), Some(q)) if one_point(p, q)))
+}
+
+/// [`collapse_point_edges`] for the edges `same` holds for: a trial mesh,
+/// not yet sewn, judges its shape by the edges sewing will make one point.
+pub(crate) fn collapse_edges(tris: &mut Vec<[u32; 3]>, same: impl Fn(u32, u32) -> bool) -> usize {
     let mut edges: Vec<(u32, u32)> = Vec::new();
     for t in tris.iter() {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
-            if a != b && matches!((at(a), at(b)), (Some(p), Some(q)) if one_point(p, q)) {
+            if a != b && same(a, b) {
                 edges.push((a.min(b), a.max(b)));
             }
         }

@@ -558,8 +558,16 @@ fn rebuild_loses(
     let old = original.as_ref().ok()?;
     let p1 = |m: &refine::WorkMesh| {
         let corner = |a: glam::DVec3, b: glam::DVec3, c: glam::DVec3| crate::math::angle_between(b - a, c - a);
-        let mut a: Vec<f64> = m
-            .tris
+        // As the model's mesh will have them: the edges whose ends sewing
+        // puts on one model node collapsed.
+        let mut tris = m.tris.clone();
+        let pos = |v: u32| m.pos.get(v as usize).copied();
+        let gid = |v: u32| m.gid.get(v as usize).copied().unwrap_or(u32::MAX);
+        collapse::collapse_edges(&mut tris, |a, b| {
+            (gid(a) == gid(b) && gid(a) != u32::MAX)
+                || matches!((pos(a), pos(b)), (Some(p), Some(q)) if collapse::one_point(p, q))
+        });
+        let mut a: Vec<f64> = tris
             .iter()
             .map(|t| {
                 let [p, q, r] = t.map(|v| m.pos.get(v as usize).copied().unwrap_or_default());

@@ -353,6 +353,9 @@ fn reparam_flagged_corpus_faces_win() {
     // Fillets whose rebuild ran out of triangles while the CDT fanned across
     // them (see `band_scale`): laid along the grid, the rebuild pays.
     rows.extend([("trj6_pm4-ec-203.stp", 774, 1e-2), ("trj6_pm4-ec-203.stp", 801, 1e-3)]);
+    // A tip whose pole's two loop ends sewing puts on one point: its rebuild
+    // is judged, as the model's mesh has it, without the triangle between them.
+    rows.push(("trj6_pm4-ec-203.stp", 309, 1e-3));
     let mut tols = std::collections::HashMap::new();
     let mut models = std::collections::HashMap::new();
     for (file, index, rel) in rows {
@@ -444,13 +447,14 @@ fn sews_part(m: &Model, faces: &[usize], least: usize) {
 /// at its model's tolerance: `auto` falls back to the original with a
 /// warning and meshes exactly what `off` does. asmo_car's face 2 at 1e-3
 /// is a thin quad that both mesh in 2 triangles on the same 4 corners, so
-/// the angles tie; trj6's face 309 is a tip where the original's own
-/// normal swings, whose rebuild meshes lighter but with slivers, and face 774's rebuild runs
+/// the angles tie; trj6's face 309 at 1e-2 is a tip whose rebuild meshes
+/// in a tenth of the triangles, but its few long ones reach a cluster of
+/// tiny borders at the pole in slivers, and face 774's rebuild runs
 /// out of the original's triangles before it is within tolerance.
 #[test]
 fn reparam_losing_corpus_faces_mesh_as_off() {
     for (file, index, rel) in
-        [("asmo_car.igs", 2, 1e-3), ("trj6_pm4-ec-203.stp", 309, 1e-3), ("trj6_pm4-ec-203.stp", 774, 1e-3)]
+        [("asmo_car.igs", 2, 1e-3), ("trj6_pm4-ec-203.stp", 309, 1e-2), ("trj6_pm4-ec-203.stp", 774, 1e-3)]
     {
         let Some(m) = corpus(file) else {
             println!("{file}: corpus not found, skipped");
