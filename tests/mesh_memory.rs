@@ -43,15 +43,15 @@ static A: Counting = Counting;
 /// trj7 (23k triangles at 1e-3) peaked at 190 bytes a final triangle over
 /// its model while every face's working mesh was held at full size (edge
 /// table, measure cache and hash tables per face) and the model's mesh was
-/// presized beside them; with faces at rest between visits and the census
-/// without a hash grid, about 150. Since the CDT lays a trimmed face's first
-/// triangles along its grid, trj7 takes 7.4k triangles and what each of its
-/// 414 faces holds for a moment outweighs them (280 bytes a triangle, 2 MB in
-/// all, down from 3.5 MB), so the figure is taken on trj3: 94 faces, 42k
-/// triangles (111 bytes a triangle). The output itself is 28 bytes a triangle.
+/// presized beside them. Since then the first triangles lie along the grid
+/// and creases are no longer split down, and the models take far fewer
+/// triangles (trj7 7.4k, trj3 16k), so what each face holds for a moment
+/// weighs more per triangle: the figure is taken on the largest model,
+/// trj6 (801 faces, 42k triangles): 191 bytes a triangle, 8.0 MB; 226 with
+/// faces kept awake between refinement visits. The output is 28 bytes a triangle.
 #[test]
-fn meshing_a_mid_size_model_peaks_under_170_bytes_a_triangle() {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus/trj3_s1-al-214.stp");
+fn meshing_the_largest_model_peaks_under_205_bytes_a_triangle() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus/trj6_pm4-ec-203.stp");
     if !file.exists() {
         eprintln!("SKIPPED: no corpus file {} (needs ../shared/corpus)", file.display());
         return;
@@ -63,7 +63,7 @@ fn meshing_a_mid_size_model_peaks_under_170_bytes_a_triangle() {
     let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-3)).unwrap();
     let peak = PEAK.load(Relaxed) - before;
     let tris = r.report.triangles;
-    assert!(tris > 20_000, "{tris} triangles");
+    assert!(tris > 30_000, "{tris} triangles");
     let per = peak as f64 / tris as f64;
-    assert!(per < 170.0, "mesh phase peak {peak} bytes over the model: {per:.0} bytes a triangle");
+    assert!(per < 205.0, "mesh phase peak {peak} bytes over the model: {per:.0} bytes a triangle");
 }

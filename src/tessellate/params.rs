@@ -46,26 +46,43 @@ pub(crate) const MAX_PARAMS: usize = 20_000;
 
 /// How badly the interval `[a, b]` fails: the factor by which it must be
 /// split (1.0 = accepted). `eval(t)` gives point and unit normal (or tangent).
-fn interval_need(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits) -> (f64, f64) {
-    let (demand, sag) = interval_demand(eval, a, b, lim);
+fn interval_need(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits, one_sided: bool) -> (f64, f64) {
+    let (demand, sag) = interval_demand(eval, a, b, lim, one_sided);
     (demand.max(1.0), sag)
 }
 
 /// How many chords `[a, b]` needs, as a fraction, and its largest sag: sag
 /// falls as the square of the step, turn and length as the step, so over
 /// short intervals the demand adds up along the curve. 0 at or below the
-/// shortest edge.
-fn interval_demand(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits) -> (f64, f64) {
+/// shortest edge. With `one_sided`, see [`Probe::one_sided`].
+fn interval_demand(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits, one_sided: bool) -> (f64, f64) {
     let (pa, na) = eval(a);
     let (pb, nb) = eval(b);
     let chord = pb - pa;
     let len = chord.length();
     let mut sag: f64 = 0.0;
-    let mut turn = crate::math::angle_between(na, nb);
-    for f in [0.25, 0.5, 0.75] {
+    let mut mids = [DVec3::ZERO; 3];
+    for (k, f) in [0.25, 0.5, 0.75].into_iter().enumerate() {
         let (p, n) = eval(a + (b - a) * f);
         sag = sag.max(dist_to_segment(p, pa, pb));
-        turn = turn.max(crate::math::angle_between(na, n)).max(crate::math::angle_between(n, nb));
+        mids[k] = n;
+    }
+    let turn_of = |na: DVec3, nb: DVec3| {
+        mids.iter().fold(crate::math::angle_between(na, nb), |t, &n| {
+            t.max(crate::math::angle_between(na, n)).max(crate::math::angle_between(n, nb))
+        })
+    };
+    let mut turn = turn_of(na, nb);
+    if one_sided && turn > lim.angle {
+        // On a crease (a C0 knot: a folded strip, a polyline's corner) an
+        // end's own normal or tangent is the next piece's: the interval
+        // turns by what it sees from inside, or it is split down to the
+        // shortest edge for a turn it does not have. A rounding error
+        // inside, so that at a pole the normal is still the fallback the
+        // end itself gets (a step inside would see the pole's fan turn);
+        // and only ever less, so no interval is split more than before.
+        let e = (b - a) * 1e-12;
+        turn = turn.min(turn_of(eval(a + e).1, eval(b - e).1));
     }
     if len <= lim.min_edge {
         return (0.0, sag);
@@ -100,6 +117,10 @@ pub(crate) fn dist_to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
 pub(crate) struct Probe<'e> {
     pub eval: &'e dyn Fn(f64) -> (DVec3, DVec3),
     pub inside: Option<Vec<(f64, f64)>>,
+    /// Whether an interval's turn is judged from inside it where its ends
+    /// disagree (a surface's iso-lines across a crease). Trim curves are
+    /// not: [`coarsen`] judges their runs by the ends' own tangents.
+    pub one_sided: bool,
 }
 
 /// Subdivides `[t0, t1]` (already split at `breaks`) until every interval passes
@@ -107,7 +128,7 @@ pub(crate) struct Probe<'e> {
 /// and the largest sag left in an accepted interval.
 #[cfg(feature = "std")]
 pub(crate) fn subdivide(evals: &[&dyn Fn(f64) -> (DVec3, DVec3)], breaks: &[f64], lim: &Limits) -> (Vec<f64>, f64) {
-    let probes: Vec<Probe<'_>> = evals.iter().map(|&eval| Probe { eval, inside: None }).collect();
+    let probes: Vec<Probe<'_>> = evals.iter().map(|&eval| Probe { eval, inside: None, one_sided: false }).collect();
     subdivide_probes(&probes, breaks, lim, MAX_PARAMS)
 }
 
@@ -255,7 +276,7 @@ fn need_all(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits) -> (f64, f64) {
 }
 
 /// A test of one interval of one curve: a need and the largest sag.
-type IntervalTest = fn(&dyn Fn(f64) -> (DVec3, DVec3), f64, f64, &Limits) -> (f64, f64);
+type IntervalTest = fn(&dyn Fn(f64) -> (DVec3, DVec3), f64, f64, &Limits, bool) -> (f64, f64);
 
 /// The largest `test` over the parts of `[a, b]` where each probe matters, starting from `floor`.
 fn over_probes(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits, test: IntervalTest, floor: f64) -> (f64, f64) {
@@ -267,7 +288,7 @@ fn over_probes(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits, test: Interva
     };
     for p in probes {
         match &p.inside {
-            None => take(test(p.eval, a, b, lim)),
+            None => take(test(p.eval, a, b, lim, p.one_sided)),
             Some(pieces) => {
                 // Only the part of [a, b] inside the region is tested; a piece
                 // a rounding error long says nothing.
@@ -275,7 +296,7 @@ fn over_probes(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits, test: Interva
                 for &(lo, hi) in pieces {
                     let (x, y) = (a.max(lo), b.min(hi));
                     if y - x > eps {
-                        take(test(p.eval, x, y, lim));
+                        take(test(p.eval, x, y, lim, p.one_sided));
                     }
                 }
             }
@@ -408,8 +429,10 @@ fn with_probes<R>(
     f: impl FnOnce(&[Probe<'_>]) -> R,
 ) -> R {
     let curves = iso_curves(surface, lo, hi, along_u, if region.is_some() { 8 } else { 4 });
-    let probes: Vec<Probe<'_>> =
-        curves.iter().map(|(s, c)| Probe { eval: c, inside: region.map(|r| r(along_u, *s)) }).collect();
+    let probes: Vec<Probe<'_>> = curves
+        .iter()
+        .map(|(s, c)| Probe { eval: c, inside: region.map(|r| r(along_u, *s)), one_sided: true })
+        .collect();
     f(&probes)
 }
 
@@ -563,7 +586,7 @@ mod tests {
             let d = DVec3::new(3.0, 0.0, -6.0 * (1.0 - t) * (1.0 - t)).normalize();
             (p, DVec3::new(-d.z, 0.0, d.x))
         };
-        let probes = [Probe { eval: &curve, inside: None }];
+        let probes = [Probe { eval: &curve, inside: None, one_sided: false }];
         let l = lim(1e-3);
         let (even, _) = equidistribute(&probes, 0.0, 1.0, &l, MAX_PARAMS, None);
         let breaks: Vec<f64> = (0..=16).map(|k| k as f64 / 16.0).collect();

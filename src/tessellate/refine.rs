@@ -391,24 +391,27 @@ impl WorkMesh {
             |n: &[DVec3; 3]| angle_between(n[0], n[1]).max(angle_between(n[1], n[2])).max(angle_between(n[2], n[0]));
         let mut turn = turn_of(&n);
         if turn > c.angle {
-            // Where the surface collapses (a cone's apex) it has no one
-            // normal: a triangle there turns by what it sees from its side.
+            // A corner's own normal is one side's on a crease (a C0 knot
+            // line: a zig-zag strip's every fold) and none where the surface
+            // collapses (a cone's apex): a triangle there turns by what it
+            // sees from its side. Else every triangle on the other side of
+            // a crease was split down to a tenth of the tolerance.
             let centre = (uv[0] + uv[1] + uv[2]) / 3.0;
-            let mut any = false;
-            for k in 0..3 {
-                if regular_normal(&surface.derivs(uv[k])).is_none() {
-                    let limit = [1e-6, 1e-4, 1e-2]
-                        .iter()
-                        .find_map(|f| regular_normal(&surface.derivs(uv[k] + (centre - uv[k]) * *f)));
-                    if let Some(l) = limit {
-                        n[k] = l;
-                        any = true;
+            let inside = |k: usize| {
+                [1e-6, 1e-4, 1e-2].iter().find_map(|f| regular_normal(&surface.derivs(uv[k] + (centre - uv[k]) * *f)))
+            };
+            if let (Some(a), Some(b), Some(c)) = (inside(0), inside(1), inside(2)) {
+                n = [a, b, c];
+            } else {
+                for k in 0..3 {
+                    if regular_normal(&surface.derivs(uv[k])).is_none() {
+                        if let Some(l) = inside(k) {
+                            n[k] = l;
+                        }
                     }
                 }
             }
-            if any {
-                turn = turn_of(&n);
-            }
+            turn = turn_of(&n);
         }
         (m, turn)
     }

@@ -587,3 +587,31 @@ fn mesh_trimmed_fillet_stays_near_the_grid_its_bends_need() {
         );
     }
 }
+
+/// A strip folded at right angles along its degree-1 knots (as trj3's
+/// zig-zag band is): each flat panel takes a few triangles. A corner on a
+/// fold has the normal of one panel only, so a triangle of the other panel
+/// was judged to turn 90° and split down to a tenth of the tolerance
+/// (trj3's band: 15k triangles, 2,200 of them flat).
+#[test]
+fn mesh_folded_strip_keeps_its_panels_flat_and_few() {
+    let corners = [(0.0, 0.0), (4.0, 0.0), (4.0, 4.0), (8.0, 4.0), (8.0, 8.0)];
+    let pts: Vec<Vec<DVec3>> =
+        corners.iter().map(|&(x, y)| vec![DVec3::new(x, y, 0.0), DVec3::new(x, y, 1.0)]).collect();
+    let ku = vec![0.0, 0.0, 1.0, 2.0, 3.0, 4.0, 4.0];
+    let kv = vec![0.0, 0.0, 1.0, 1.0];
+    let strip = NurbsSurface::try_new([1, 1], ku, kv, &pts, None).expect("strip");
+    let model = Model {
+        units: "mm".into(),
+        faces: vec![Face { name: None, surface: FaceSurface::Nurbs(strip), loops: vec![] }],
+        warnings: vec![],
+        tolerance: None,
+        bodies: vec![],
+    };
+    for rel in RELS {
+        let r = mesh(&model, rel);
+        check_common("folded strip", &r, rel);
+        // Four flat panels: two triangles each would do; eight each is slack.
+        assert!(r.report.triangles <= 32, "rel {rel}: {} triangles for four flat panels", r.report.triangles);
+    }
+}
