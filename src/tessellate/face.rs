@@ -217,7 +217,12 @@ pub(crate) fn mesh_face<'a>(
             tight + lim.tol,
         );
         let mut wm = initial_from_outline(index, &face.surface, &o, budget)?;
-        let outcome = wm.refine(&face.surface, &o.loops.curves, crit, budget);
+        wm.refine(&face.surface, &o.loops.curves, crit, budget);
+        // Flipped as the model's faces are, so that the shapes compared are
+        // those the model's mesh would have.
+        let flipped = wm.improve_angles(&face.surface, crit, &mut crate::collections::HashSet::default());
+        wm.forget(&flipped);
+        let outcome = wm.outcome(&face.surface, crit);
         Ok(FaceResult { mesh: wm, outcome, outline: Some(unsewn) })
     }
     #[cfg(not(feature = "std"))]

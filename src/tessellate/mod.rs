@@ -302,6 +302,16 @@ pub fn mesh_model_with_progress(
             }
         }
     }
+    let mut taken = crate::collections::HashSet::default();
+    for w in &works {
+        w.mesh.border_node_edges(&mut taken);
+    }
+    for w in works.iter_mut() {
+        let changed = w.mesh.improve_angles(w.surface, &w.crit, &mut taken);
+        w.mesh.forget(&changed);
+        w.mesh.rest();
+    }
+    drop(taken);
     // Three faces' corners that sewing left apart: a sliver between them.
     #[cfg(feature = "std")]
     fill::close_slivers(&mut works, tol);

@@ -11,6 +11,10 @@ use crate::nurbs::Surface;
 #[cfg(feature = "std")]
 use {super::STALE, crate::nurbs::project_to_surface};
 
+/// The smallest angle below which [`WorkMesh::improve_angles`] looks for a
+/// better diagonal (radians, 15°): wider pairs gain little for the measuring.
+const THIN: f64 = 0.26;
+
 impl WorkMesh {
     /// Repairs folded triangles by edge flips: for each inverted triangle,
     /// its interior edges (not trim edges) are tried in turn, and a flip is
@@ -75,6 +79,115 @@ impl WorkMesh {
         changed.dedup();
         let left = self.folded(surface);
         (changed, left)
+    }
+
+    /// Beyond paper 000: flips interior edges whose two triangles are not
+    /// Delaunay in space (their angles facing the edge sum past 180°) when
+    /// the flip raises their smaller angle and the new pair passes every
+    /// limit as [`Self::repair_inverted`] judges it. Refinement splits
+    /// longest edges and never flips, so its thin triangles stay thin where a
+    /// flip would mend them at no cost in triangles. Returns the triangles changed.
+    ///
+    /// `taken` holds the model's edges between border nodes (by node id):
+    /// a new edge between two border nodes that another face already has
+    /// (a strip between them) would be the model's third use of it.
+    pub fn improve_angles(
+        &mut self,
+        surface: &dyn Surface,
+        c: &Criteria,
+        taken: &mut crate::collections::HashSet<(u32, u32)>,
+    ) -> Vec<u32> {
+        let mut changed = Vec::new();
+        // Only thin triangles are worth a flip; the edge table is built
+        // for faces that have some.
+        let p = |x: u32| self.pos[x as usize];
+        let thin = |t: &[u32; 3]| {
+            let angle = |k: usize| {
+                let at = p(t[k]);
+                crate::math::angle_between(p(t[(k + 1) % 3]) - at, p(t[(k + 2) % 3]) - at)
+            };
+            angle(0).min(angle(1)).min(angle(2)) < THIN
+        };
+        let mut todo: Vec<u32> = (0..self.tris.len() as u32).filter(|&t| thin(&self.tris[t as usize])).collect();
+        if todo.is_empty() || self.tris.len() < 2 {
+            return changed;
+        }
+        self.wake();
+        // Each flip raises the pair's smaller angle, so this ends; the cap
+        // bounds the work on a mesh that keeps finding small gains.
+        let mut budget = 2 * self.tris.len() + 16;
+        while let Some(t) = todo.pop() {
+            let v = self.tris[t as usize];
+            for k in 0..3 {
+                if budget == 0 {
+                    break;
+                }
+                let Some((u, across)) = self.delaunay_gain(t, v[k], v[(k + 1) % 3], taken) else { continue };
+                budget -= 1;
+                if self.try_flip(surface, c, t, v[k], v[(k + 1) % 3]).is_some() {
+                    if let Some(e) = across {
+                        taken.insert(e);
+                    }
+                    changed.extend([t, u]);
+                    todo.extend([t, u]);
+                    break;
+                }
+            }
+        }
+        changed.sort_unstable();
+        changed.dedup();
+        changed
+    }
+
+    /// Adds this face's edges between two border nodes to `taken` (see
+    /// [`Self::improve_angles`]).
+    pub fn border_node_edges(&self, taken: &mut crate::collections::HashSet<(u32, u32)>) {
+        for t in &self.tris {
+            for k in 0..3 {
+                let (ga, gb) = (self.gid[t[k] as usize], self.gid[t[(k + 1) % 3] as usize]);
+                if ga != NONE && gb != NONE {
+                    taken.insert((ga.min(gb), ga.max(gb)));
+                }
+            }
+        }
+    }
+
+    /// The triangle across interior edge `a-b` of `t` (which runs a→b) when
+    /// the two are not Delaunay in space, one of them is thinner than
+    /// [`THIN`], and flipping their edge would raise their smallest angle.
+    /// With it, the new edge's node ids when both its ends are border nodes.
+    #[allow(clippy::type_complexity)]
+    fn delaunay_gain(
+        &self,
+        t: u32,
+        a: u32,
+        b: u32,
+        taken: &crate::collections::HashSet<(u32, u32)>,
+    ) -> Option<(u32, Option<(u32, u32)>)> {
+        let &adj = self.edges.get(&key(a, b))?;
+        let u = if adj[0] == t { adj[1] } else { adj[0] };
+        if u == NONE || (adj[0] != t && adj[1] != t) || self.trim.contains_key(&key(a, b)) {
+            return None;
+        }
+        let cv = self.tris[t as usize].into_iter().find(|&x| x != a && x != b)?;
+        let d = self.tris[u as usize].into_iter().find(|&x| x != a && x != b)?;
+        let (gc, gd) = (self.gid[cv as usize], self.gid[d as usize]);
+        let across = (gc != NONE && gd != NONE).then(|| (gc.min(gd), gc.max(gd)));
+        if across.is_some_and(|e| gc == gd || taken.contains(&e)) {
+            return None;
+        }
+        let p = |x: u32| self.pos[x as usize];
+        let angle = |at: u32, x: u32, y: u32| crate::math::angle_between(p(x) - p(at), p(y) - p(at));
+        if angle(cv, a, b) + angle(d, a, b) <= core::f64::consts::PI * (1.0 + 1e-9) {
+            return None;
+        }
+        let least = |x: u32, y: u32, z: u32| angle(x, y, z).min(angle(y, z, x)).min(angle(z, x, y));
+        let before = least(a, b, cv).min(least(b, a, d));
+        if before >= THIN {
+            return None;
+        }
+        let after = least(a, d, cv).min(least(d, b, cv));
+        (after > 2.0 * before).then_some((u, across))
     }
 
     /// Of triangles `ts`, how many fold against the surface or exceed the

@@ -132,3 +132,49 @@ fn refined_corners_keep_their_vertices_uv() {
         }
     }
 }
+
+/// A flat quad split along its long diagonal (a 5.7° sliver) is re-split
+/// along its short one (smallest angle 22°): no triangle more. With the
+/// short diagonal's ends two border nodes whose edge another face already
+/// has, it stays.
+#[test]
+fn thin_pair_is_flipped_to_its_better_diagonal() {
+    let quad = || {
+        let mut m = WorkMesh::default();
+        let pts = [(-4.0, 0.0), (1.0, -0.5), (4.0, 0.0), (1.0, 1.5)];
+        for p in pts {
+            m.add_vertex(DVec3::new(p.0, p.1, 0.0), DVec3::Z);
+        }
+        let w = |k: usize| at(pts[k].0, pts[k].1);
+        m.add_triangle([0, 1, 2], [w(0), w(1), w(2)]);
+        m.add_triangle([0, 2, 3], [w(0), w(2), w(3)]);
+        m
+    };
+    let least = |m: &WorkMesh| {
+        (0..m.tris.len())
+            .map(|t| {
+                let p = m.tris[t].map(|v| m.pos[v as usize]);
+                (0..3)
+                    .map(|k| crate::math::angle_between(p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]))
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let s = plane();
+    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 10.0, min_edge: 0.0, steps: 2 };
+    let mut m = quad();
+    let before = least(&m);
+    let changed = m.improve_angles(&s, &c, &mut crate::collections::HashSet::default());
+    assert_eq!(changed, alloc::vec![0, 1]);
+    assert_eq!(m.tris.len(), 2);
+    assert!(m.tris.iter().all(|t| t.contains(&1) && t.contains(&3)), "{:?}", m.tris);
+    assert!(least(&m) > 3.0 * before, "{} against {before}", least(&m));
+    // Vertices 1 and 3 as border nodes 7 and 9, already joined elsewhere.
+    let mut m = quad();
+    m.gid[1] = 7;
+    m.gid[3] = 9;
+    let mut taken = crate::collections::HashSet::default();
+    taken.insert((7, 9));
+    assert!(m.improve_angles(&s, &c, &mut taken).is_empty());
+    assert_eq!(m.tris[0], [0, 1, 2]);
+}
