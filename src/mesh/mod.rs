@@ -8,6 +8,7 @@ use alloc::vec::Vec;
 use glam::DVec3;
 use serde::Serialize;
 
+pub(crate) use metrics::min_angle;
 pub use metrics::{angle_stats, edge_counts, edge_counts_in_bodies, AngleStats, EdgeCounts};
 pub use weld::{weld_mesh, weld_positions};
 

@@ -12,8 +12,8 @@ use glam::DVec3;
 
 use crate::collections::HashMap;
 
-/// Whether `a` and `b` are one point up to rounding (as [`super::face`]'s
-/// band judges a loop segment's two ends).
+/// Whether `a` and `b` are one point up to rounding (also how the band of a
+/// trimmed face judges a loop segment's two ends).
 pub(crate) fn one_point(a: DVec3, b: DVec3) -> bool {
     a.distance(b) <= 1e-12 * a.abs().max(b.abs()).max_element().max(1.0)
 }

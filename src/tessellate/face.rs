@@ -676,9 +676,7 @@ impl Band {
         let mut apart = alloc::vec![false; self.nodes.len()];
         for &(a, b, ..) in &self.segs {
             let (ga, gb) = (flat.get(a).copied(), flat.get(b).copied());
-            let (pa, pb) = (points[a], points[b]);
-            let rounding = 1e-12 * pa.abs().max(pb.abs()).max_element().max(1.0);
-            if ga.is_some() && ga == gb && ga != Some(u32::MAX) && pa.distance(pb) > rounding {
+            if ga.is_some() && ga == gb && ga != Some(u32::MAX) && !super::collapse::one_point(points[a], points[b]) {
                 apart[a] = true;
                 apart[b] = true;
             }

@@ -567,7 +567,6 @@ fn rebuild_loses(
     };
     let old = original.as_ref().ok()?;
     let p1 = |m: &refine::WorkMesh| {
-        let corner = |a: glam::DVec3, b: glam::DVec3, c: glam::DVec3| crate::math::angle_between(b - a, c - a);
         // As the model's mesh will have them: the edges whose ends sewing
         // puts on one model node collapsed.
         let mut tris = m.tris.clone();
@@ -579,10 +578,7 @@ fn rebuild_loses(
         });
         let mut a: Vec<f64> = tris
             .iter()
-            .map(|t| {
-                let [p, q, r] = t.map(|v| m.pos.get(v as usize).copied().unwrap_or_default());
-                corner(p, q, r).min(corner(q, r, p)).min(corner(r, p, q))
-            })
+            .map(|t| crate::mesh::min_angle(t.map(|v| m.pos.get(v as usize).copied().unwrap_or_default())))
             .collect();
         a.sort_by(f64::total_cmp);
         a.get(a.len().saturating_sub(1) / 100).map_or(0.0, |x| x.to_degrees())

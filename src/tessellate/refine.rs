@@ -397,17 +397,14 @@ impl WorkMesh {
             // sees from its side. Else every triangle on the other side of
             // a crease was split down to a tenth of the tolerance.
             let centre = (uv[0] + uv[1] + uv[2]) / 3.0;
-            let inside = |k: usize| {
+            let inside: [Option<DVec3>; 3] = core::array::from_fn(|k| {
                 [1e-6, 1e-4, 1e-2].iter().find_map(|f| regular_normal(&surface.derivs(uv[k] + (centre - uv[k]) * *f)))
-            };
-            if let (Some(a), Some(b), Some(c)) = (inside(0), inside(1), inside(2)) {
-                n = [a, b, c];
-            } else {
-                for k in 0..3 {
-                    if regular_normal(&surface.derivs(uv[k])).is_none() {
-                        if let Some(l) = inside(k) {
-                            n[k] = l;
-                        }
+            });
+            let all = inside.iter().all(Option::is_some);
+            for k in 0..3 {
+                if let Some(l) = inside[k] {
+                    if all || regular_normal(&surface.derivs(uv[k])).is_none() {
+                        n[k] = l;
                     }
                 }
             }

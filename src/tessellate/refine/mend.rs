@@ -100,14 +100,7 @@ impl WorkMesh {
         let mut changed = Vec::new();
         // Only thin triangles are worth a flip; the edge table is built
         // for faces that have some.
-        let p = |x: u32| self.pos[x as usize];
-        let thin = |t: &[u32; 3]| {
-            let angle = |k: usize| {
-                let at = p(t[k]);
-                crate::math::angle_between(p(t[(k + 1) % 3]) - at, p(t[(k + 2) % 3]) - at)
-            };
-            angle(0).min(angle(1)).min(angle(2)) < THIN
-        };
+        let thin = |t: &[u32; 3]| crate::mesh::min_angle(t.map(|v| self.pos[v as usize])) < THIN;
         let mut todo: Vec<u32> = (0..self.tris.len() as u32).filter(|&t| thin(&self.tris[t as usize])).collect();
         if todo.is_empty() || self.tris.len() < 2 {
             return changed;
@@ -146,7 +139,7 @@ impl WorkMesh {
             for k in 0..3 {
                 let (ga, gb) = (self.gid[t[k] as usize], self.gid[t[(k + 1) % 3] as usize]);
                 if ga != NONE && gb != NONE {
-                    taken.insert((ga.min(gb), ga.max(gb)));
+                    taken.insert(key(ga, gb));
                 }
             }
         }
@@ -172,7 +165,7 @@ impl WorkMesh {
         let cv = self.tris[t as usize].into_iter().find(|&x| x != a && x != b)?;
         let d = self.tris[u as usize].into_iter().find(|&x| x != a && x != b)?;
         let (gc, gd) = (self.gid[cv as usize], self.gid[d as usize]);
-        let across = (gc != NONE && gd != NONE).then(|| (gc.min(gd), gc.max(gd)));
+        let across = (gc != NONE && gd != NONE).then(|| key(gc, gd));
         if across.is_some_and(|e| gc == gd || taken.contains(&e)) {
             return None;
         }
@@ -181,7 +174,7 @@ impl WorkMesh {
         if angle(cv, a, b) + angle(d, a, b) <= core::f64::consts::PI * (1.0 + 1e-9) {
             return None;
         }
-        let least = |x: u32, y: u32, z: u32| angle(x, y, z).min(angle(y, z, x)).min(angle(z, x, y));
+        let least = |x: u32, y: u32, z: u32| crate::mesh::min_angle([p(x), p(y), p(z)]);
         let before = least(a, b, cv).min(least(b, a, d));
         if before >= THIN {
             return None;
