@@ -1,6 +1,8 @@
 //! Tessellation of trimmed surfaces within a verified tolerance (paper 000).
 
 #[cfg(feature = "std")]
+mod band;
+#[cfg(feature = "std")]
 mod cdt;
 mod collapse;
 mod face;

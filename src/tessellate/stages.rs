@@ -6,7 +6,8 @@
 use alloc::vec::Vec;
 use glam::DVec2;
 
-use super::face::{build_full_grid, check_grid, grid, Band};
+use super::band::Band;
+use super::face::{build_full_grid, check_grid, grid};
 use super::refine::WorkMesh;
 use super::trim::{prepare_loops, Loops};
 use super::{setup, Setup};
