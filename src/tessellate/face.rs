@@ -222,6 +222,8 @@ pub(crate) fn mesh_face<'a>(
         // those the model's mesh would have.
         let flipped = wm.improve_angles(&face.surface, crit, &mut crate::collections::HashSet::default());
         wm.forget(&flipped);
+        let lifted = wm.lift_angles(&face.surface, crit);
+        wm.forget(&lifted);
         let outcome = wm.outcome(&face.surface, crit);
         Ok(FaceResult { mesh: wm, outcome, outline: Some(unsewn) })
     }

@@ -195,6 +195,25 @@ pub fn mesh_model_with_progress(
                         }
                     }
                 }
+                if why.is_some() && auto {
+                    // Fewer triangles but needles: the lighter mesh spends
+                    // the difference on them.
+                    let lighter = match &free_run {
+                        Some(free) if tris_of(&free.0) < tris_of(&capped.0) => free,
+                        _ => &capped,
+                    };
+                    if let (Ok(old), (Ok(new), l, c)) = (&orig, lighter) {
+                        if new.mesh.tris.len() < old.mesh.tris.len() {
+                            let goal = (p1(&old.mesh) + 1.0).to_radians();
+                            let c = refine::Criteria { lift: refine::Lift { goal, most: old.mesh.tris.len() }, ..*c };
+                            let mut r = face::mesh_face(index, f, f_loops, l, &c, trial, auto_tight);
+                            if rebuild_loses(&r, &orig).is_none() {
+                                (why, face_lim, face_crit) = (None, *l, c);
+                                made.extend(outline_of(&mut r).map(|o| (f, *l, o)));
+                            }
+                        }
+                    }
+                }
                 if let Some(why) = why {
                     report.warnings.push(format!("face {index}: {why}; meshed the original"));
                     if let Some(r) = report.reparameterized.iter_mut().find(|r| r.face == index) {
@@ -311,6 +330,11 @@ pub fn mesh_model_with_progress(
     for w in works.iter_mut() {
         let changed = w.mesh.improve_angles(w.surface, &w.crit, &mut taken);
         w.mesh.forget(&changed);
+        #[cfg(feature = "std")]
+        {
+            let lifted = w.mesh.lift_angles(w.surface, &w.crit);
+            w.mesh.forget(&lifted);
+        }
         w.mesh.rest();
     }
     drop(taken);
@@ -555,6 +579,25 @@ fn shorter_edges<'x>(
     None
 }
 
+/// The 1st-percentile smallest angle of a trial mesh, degrees, as the
+/// model's mesh will have it: the edges whose ends sewing puts on one model
+/// node collapsed.
+fn p1(m: &refine::WorkMesh) -> f64 {
+    let mut tris = m.tris.clone();
+    let pos = |v: u32| m.pos.get(v as usize).copied();
+    let gid = |v: u32| m.gid.get(v as usize).copied().unwrap_or(u32::MAX);
+    collapse::collapse_edges(&mut tris, |a, b| {
+        (gid(a) == gid(b) && gid(a) != u32::MAX)
+            || matches!((pos(a), pos(b)), (Some(p), Some(q)) if collapse::one_point(p, q))
+    });
+    let mut a: Vec<f64> = tris
+        .iter()
+        .map(|t| crate::mesh::min_angle(t.map(|v| m.pos.get(v as usize).copied().unwrap_or_default())))
+        .collect();
+    a.sort_by(f64::total_cmp);
+    a.get(a.len().saturating_sub(1) / 100).map_or(0.0, |x| x.to_degrees())
+}
+
 /// Why the mesh of a rebuilt face loses to the original's, if it does: it
 /// failed or is empty, is not proven where the original is, has more
 /// triangles, or a smaller 1st-percentile angle. `None` keeps the rebuild.
@@ -568,23 +611,6 @@ fn rebuild_loses(
         Err(e) => return Some(format!("the rebuilt face did not mesh ({e})")),
     };
     let old = original.as_ref().ok()?;
-    let p1 = |m: &refine::WorkMesh| {
-        // As the model's mesh will have them: the edges whose ends sewing
-        // puts on one model node collapsed.
-        let mut tris = m.tris.clone();
-        let pos = |v: u32| m.pos.get(v as usize).copied();
-        let gid = |v: u32| m.gid.get(v as usize).copied().unwrap_or(u32::MAX);
-        collapse::collapse_edges(&mut tris, |a, b| {
-            (gid(a) == gid(b) && gid(a) != u32::MAX)
-                || matches!((pos(a), pos(b)), (Some(p), Some(q)) if collapse::one_point(p, q))
-        });
-        let mut a: Vec<f64> = tris
-            .iter()
-            .map(|t| crate::mesh::min_angle(t.map(|v| m.pos.get(v as usize).copied().unwrap_or_default())))
-            .collect();
-        a.sort_by(f64::total_cmp);
-        a.get(a.len().saturating_sub(1) / 100).map_or(0.0, |x| x.to_degrees())
-    };
     let (nt, ot) = (new.mesh.tris.len(), old.mesh.tris.len());
     if new.outcome.unproven > old.outcome.unproven {
         Some(format!("the rebuilt face left {} triangles unproven", new.outcome.unproven))
@@ -631,7 +657,14 @@ fn setup(model: &Model, options: &MeshOptions) -> Result<Setup, Error> {
     let max_edge = options.max_edge.unwrap_or(f64::INFINITY);
     let aim = tol * options.safety;
     let lim = params::Limits { tol: aim, angle: options.angle, max_edge, min_edge };
-    let crit = refine::Criteria { tol: aim, angle: options.angle, max_edge, min_edge, steps: options.measure_steps };
+    let crit = refine::Criteria {
+        tol: aim,
+        angle: options.angle,
+        max_edge,
+        min_edge,
+        steps: options.measure_steps,
+        lift: refine::Lift::NONE,
+    };
     Ok(Setup { tol, diag, lim, crit })
 }
 

@@ -12,6 +12,8 @@ use crate::math::angle_between;
 use crate::nurbs::{project_to_surface, regular_normal, NurbsCurve, Surface};
 
 mod edges;
+#[cfg(feature = "std")]
+mod lift;
 mod mend;
 
 pub(crate) use edges::EdgeList;
@@ -135,6 +137,24 @@ pub(crate) struct Criteria {
     pub max_edge: f64,
     pub min_edge: f64,
     pub steps: usize,
+    /// Beyond the limits: needles an auto rebuild mends with its spare
+    /// triangles (the CDT's faces only, so read with `std` alone).
+    #[cfg_attr(not(feature = "std"), allow(dead_code))]
+    pub lift: Lift,
+}
+
+/// The smallest angle a lift aims at and the triangles the face may reach
+/// doing it (none when `goal` is 0); see `refine/lift.rs`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct Lift {
+    /// Radians.
+    pub goal: f64,
+    pub most: usize,
+}
+
+impl Lift {
+    /// No lift.
+    pub const NONE: Lift = Lift { goal: 0.0, most: 0 };
 }
 
 impl Criteria {

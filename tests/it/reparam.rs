@@ -356,6 +356,10 @@ fn reparam_flagged_corpus_faces_win() {
     // A tip whose pole's two loop ends sewing puts on one point: its rebuild
     // is judged, as the model's mesh has it, without the triangle between them.
     rows.push(("trj6_pm4-ec-203.stp", 309, 1e-3));
+    // The same tip at 1e-2: its rebuild takes a tenth of the triangles, but
+    // long ones fanned onto a ring of tiny edges at the pole; some of the
+    // difference goes to Delaunay refinement of those needles (see `lift_angles`).
+    rows.push(("trj6_pm4-ec-203.stp", 309, 1e-2));
     let mut tols = std::collections::HashMap::new();
     let mut models = std::collections::HashMap::new();
     for (file, index, rel) in rows {
@@ -447,14 +451,15 @@ fn sews_part(m: &Model, faces: &[usize], least: usize) {
 /// at its model's tolerance: `auto` falls back to the original with a
 /// warning and meshes exactly what `off` does. asmo_car's face 2 at 1e-3
 /// is a thin quad that both mesh in 2 triangles on the same 4 corners, so
-/// the angles tie; trj6's face 309 at 1e-2 is a tip whose rebuild meshes
-/// in a tenth of the triangles, but its few long ones reach a cluster of
-/// tiny borders at the pole in slivers, and face 774's rebuild runs
-/// out of the original's triangles before it is within tolerance.
+/// the angles tie; trj6's face 653 at 1e-2 is a fillet's tip whose rebuild
+/// fans long triangles onto tiny borders, thinner than the original's, and
+/// with 6 triangles to spare no vertex inside them stays unfolded on the
+/// curved surface; face 774's rebuild runs out of the original's triangles
+/// before it is within tolerance.
 #[test]
 fn reparam_losing_corpus_faces_mesh_as_off() {
     for (file, index, rel) in
-        [("asmo_car.igs", 2, 1e-3), ("trj6_pm4-ec-203.stp", 309, 1e-2), ("trj6_pm4-ec-203.stp", 774, 1e-3)]
+        [("asmo_car.igs", 2, 1e-3), ("trj6_pm4-ec-203.stp", 653, 1e-2), ("trj6_pm4-ec-203.stp", 774, 1e-3)]
     {
         let Some(m) = corpus(file) else {
             println!("{file}: corpus not found, skipped");

@@ -197,7 +197,7 @@ impl WorkMesh {
     }
 
     /// Flips edge `a-b` of triangle `t` (where `t` runs a→b) if the result is better; see [`Self::repair_inverted`].
-    fn try_flip(&mut self, surface: &dyn Surface, c: &Criteria, t: u32, a: u32, b: u32) -> Option<u32> {
+    pub(super) fn try_flip(&mut self, surface: &dyn Surface, c: &Criteria, t: u32, a: u32, b: u32) -> Option<u32> {
         if self.trim.contains_key(&key(a, b)) {
             return None;
         }
@@ -313,7 +313,7 @@ impl WorkMesh {
     /// Whether triangle `t`'s normal turn passes: within the angle limit, or
     /// too short to split for it ([`Criteria::short_for_angle`]), so a repair
     /// that unfolds such a triangle is not refused for a turn refinement keeps too.
-    fn turn_ok(&self, c: &Criteria, m: &TriMeasure, turn: f64, t: u32) -> bool {
+    pub(super) fn turn_ok(&self, c: &Criteria, m: &TriMeasure, turn: f64, t: u32) -> bool {
         turn <= c.angle || c.short_for_angle(m, turn, self.longest_edge(t as usize).2)
     }
 
@@ -395,7 +395,7 @@ impl WorkMesh {
 
     /// Takes back the last triangle added.
     #[cfg(feature = "std")]
-    fn pop_triangle(&mut self) {
+    pub(super) fn pop_triangle(&mut self) {
         self.wake();
         let Some(&v) = self.tris.last() else { return };
         let t = (self.tris.len() - 1) as u32;
@@ -411,7 +411,7 @@ impl WorkMesh {
 
     /// Takes back the vertices from `n` on.
     #[cfg(feature = "std")]
-    fn truncate_vertices(&mut self, n: usize) {
+    pub(super) fn truncate_vertices(&mut self, n: usize) {
         self.pos.truncate(n);
         self.normal.truncate(n);
         self.gid.truncate(n);

@@ -92,7 +92,7 @@ fn a_face_split_at_rest_wakes_as_if_it_never_slept() {
     assert_eq!(rested.tris, awake.tris);
     rested.wake();
     assert_eq!(edge_table(&rested), edge_table(&awake));
-    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 0.3, min_edge: 0.0, steps: 2 };
+    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 0.3, min_edge: 0.0, steps: 2, lift: Lift::NONE };
     awake.refine(&s, &[], &c, 100_000);
     rested.refine(&s, &[], &c, 100_000);
     assert!(awake.tris.len() > 400);
@@ -122,7 +122,7 @@ fn refined_corners_keep_their_vertices_uv() {
     }
     m.add_triangle([0, 1, 2], [at(-8.0, -8.0), at(8.0, -8.0), at(8.0, 8.0)]);
     m.add_triangle([0, 2, 3], [at(-8.0, -8.0), at(8.0, 8.0), at(-8.0, 8.0)]);
-    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 1.0, min_edge: 0.0, steps: 2 };
+    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 1.0, min_edge: 0.0, steps: 2, lift: Lift::NONE };
     m.refine(&s, &[], &c, 100_000);
     assert!(m.tris.len() > 500);
     for t in 0..m.tris.len() {
@@ -161,7 +161,7 @@ fn thin_pair_is_flipped_to_its_better_diagonal() {
             .fold(f64::INFINITY, f64::min)
     };
     let s = plane();
-    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 10.0, min_edge: 0.0, steps: 2 };
+    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 10.0, min_edge: 0.0, steps: 2, lift: Lift::NONE };
     let mut m = quad();
     let before = least(&m);
     let changed = m.improve_angles(&s, &c, &mut crate::collections::HashSet::default());
@@ -177,4 +177,58 @@ fn thin_pair_is_flipped_to_its_better_diagonal() {
     taken.insert((7, 9));
     assert!(m.improve_angles(&s, &c, &mut taken).is_empty());
     assert_eq!(m.tris[0], [0, 1, 2]);
+}
+
+/// Needles fanned from a ring of tiny edges to a far border (as around a
+/// pole): the lift refines them by circumcentres and flips until the
+/// thinnest triangle is far wider, keeps the border's edges as they were,
+/// never folds a triangle, covers the same area, and stops at its budget.
+#[cfg(feature = "std")]
+#[test]
+fn lift_mends_a_fan_of_needles_within_its_budget() {
+    let fan = || {
+        let mut m = WorkMesh::default();
+        let ring = |r: f64, deg: f64| (r * deg.to_radians().cos(), r * deg.to_radians().sin());
+        // The centre, 6 ring vertices 0.01 out, 12 border vertices 9 out.
+        let mut pts = alloc::vec![(0.0, 0.0)];
+        pts.extend((0..6).map(|k| ring(0.01, 60.0 * k as f64)));
+        pts.extend((0..12).map(|j| ring(9.0, 30.0 * j as f64)));
+        for p in &pts {
+            m.add_vertex(DVec3::new(p.0, p.1, 0.0), DVec3::Z);
+        }
+        let (h, o) = (|k: u32| 1 + k % 6, |j: u32| 7 + j % 12);
+        let w = |v: u32| at(pts[v as usize].0, pts[v as usize].1);
+        for k in 0..6 {
+            for v in [[0, h(k), h(k + 1)], [h(k), o(2 * k), o(2 * k + 1)], [h(k), o(2 * k + 1), h(k + 1)]] {
+                m.add_triangle(v, v.map(w));
+            }
+            let v = [o(2 * k + 1), o(2 * k + 2), h(k + 1)];
+            m.add_triangle(v, v.map(w));
+        }
+        m
+    };
+    let least = |m: &WorkMesh| (0..m.tris.len() as u32).map(|t| m.least_angle(t)).fold(f64::INFINITY, f64::min);
+    let uv_area = |m: &WorkMesh, t: usize| {
+        let w = m.uv(t);
+        0.5 * (w[1] - w[0]).perp_dot(w[2] - w[0])
+    };
+    let s = plane();
+    let lift = Lift { goal: 25f64.to_radians(), most: 600 };
+    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 100.0, min_edge: 0.0, steps: 2, lift };
+    let mut m = fan();
+    let n = m.tris.len();
+    let (before, border, area) = (least(&m), m.boundary_edges(), (0..n).map(|t| uv_area(&m, t)).sum::<f64>());
+    assert!(before < 0.1f64.to_radians());
+    let changed = m.lift_angles(&s, &c);
+    assert!(!changed.is_empty());
+    assert!(m.tris.len() <= 600, "{}", m.tris.len());
+    assert!(least(&m) > 10f64.to_radians(), "{}° from {}°", least(&m).to_degrees(), before.to_degrees());
+    assert_eq!(m.boundary_edges(), border);
+    assert!((0..m.tris.len()).all(|t| uv_area(&m, t) > 0.0 && !m.inverted(&s, t)));
+    let after: f64 = (0..m.tris.len()).map(|t| uv_area(&m, t)).sum();
+    assert!((after - area).abs() <= 1e-9 * area, "{after} against {area}");
+    // A budget of 4 more triangles is kept.
+    let mut m = fan();
+    m.lift_angles(&s, &Criteria { lift: Lift { most: n + 4, ..lift }, ..c });
+    assert!(m.tris.len() <= n + 4, "{}", m.tris.len());
 }
