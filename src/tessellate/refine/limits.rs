@@ -1,0 +1,102 @@
+//! What refinement holds a triangle to ([`Criteria`]), what it reports
+//! ([`Outcome`]), and the 12-byte cache of each triangle's measure.
+
+use super::TriMeasure;
+
+/// Limits a triangle must meet.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Criteria {
+    pub tol: f64,
+    pub angle: f64,
+    pub max_edge: f64,
+    pub min_edge: f64,
+    pub steps: usize,
+    /// Beyond the limits: needles an auto rebuild mends with its spare
+    /// triangles (the CDT's faces only, so read with `std` alone).
+    #[cfg_attr(not(feature = "std"), allow(dead_code))]
+    pub lift: Lift,
+}
+
+/// The smallest angle a lift aims at and the triangles the face may reach
+/// doing it (none when `goal` is 0); see `refine/lift.rs`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct Lift {
+    /// Radians.
+    pub goal: f64,
+    pub most: usize,
+}
+
+impl Lift {
+    /// No lift.
+    pub const NONE: Lift = Lift { goal: 0.0, most: 0 };
+}
+
+impl Criteria {
+    /// Whether a triangle that fails only the angle limit is too short to
+    /// split for it: across a fold or crease of the surface the normal turns
+    /// by up to 180° however small the triangle, and splitting down to
+    /// `min_edge` there only breeds millions of triangles (a folded patch
+    /// took 3.9M triangles and two minutes). Detail a tenth of the tolerance
+    /// wide cannot be seen within the tolerance anyway.
+    pub fn short_for_angle(&self, m: &TriMeasure, turn: f64, len: f64) -> bool {
+        m.max <= self.tol && len <= self.max_edge && turn > self.angle && len <= 0.1 * self.tol
+    }
+}
+
+/// Per-triangle results after refinement.
+#[derive(Debug, Default)]
+pub(crate) struct Outcome {
+    /// Largest measured distance over the triangles.
+    pub max: f64,
+    /// Sum and number of the distance samples, for the mean.
+    pub sum: f64,
+    pub count: u64,
+    /// Largest normal turn across a triangle.
+    pub max_turn: f64,
+    /// Triangles left failing because the budget ran out or their edges hit `min_edge`.
+    pub unproven: usize,
+    /// Triangles within the tolerance that turn more than the angle limit but
+    /// are too short to split for it ([`Criteria::short_for_angle`]).
+    pub creased: usize,
+}
+
+/// A triangle's cached measure in 12 bytes: the largest distance and the
+/// normal turn rounded up to `f32` (a cached triangle never looks better than
+/// it measured, and the report never understates), the distance sum to the
+/// nearest. Every face's cache is held until the model is assembled.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Packed {
+    pub(super) max: f32,
+    sum: f32,
+    turn: f32,
+}
+
+/// A measure cache slot to be filled: a measured largest distance is never
+/// NaN (it starts at 0 and `f64::max` passes over NaN samples).
+pub(super) const STALE: Packed = Packed { max: f32::NAN, sum: 0.0, turn: 0.0 };
+
+/// The least `f32` not below `x`.
+fn up(x: f64) -> f32 {
+    let y = x as f32;
+    if f64::from(y) >= x || y.is_nan() {
+        return y;
+    }
+    // The next f32 towards +inf (`f32::next_up` is newer than the MSRV).
+    if y == 0.0 {
+        f32::from_bits(1)
+    } else if y > 0.0 {
+        f32::from_bits(y.to_bits() + 1)
+    } else {
+        f32::from_bits(y.to_bits() - 1)
+    }
+}
+
+impl Packed {
+    pub(super) fn pack(m: TriMeasure, turn: f64) -> Self {
+        Self { max: up(m.max), sum: m.sum as f32, turn: up(turn) }
+    }
+
+    pub(super) fn unpack(self) -> (TriMeasure, f64) {
+        (TriMeasure { max: f64::from(self.max), sum: f64::from(self.sum) }, f64::from(self.turn))
+    }
+}
