@@ -310,14 +310,7 @@ mod tests {
         crate::nurbs::analytic::xy_plane(20.0)
     }
 
-    const CRIT: Criteria = Criteria {
-        tol: 0.1,
-        angle: 0.5,
-        max_edge: f64::INFINITY,
-        min_edge: 0.0,
-        steps: 4,
-        lift: crate::tessellate::refine::Lift::NONE,
-    };
+    const CRIT: Criteria = Criteria::PLANE_TEST;
 
     /// A face on the plane: its points with their model node ids (`NONE`
     /// inside) and its triangles, counter-clockwise.

@@ -556,14 +556,7 @@ mod tests {
     }
 
     /// The limits the test faces are held to.
-    const CRIT: Criteria = Criteria {
-        tol: 0.1,
-        angle: 0.5,
-        max_edge: f64::INFINITY,
-        min_edge: 0.0,
-        steps: 4,
-        lift: crate::tessellate::refine::Lift::NONE,
-    };
+    const CRIT: Criteria = Criteria::PLANE_TEST;
 
     /// One triangle on the plane z = 0 (u = x, v = y), its vertex `node` the model node 7.
     fn face(corners: [(f64, f64); 3], node: usize) -> WorkMesh {

@@ -191,13 +191,7 @@ impl WorkMesh {
         self.add_triangle([r, a, x], [ur, ua, uv]);
         self.measure_slots();
         self.measures[t as usize] = STALE;
-        let good = [t, t2, t2 + 1].iter().all(|&y| {
-            let (m, turn) = self.measure(surface, y as usize, c);
-            area(self.uv(y as usize)) * sense > 0.0
-                && !self.inverted(surface, y as usize)
-                && m.max <= c.tol
-                && self.turn_ok(c, &m, turn, y)
-        });
+        let good = [t, t2, t2 + 1].iter().all(|&y| self.holds(surface, c, y, sense));
         if good {
             return Some(alloc::vec![(t, a, b), (t2, b, r), (t2 + 1, r, a)]);
         }

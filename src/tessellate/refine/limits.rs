@@ -31,6 +31,13 @@ impl Lift {
     pub const NONE: Lift = Lift { goal: 0.0, most: 0 };
 }
 
+#[cfg(test)]
+impl Criteria {
+    /// The limits unit tests hold their faces on a plane to.
+    pub const PLANE_TEST: Criteria =
+        Criteria { tol: 0.1, angle: 0.5, max_edge: f64::INFINITY, min_edge: 0.0, steps: 4, lift: Lift::NONE };
+}
+
 impl Criteria {
     /// Whether a triangle that fails only the angle limit is too short to
     /// split for it: across a fold or crease of the surface the normal turns

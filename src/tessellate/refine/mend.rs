@@ -295,19 +295,25 @@ impl WorkMesh {
             m.move_uv(x, &ring, q);
         };
         set(self, new_uv, surface.point(new_uv), surface.normal(new_uv));
-        let good = ring.iter().all(|&t| {
-            let (m, turn) = self.measure(surface, t as usize, c);
-            area(self.uv(t as usize)) * sense > 0.0
-                && !self.inverted(surface, t as usize)
-                && m.max <= c.tol
-                && self.turn_ok(c, &m, turn, t)
-        });
+        let good = ring.iter().all(|&t| self.holds(surface, c, t, sense));
         if good {
             Some(ring)
         } else {
             set(self, old_uv, old_p, old_n);
             None
         }
+    }
+
+    /// Whether triangle `t`, just changed, keeps the (u,v) orientation
+    /// `sense` (the sign of a (u,v) area), faces the surface's way and passes
+    /// the deviation and turn limits.
+    pub(super) fn holds(&self, surface: &dyn Surface, c: &Criteria, t: u32, sense: f64) -> bool {
+        let w = self.uv(t as usize);
+        let (m, turn) = self.measure(surface, t as usize, c);
+        (w[1] - w[0]).perp_dot(w[2] - w[0]) * sense > 0.0
+            && !self.inverted(surface, t as usize)
+            && m.max <= c.tol
+            && self.turn_ok(c, &m, turn, t)
     }
 
     /// Whether triangle `t`'s normal turn passes: within the angle limit, or
