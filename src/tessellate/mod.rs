@@ -170,6 +170,11 @@ pub fn mesh_model_with_progress(
                         free_run = Some((free, l, c));
                     }
                 }
+                // The lighter of the capped and the free mesh.
+                let lighter = match &free_run {
+                    Some(free) if tris_of(&free.0) < tris_of(&capped.0) => free,
+                    _ => &capped,
+                };
                 if why.is_some() && auto {
                     // Shorter edges start from the capped mesh (the free one
                     // where it failed) at half its longest edge, then from
@@ -178,10 +183,6 @@ pub fn mesh_model_with_progress(
                     // repeat the tries that already failed.
                     let first = match (&capped.0, &free_run) {
                         (Err(_), Some(free)) => free,
-                        _ => &capped,
-                    };
-                    let lighter = match &free_run {
-                        Some(free) if tris_of(&free.0) < tris_of(&capped.0) => free,
                         _ => &capped,
                     };
                     let again = if core::ptr::eq(first, lighter) { 1 } else { SHORTER_TRIES };
@@ -196,22 +197,10 @@ pub fn mesh_model_with_progress(
                     }
                 }
                 if why.is_some() && auto {
-                    // Fewer triangles but needles: the lighter mesh spends
-                    // the difference on them.
-                    let lighter = match &free_run {
-                        Some(free) if tris_of(&free.0) < tris_of(&capped.0) => free,
-                        _ => &capped,
-                    };
-                    if let (Ok(old), (Ok(new), l, c)) = (&orig, lighter) {
-                        if new.mesh.tris.len() < old.mesh.tris.len() {
-                            let goal = (p1(&old.mesh) + 1.0).to_radians();
-                            let c = refine::Criteria { lift: refine::Lift { goal, most: old.mesh.tris.len() }, ..*c };
-                            let mut r = face::mesh_face(index, f, f_loops, l, &c, trial, auto_tight);
-                            if rebuild_loses(&r, &orig).is_none() {
-                                (why, face_lim, face_crit) = (None, *l, c);
-                                made.extend(outline_of(&mut r).map(|o| (f, *l, o)));
-                            }
-                        }
+                    let (_, l, _) = *lighter;
+                    if let Some((c, o)) = lift_needles(index, (f, f_loops), lighter, &orig, trial, auto_tight) {
+                        (why, face_lim, face_crit) = (None, l, c);
+                        made.extend(o.map(|o| (f, l, o)));
                     }
                 }
                 if let Some(why) = why {
@@ -577,6 +566,31 @@ fn shorter_edges<'x>(
         edge *= core::f64::consts::FRAC_1_SQRT_2;
     }
     None
+}
+
+/// Beyond paper 001: a rebuilt face whose mesh `(rebuilt, lim, crit)`
+/// takes fewer triangles than the original's but loses on shape (needles
+/// fanned onto tiny edges) spends the difference on Delaunay refinement of
+/// its triangles under the original's 1st-percentile angle + 1°
+/// (`refine/lift.rs`); the limits of the mesh if it then wins, and its
+/// unsewn outline.
+fn lift_needles<'x>(
+    index: usize,
+    (face, loops): (&'x crate::Face, &'x [crate::TrimLoop]),
+    (rebuilt, lim, crit): &(Result<face::FaceResult<'_>, Error>, params::Limits, refine::Criteria),
+    original: &Result<face::FaceResult<'_>, Error>,
+    budget: usize,
+    tight: f64,
+) -> Option<(refine::Criteria, Option<face::Outline<'x>>)> {
+    let (Ok(new), Ok(old)) = (rebuilt, original) else { return None };
+    let most = old.mesh.tris.len();
+    if new.mesh.tris.len() >= most {
+        return None;
+    }
+    let goal = (p1(&old.mesh) + 1.0).to_radians();
+    let c = refine::Criteria { lift: refine::Lift { goal, most }, ..*crit };
+    let mut r = face::mesh_face(index, face, loops, lim, &c, budget, tight);
+    rebuild_loses(&r, original).is_none().then(|| (c, outline_of(&mut r)))
 }
 
 /// The 1st-percentile smallest angle of a trial mesh, degrees, as the

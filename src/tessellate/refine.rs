@@ -338,6 +338,11 @@ impl WorkMesh {
         (m, turn)
     }
 
+    /// Triangle `t`'s smallest angle in space.
+    pub(crate) fn least_angle(&self, t: u32) -> f64 {
+        crate::mesh::min_angle(self.tris[t as usize].map(|v| self.pos[v as usize]))
+    }
+
     fn longest_edge(&self, t: usize) -> (u32, u32, f64) {
         let v = self.tris[t];
         let mut best = (v[0], v[1], -1.0);

@@ -73,11 +73,6 @@ impl WorkMesh {
         changed
     }
 
-    /// Triangle `t`'s smallest angle in space.
-    pub(super) fn least_angle(&self, t: u32) -> f64 {
-        crate::mesh::min_angle(self.tris[t as usize].map(|v| self.pos[v as usize]))
-    }
-
     /// Puts a vertex at triangle `t`'s circumcentre in space (the surface's
     /// point nearest it) into the triangle whose (u,v) holds it, found by a
     /// walk from `t` across inner edges; returns the three triangles around
@@ -109,8 +104,8 @@ impl WorkMesh {
         let hv = self.tris[home as usize];
         let encroaches = (0..3).any(|k| {
             let (a, b) = (hv[k], hv[(k + 1) % 3]);
-            let border = self.trim.contains_key(&key(a, b)) || self.edges.get(&key(a, b)).is_none_or(|e| e[1] == NONE);
-            border && (self.pos[a as usize] - x).dot(self.pos[b as usize] - x) < 0.0
+            (self.trim.contains_key(&key(a, b)) || self.is_border(a, b))
+                && (self.pos[a as usize] - x).dot(self.pos[b as usize] - x) < 0.0
         });
         if encroaches {
             return None;
@@ -229,9 +224,7 @@ impl WorkMesh {
             }
             let Some(x) = self.tris[t as usize].into_iter().find(|&v| v != a && v != b) else { continue };
             let Some(d) = self.tris[u as usize].into_iter().find(|&v| v != a && v != b) else { continue };
-            let p = |v: u32| self.pos[v as usize];
-            let angle = |at: u32, y: u32, z: u32| crate::math::angle_between(p(y) - p(at), p(z) - p(at));
-            if angle(x, a, b) + angle(d, a, b) <= core::f64::consts::PI * (1.0 + 1e-9) {
+            if !self.not_delaunay(a, b, x, d) {
                 continue;
             }
             flips -= 1;

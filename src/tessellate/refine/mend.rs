@@ -100,8 +100,7 @@ impl WorkMesh {
         let mut changed = Vec::new();
         // Only thin triangles are worth a flip; the edge table is built
         // for faces that have some.
-        let thin = |t: &[u32; 3]| crate::mesh::min_angle(t.map(|v| self.pos[v as usize])) < THIN;
-        let mut todo: Vec<u32> = (0..self.tris.len() as u32).filter(|&t| thin(&self.tris[t as usize])).collect();
+        let mut todo: Vec<u32> = (0..self.tris.len() as u32).filter(|&t| self.least_angle(t) < THIN).collect();
         if todo.is_empty() || self.tris.len() < 2 {
             return changed;
         }
@@ -169,11 +168,10 @@ impl WorkMesh {
         if across.is_some_and(|e| gc == gd || taken.contains(&e)) {
             return None;
         }
-        let p = |x: u32| self.pos[x as usize];
-        let angle = |at: u32, x: u32, y: u32| crate::math::angle_between(p(x) - p(at), p(y) - p(at));
-        if angle(cv, a, b) + angle(d, a, b) <= core::f64::consts::PI * (1.0 + 1e-9) {
+        if !self.not_delaunay(a, b, cv, d) {
             return None;
         }
+        let p = |x: u32| self.pos[x as usize];
         let least = |x: u32, y: u32, z: u32| crate::mesh::min_angle([p(x), p(y), p(z)]);
         let before = least(a, b, cv).min(least(b, a, d));
         if before >= THIN {
@@ -181,6 +179,20 @@ impl WorkMesh {
         }
         let after = least(a, d, cv).min(least(d, b, cv));
         (after > 2.0 * before).then_some((u, across))
+    }
+
+    /// Whether the pair of triangles on edge `a-b`, with third corners `x`
+    /// and `y`, is not Delaunay in space: their angles facing the edge sum
+    /// past 180°.
+    pub(super) fn not_delaunay(&self, a: u32, b: u32, x: u32, y: u32) -> bool {
+        let p = |v: u32| self.pos[v as usize];
+        let angle = |at: u32| crate::math::angle_between(p(a) - p(at), p(b) - p(at));
+        let limit = core::f64::consts::PI * (1.0 + 1e-9);
+        // Not "at most 180°", so that a pair with a NaN angle counts as not Delaunay.
+        !matches!(
+            (angle(x) + angle(y)).partial_cmp(&limit),
+            Some(core::cmp::Ordering::Less | core::cmp::Ordering::Equal)
+        )
     }
 
     /// Of triangles `ts`, how many fold against the surface or exceed the
