@@ -15,6 +15,7 @@ mod refine;
 mod sew;
 #[cfg(feature = "std")]
 pub mod stages;
+mod trial;
 #[cfg(feature = "std")]
 mod trim;
 
@@ -26,6 +27,7 @@ use crate::mesh::{angle_stats, edge_counts_in_bodies, FaceRange};
 use crate::nurbs::{Aabb, Surface};
 use crate::reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
 use crate::{Error, Mesh, Model, Report};
+use trial::{lift_needles, outline_of, rebuild_loses, shorter_edges, tris_of, SHORTER_TRIES};
 
 pub use options::{share_of_faces, MeshMode, MeshOptions, OptionsError, Tolerance};
 
@@ -504,140 +506,6 @@ fn face_loops<'x>(
         (false, _) => &g.loops,
         (true, true) => domain,
         (true, false) => rebuilt_domain,
-    }
-}
-
-/// The unsewn outline a trial mesh made, taken out of it.
-fn outline_of<'x>(r: &mut Result<face::FaceResult<'x>, Error>) -> Option<face::Outline<'x>> {
-    r.as_mut().ok().and_then(|r| r.outline.take())
-}
-
-/// The triangles of a trial mesh (`usize::MAX` when it failed).
-fn tris_of(r: &Result<face::FaceResult<'_>, Error>) -> usize {
-    r.as_ref().map_or(usize::MAX, |r| r.mesh.tris.len())
-}
-
-/// Most meshes [`shorter_edges`] tries.
-const SHORTER_TRIES: usize = 6;
-
-/// Beyond paper 001: a rebuilt face whose mesh `rebuilt` takes fewer
-/// triangles than the original's but loses on shape (a thin face meshed by
-/// few long triangles) may spend the difference on shorter edges. The edge
-/// limit starts at `first` times the longest edge and falls by √2 a try (about twice
-/// the triangles), for at most `tries` tries, until the mesh wins or takes
-/// more triangles than the original's; the limits of the winning mesh, if
-/// one does, and its unsewn outline.
-fn shorter_edges<'x>(
-    index: usize,
-    (face, loops): (&'x crate::Face, &'x [crate::TrimLoop]),
-    rebuilt: &Result<face::FaceResult<'_>, Error>,
-    original: &Result<face::FaceResult<'_>, Error>,
-    (lim, crit, first, tries): (&params::Limits, &refine::Criteria, f64, usize),
-    budget: usize,
-    tight: f64,
-) -> Option<(params::Limits, refine::Criteria, Option<face::Outline<'x>>)> {
-    let (Ok(new), Ok(old)) = (rebuilt, original) else { return None };
-    if new.mesh.tris.is_empty() || new.mesh.tris.len() >= old.mesh.tris.len() {
-        return None;
-    }
-    let pos = |v: u32| new.mesh.pos.get(v as usize).copied().unwrap_or_default();
-    let longest = new
-        .mesh
-        .tris
-        .iter()
-        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
-        .map(|(a, b)| pos(a).distance(pos(b)))
-        .fold(0.0f64, f64::max);
-    let mut edge = first * longest;
-    for _ in 0..tries {
-        if !(edge > crit.min_edge && edge.is_finite()) {
-            return None;
-        }
-        let l = params::Limits { max_edge: lim.max_edge.min(edge), ..*lim };
-        let c = refine::Criteria { max_edge: crit.max_edge.min(edge), ..*crit };
-        let mut r = face::mesh_face(index, face, loops, &l, &c, budget, tight);
-        match &r {
-            Ok(m) if !m.mesh.tris.is_empty() && m.mesh.tris.len() <= old.mesh.tris.len() => {}
-            _ => return None,
-        }
-        if rebuild_loses(&r, original).is_none() {
-            return Some((l, c, outline_of(&mut r)));
-        }
-        edge *= core::f64::consts::FRAC_1_SQRT_2;
-    }
-    None
-}
-
-/// Beyond paper 001: a rebuilt face whose mesh `(rebuilt, lim, crit)`
-/// takes fewer triangles than the original's but loses on shape (needles
-/// fanned onto tiny edges) spends the difference on Delaunay refinement of
-/// its triangles under the original's 1st-percentile angle + 1°
-/// (`refine/lift.rs`); the limits of the mesh if it then wins, and its
-/// unsewn outline.
-fn lift_needles<'x>(
-    index: usize,
-    (face, loops): (&'x crate::Face, &'x [crate::TrimLoop]),
-    (rebuilt, lim, crit): &(Result<face::FaceResult<'_>, Error>, params::Limits, refine::Criteria),
-    original: &Result<face::FaceResult<'_>, Error>,
-    budget: usize,
-    tight: f64,
-) -> Option<(refine::Criteria, Option<face::Outline<'x>>)> {
-    let (Ok(new), Ok(old)) = (rebuilt, original) else { return None };
-    let most = old.mesh.tris.len();
-    if new.mesh.tris.len() >= most {
-        return None;
-    }
-    let goal = (p1(&old.mesh) + 1.0).to_radians();
-    let c = refine::Criteria { lift: refine::Lift { goal, most }, ..*crit };
-    let mut r = face::mesh_face(index, face, loops, lim, &c, budget, tight);
-    rebuild_loses(&r, original).is_none().then(|| (c, outline_of(&mut r)))
-}
-
-/// The 1st-percentile smallest angle of a trial mesh, degrees, as the
-/// model's mesh will have it: the edges whose ends sewing puts on one model
-/// node collapsed.
-fn p1(m: &refine::WorkMesh) -> f64 {
-    let mut tris = m.tris.clone();
-    let pos = |v: u32| m.pos.get(v as usize).copied();
-    let gid = |v: u32| m.gid.get(v as usize).copied().unwrap_or(u32::MAX);
-    collapse::collapse_edges(&mut tris, |a, b| {
-        (gid(a) == gid(b) && gid(a) != u32::MAX)
-            || matches!((pos(a), pos(b)), (Some(p), Some(q)) if collapse::one_point(p, q))
-    });
-    let mut a: Vec<f64> = tris
-        .iter()
-        .map(|t| crate::mesh::min_angle(t.map(|v| m.pos.get(v as usize).copied().unwrap_or_default())))
-        .collect();
-    a.sort_by(f64::total_cmp);
-    a.get(a.len().saturating_sub(1) / 100).map_or(0.0, |x| x.to_degrees())
-}
-
-/// Why the mesh of a rebuilt face loses to the original's, if it does: it
-/// failed or is empty, is not proven where the original is, has more
-/// triangles, or a smaller 1st-percentile angle. `None` keeps the rebuild.
-fn rebuild_loses(
-    rebuilt: &Result<face::FaceResult<'_>, Error>,
-    original: &Result<face::FaceResult<'_>, Error>,
-) -> Option<alloc::string::String> {
-    let new = match rebuilt {
-        Ok(r) if !r.mesh.tris.is_empty() => r,
-        Ok(_) => return Some("the rebuilt face gave no triangles".into()),
-        Err(e) => return Some(format!("the rebuilt face did not mesh ({e})")),
-    };
-    let old = original.as_ref().ok()?;
-    let (nt, ot) = (new.mesh.tris.len(), old.mesh.tris.len());
-    if new.outcome.unproven > old.outcome.unproven {
-        Some(format!("the rebuilt face left {} triangles unproven", new.outcome.unproven))
-    } else if nt > ot {
-        Some(format!("the rebuilt face took more triangles ({nt} against {ot})"))
-    } else if p1(&new.mesh) < p1(&old.mesh) {
-        Some(format!(
-            "the rebuilt face's triangles were worse shaped (1st-percentile angle {:.1}° against {:.1}°)",
-            p1(&new.mesh),
-            p1(&old.mesh)
-        ))
-    } else {
-        None
     }
 }
 
