@@ -387,6 +387,21 @@ fn equidistribute(
     subdivide_probes(probes, &[t0, t1], lim, cap)
 }
 
+/// A curve with even parameters (a trim curve of paper 001's rebuild,
+/// interpolated at equal arc length) discretized by [`equidistribute`] over
+/// `[t0, t1]`: its knots are sample sites, not features, so the nodes go
+/// at equal shares of the chord demand instead of one split per knot group.
+#[cfg(feature = "std")]
+pub(crate) fn subdivide_even(
+    evals: &[&dyn Fn(f64) -> (DVec3, DVec3)],
+    t0: f64,
+    t1: f64,
+    lim: &Limits,
+) -> (Vec<f64>, f64) {
+    let probes: Vec<Probe<'_>> = evals.iter().map(|&eval| Probe { eval, inside: None, one_sided: false }).collect();
+    equidistribute(&probes, t0, t1, lim, MAX_PARAMS, None)
+}
+
 /// The ends of [`FINE`] equal intervals over `[t0, t1]`.
 fn fine_params(t0: f64, t1: f64) -> Vec<f64> {
     (0..=FINE).map(|k| if k == FINE { t1 } else { t0 + (t1 - t0) * k as f64 / FINE as f64 }).collect()

@@ -163,9 +163,7 @@ pub(crate) fn prepare_loops<'a>(
                 (p, tg)
             };
             let (a, b) = c.domain();
-            let breaks = initial_breaks(&c.knots().breakpoints(), a, b, 16);
             let evals: [&dyn Fn(f64) -> (DVec3, DVec3); 2] = [&by_normal, &by_tangent];
-            let (ts, _) = subdivide(&evals, &breaks, lim);
             // A coarse edge is a straight (u,v) segment in the mesh: its
             // image must stay as close to its chord as the curve does.
             let straight = |ta: f64, tb: f64| {
@@ -175,6 +173,11 @@ pub(crate) fn prepare_loops<'a>(
                     let p = surface.point(ua.lerp(ub, k as f64 / 8.0));
                     super::params::dist_to_segment(p, pa, pb) <= lim.tol
                 })
+            };
+            let (ts, _) = if surface.even_parameters() {
+                super::params::subdivide_even(&evals, a, b, lim)
+            } else {
+                subdivide(&evals, &initial_breaks(&c.knots().breakpoints(), a, b, 16), lim)
             };
             let ts = super::params::coarsen(&evals, &straight, &ts, lim);
             // The last node of each curve is the first of the next: drop it.
@@ -503,6 +506,49 @@ mod tests {
         for (s, at) in poly.seg.iter().zip(&poly.at) {
             assert_eq!((s.0, s.1), (at.curve, at.t));
         }
+    }
+
+    /// A trim curve of a rebuilt face (paper 001: interpolated at equal arc
+    /// length, its 49 knots sample sites) takes nodes at equal steps: the
+    /// split per knot group and the coarsening after it left a short last
+    /// segment, and a short border segment fans needles into the face.
+    #[test]
+    fn a_rebuilt_faces_trim_curve_takes_even_nodes() {
+        let pts: Vec<Vec<DVec3>> =
+            (0..2).map(|i| (0..2).map(|j| DVec3::new(i as f64, j as f64, 0.0)).collect()).collect();
+        let k = alloc::vec![0.0, 0.0, 1.0, 1.0];
+        let plane = crate::nurbs::NurbsSurface::try_new([1, 1], k.clone(), k, &pts, None).unwrap();
+        let surface = crate::FaceSurface::Rebuilt(plane);
+        let (c, r) = (DVec2::new(0.5, 0.5), 0.4);
+        let n = 50;
+        let arc: Vec<DVec2> =
+            (0..=n).map(|i| c + r * DVec2::from_angle(core::f64::consts::PI * i as f64 / n as f64)).collect();
+        let params: Vec<f64> = (0..=n).map(|i| i as f64 / n as f64).collect();
+        let half = crate::reparam::interpolate_curve(&arc, &params).unwrap();
+        let (a, b) = (arc[n].extend(0.0), arc[0].extend(0.0));
+        let line = NurbsCurve::try_new(1, alloc::vec![0.0, 0.0, 1.0, 1.0], alloc::vec![a, b], None).unwrap();
+        let loops = [TrimLoop { curves: alloc::vec![half, line] }];
+        let lim = Limits { tol: 1e-3, angle: 0.5, max_edge: f64::INFINITY, min_edge: 1e-6 };
+        let out = prepare_loops(0, &surface, &loops, &lim).unwrap();
+        let poly = &out.polys[0];
+        let on_arc: Vec<f64> = poly
+            .seg
+            .iter()
+            .filter(|s| s.0 == 0)
+            .map(|s| surface.point(half_uv(&out, s.1)).distance(surface.point(half_uv(&out, s.2))))
+            .collect();
+        assert!(on_arc.len() >= 20, "{on_arc:?}");
+        let (lo, hi) = on_arc.iter().fold((f64::INFINITY, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+        assert!(lo >= 0.9 * hi, "segments from {lo} to {hi}");
+        // Every segment's chord still meets the tolerance.
+        for &x in &on_arc {
+            assert!(r - (r * r - 0.25 * x * x).sqrt() <= lim.tol, "{x}");
+        }
+    }
+
+    /// The (u,v) point of curve 0 of `loops` at `t`.
+    fn half_uv(loops: &Loops<'_>, t: f64) -> DVec2 {
+        loops.curves[0].point(t).truncate()
     }
 
     /// Arcs that really cross are left crossing (and reported), within the split limit.
