@@ -25,8 +25,8 @@ type Additions = PerNode<Vec<(f64, f64, NodeRef)>>;
 
 /// Makes the outlines of all faces agree and names their nodes.
 ///
-/// A moved face's nodes first slide along its curves onto nearby nodes of
-/// faces that were not moved ([`snap_moved`]).
+/// Nodes first slide along their curves onto nearby nodes of other faces
+/// ([`slide_nodes`]).
 ///
 /// Each node has a reach: `sew`, but at most 0.3 of its shortest loop
 /// segment (so two nodes of one segment are never one). A node of one
@@ -55,8 +55,8 @@ pub(crate) fn unify(
 ) -> u32 {
     let tight = tight.min(sew).max(0.0);
     let sew = if sew.is_finite() { sew.max(0.0) } else { 0.0 };
-    if sew > 0.0 && moved.iter().any(|&m| m > 0.0) {
-        snap_moved(faces, bodies, moved, sew);
+    if sew > 0.0 {
+        slide_nodes(faces, bodies, moved, sew);
     }
     let pos = positions(faces);
     let (mut total, mut count) = (0.0, 0usize);
@@ -80,20 +80,24 @@ pub(crate) fn unify(
     name_nodes(faces, bodies, &radius, &twins, sew_used, tight)
 }
 
-/// Share of a moved node's shorter segment within which it slides along
-/// its curve onto another face's node (see [`snap_moved`]).
+/// Share of a node's shorter segment within which it slides along its
+/// curve onto another face's node (see [`slide_nodes`]).
 const SNAP_SHARE: f64 = 0.3;
 
-/// Paper 001's rebuilt faces (`moved` > 0) place their border nodes on
-/// their own, so sewn with a neighbour that kept the original's they would
-/// add a node beside each of its own, and the short segments between fan
-/// needles into both faces. Each inner node of a moved face's curve that has
-/// another face's node within [`SNAP_SHARE`] of its shorter segment slides
-/// along its curve to the point nearest that node, when that point lies
-/// within `sew` of it: the two are then one node, and the shared border
-/// keeps the neighbour's discretization. A node stays between its own
-/// neighbours on the curve.
-fn snap_moved(faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>], bodies: &[u32], moved: &[f64], sew: f64) {
+/// Two faces discretize the border they share each on its own (a rebuilt
+/// face, paper 001, on its new curves; any two faces whose curves run at
+/// different speeds), so sewn together each would add a node beside each
+/// of the other's, and the short segments between fan needles into both.
+/// Before sewing, each inner node of a curve that has another face's node
+/// within [`SNAP_SHARE`] of its shorter segment slides along its curve to
+/// the point nearest that node when that point lies within `sew` of it, no
+/// segment of its own shrinks below `1 - SNAP_SHARE` of the shorter one,
+/// and no other node of its face lies within `sew` of that node (a strip
+/// narrower than that would be sewn shut). The two are then one node. A
+/// rebuilt face (`moved` > 0) slides onto the others and never the others
+/// onto it; of two faces not rebuilt the earlier slides; two rebuilt faces
+/// keep their own nodes.
+fn slide_nodes(faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>], bodies: &[u32], moved: &[f64], sew: f64) {
     let mut pos = positions(faces);
     let body = |f: usize| crate::model::body_of(bodies, f);
     let is_moved = |f: usize| moved.get(f).is_some_and(|&m| m > 0.0);
@@ -115,9 +119,6 @@ fn snap_moved(faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>], bodies: &[
     }
     for (fi, item) in faces.iter_mut().enumerate() {
         let Some((surface, o)) = item else { continue };
-        if !is_moved(fi) {
-            continue;
-        }
         for (k, poly) in o.loops.polys.iter_mut().enumerate() {
             let n = poly.uv.len();
             if n < 3 {
@@ -139,7 +140,7 @@ fn snap_moved(faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>], bodies: &[
                     .in_box(here - r, here + r)
                     .filter(|m| {
                         let g = m.0 as usize;
-                        g != fi && body(g) == body(fi) && !is_moved(g)
+                        g != fi && body(g) == body(fi) && !is_moved(g) && (g > fi || is_moved(fi))
                     })
                     .map(|m| {
                         let q = pos[m.0 as usize][m.1 as usize][m.2 as usize];
@@ -157,6 +158,16 @@ fn snap_moved(faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>], bodies: &[
                 let p = on(s);
                 let after = p.distance(pos[fi][k][h]).min(p.distance(pos[fi][k][(i + 1) % n]));
                 if !(d <= sew && after >= (1.0 - SNAP_SHARE) * shorter) {
+                    continue;
+                }
+                // A node of this face's other side within sewing distance
+                // of q (a strip narrower than that) would be sewn to it too.
+                let w = DVec3::splat(sew);
+                if grid.in_box(q - w, q + w).any(|m| {
+                    m.0 as usize == fi
+                        && (m.1 as usize, m.2 as usize) != (k, i)
+                        && pos[fi][m.1 as usize][m.2 as usize].distance(q) <= sew
+                }) {
                     continue;
                 }
                 let t = tp + (tn - tp) * s;
@@ -746,12 +757,12 @@ mod tests {
         v
     }
 
-    /// A rebuilt face (paper 001) whose border nodes along a neighbour's
-    /// sit 0.05 from the neighbour's slides them onto the neighbour's: the
-    /// shared border keeps the neighbour's five nodes. A face not rebuilt
-    /// keeps its own nodes, and the border takes both faces' (eight).
+    /// Two faces whose border nodes along the border they share sit 0.05
+    /// apart: a rebuilt face (paper 001) slides its nodes onto the other's,
+    /// whichever comes first; of two faces not rebuilt the first slides. The
+    /// shared border keeps five nodes, where sewing alone gave it eight.
     #[test]
-    fn a_rebuilt_faces_border_takes_its_neighbours_nodes() {
+    fn shared_border_nodes_slide_onto_one_faces() {
         let pts = [[DVec3::ZERO, DVec3::Y], [DVec3::new(2.0, 0.0, 0.0), DVec3::new(2.0, 1.0, 0.0)]];
         let pts: Vec<Vec<DVec3>> = pts.iter().map(|r| r.to_vec()).collect();
         let plane =
@@ -770,17 +781,26 @@ mod tests {
             line((1.0, 1.0), (1.0, 0.0)),
         ];
         let b_nodes: &[&[f64]] = &[&[0.0], &[0.0], &[0.0], &[0.0, 0.2, 0.45, 0.8]];
-        for (moved, count) in [(1e-3, 5), (0.0, 8)] {
+        let (a_ys, b_ys) = ([0.0, 0.25, 0.5, 0.75, 1.0], [0.0, 0.2, 0.55, 0.8, 1.0]);
+        // (A first, A rebuilt, the border A's)
+        for (a_first, rebuilt, keeps_a) in [(false, true, false), (true, false, false), (false, false, true)] {
             let mut a = outline(&a_curves, &[&[0.0], &[0.0, 0.25, 0.5, 0.75], &[0.0], &[0.0]]);
             let mut b = outline(&b_curves, b_nodes);
-            let mut faces: Vec<Option<(&dyn Surface, &mut Outline<'_>)>> =
-                alloc::vec![Some((&plane as &dyn Surface, &mut a)), Some((&plane as &dyn Surface, &mut b))];
-            unify(&mut faces, &[], &[moved, 0.0], 0.01, 1e-6, 0.02);
-            let (sa, sb) = (on_shared(&a), on_shared(&b));
-            assert_eq!(sa.len(), count, "moved {moved}: {sa:?}");
-            assert_eq!(sb.len(), count, "moved {moved}: {sb:?}");
-            for ((va, ga), (vb, gb)) in sa.iter().zip(&sb) {
-                assert!((va - vb).abs() < 1e-9 && ga == gb && *ga != u32::MAX, "{sa:?} {sb:?}");
+            let moved = if rebuilt { 1e-3 } else { 0.0 };
+            let (sa, sb) = {
+                let fa = Some((&plane as &dyn Surface, &mut a));
+                let fb = Some((&plane as &dyn Surface, &mut b));
+                let (mut faces, moved) =
+                    if a_first { (alloc::vec![fa, fb], [moved, 0.0]) } else { (alloc::vec![fb, fa], [0.0, moved]) };
+                unify(&mut faces, &[], &moved, 0.01, 1e-6, 0.02);
+                drop(faces);
+                (on_shared(&a), on_shared(&b))
+            };
+            let want = if keeps_a { a_ys } else { b_ys };
+            assert_eq!(sa.len(), 5, "{sa:?}");
+            for (((va, ga), (vb, gb)), w) in sa.iter().zip(&sb).zip(want) {
+                assert!((va - w).abs() < 1e-9 && (vb - w).abs() < 1e-9, "{sa:?} {sb:?}");
+                assert!(ga == gb && *ga != u32::MAX, "{sa:?} {sb:?}");
             }
         }
     }
