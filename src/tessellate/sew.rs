@@ -93,6 +93,8 @@ fn nearest_fraction(dist: &dyn Fn(f64) -> f64, s0: f64) -> (f64, f64) {
 
 #[cfg(feature = "std")]
 mod outlines;
+#[cfg(feature = "std")]
+mod slide;
 
 #[cfg(feature = "std")]
 pub(crate) use outlines::unify;

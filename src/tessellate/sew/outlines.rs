@@ -18,7 +18,7 @@ const PAIR_MIN: usize = 3;
 type NodeRef = (u32, u32, u32);
 
 /// Per face, per loop, per node.
-type PerNode<T> = Vec<Vec<Vec<T>>>;
+pub(super) type PerNode<T> = Vec<Vec<Vec<T>>>;
 
 /// Per segment, the nodes to add to it: (fraction, curve parameter, the node it stands for).
 type Additions = PerNode<Vec<(f64, f64, NodeRef)>>;
@@ -26,7 +26,7 @@ type Additions = PerNode<Vec<(f64, f64, NodeRef)>>;
 /// Makes the outlines of all faces agree and names their nodes.
 ///
 /// Nodes first slide along their curves onto nearby nodes of other faces
-/// ([`slide_nodes`]).
+/// ([`super::slide::slide_nodes`]).
 ///
 /// Each node has a reach: `sew`, but at most 0.3 of its shortest loop
 /// segment (so two nodes of one segment are never one). A node of one
@@ -55,10 +55,7 @@ pub(crate) fn unify(
 ) -> u32 {
     let tight = tight.min(sew).max(0.0);
     let sew = if sew.is_finite() { sew.max(0.0) } else { 0.0 };
-    if sew > 0.0 {
-        slide_nodes(faces, bodies, moved, sew);
-    }
-    let pos = positions(faces);
+    let pos = super::slide::slide_nodes(faces, bodies, moved, sew);
     let (mut total, mut count) = (0.0, 0usize);
     for p in pos.iter().flatten() {
         for i in 0..p.len() {
@@ -80,109 +77,8 @@ pub(crate) fn unify(
     name_nodes(faces, bodies, &radius, &twins, sew_used, tight)
 }
 
-/// Share of a node's shorter segment within which it slides along its
-/// curve onto another face's node (see [`slide_nodes`]).
-const SNAP_SHARE: f64 = 0.3;
-
-/// Two faces discretize the border they share each on its own (a rebuilt
-/// face, paper 001, on its new curves; any two faces whose curves run at
-/// different speeds), so sewn together each would add a node beside each
-/// of the other's, and the short segments between fan needles into both.
-/// Before sewing, each inner node of a curve that has another face's node
-/// within [`SNAP_SHARE`] of its shorter segment slides along its curve to
-/// the point nearest that node when that point lies within `sew` of it, no
-/// segment of its own shrinks below `1 - SNAP_SHARE` of the shorter one,
-/// and no other node of its face lies within `sew` of that node (a strip
-/// narrower than that would be sewn shut). The two are then one node. A
-/// rebuilt face (`moved` > 0) slides onto the others and never the others
-/// onto it; of two faces not rebuilt the earlier slides; two rebuilt faces
-/// keep their own nodes.
-fn slide_nodes(faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>], bodies: &[u32], moved: &[f64], sew: f64) {
-    let mut pos = positions(faces);
-    let body = |f: usize| crate::model::body_of(bodies, f);
-    let is_moved = |f: usize| moved.get(f).is_some_and(|&m| m > 0.0);
-    let longest = pos
-        .iter()
-        .flatten()
-        .flat_map(|p| (0..p.len()).map(move |i| p[i].distance(p[(i + 1) % p.len()])))
-        .fold(0.0f64, f64::max);
-    if !(longest > 0.0 && longest.is_finite()) {
-        return;
-    }
-    let mut grid = CellGrid::new(1.0 / longest);
-    for (fi, f) in pos.iter().enumerate() {
-        for (k, p) in f.iter().enumerate() {
-            for (i, &q) in p.iter().enumerate() {
-                grid.insert(q, (fi as u32, k as u32, i as u32));
-            }
-        }
-    }
-    for (fi, item) in faces.iter_mut().enumerate() {
-        let Some((surface, o)) = item else { continue };
-        for (k, poly) in o.loops.polys.iter_mut().enumerate() {
-            let n = poly.uv.len();
-            if n < 3 {
-                continue;
-            }
-            for i in 0..n {
-                let h = (i + n - 1) % n;
-                let ((cb, tp, ti), (ca, ti2, tn)) = (poly.seg[h], poly.seg[i]);
-                // Inner nodes of one curve only: a curve's end is a corner.
-                if cb != ca || ca != poly.at[i].curve || ti != ti2 {
-                    continue;
-                }
-                let Some(c) = o.loops.curves.get(ca as usize) else { continue };
-                let here = pos[fi][k][i];
-                let shorter = here.distance(pos[fi][k][h]).min(here.distance(pos[fi][k][(i + 1) % n]));
-                let reach = SNAP_SHARE * shorter;
-                let r = DVec3::splat(reach);
-                let Some((_, q)) = grid
-                    .in_box(here - r, here + r)
-                    .filter(|m| {
-                        let g = m.0 as usize;
-                        g != fi && body(g) == body(fi) && !is_moved(g) && (g > fi || is_moved(fi))
-                    })
-                    .map(|m| {
-                        let q = pos[m.0 as usize][m.1 as usize][m.2 as usize];
-                        (q.distance(here), q)
-                    })
-                    .filter(|(d, _)| *d <= reach)
-                    .min_by(|x, y| x.0.total_cmp(&y.0))
-                else {
-                    continue;
-                };
-                // The point of the curve between its neighbours nearest q.
-                let on = |s: f64| surface.point(c.point(tp + (tn - tp) * s).truncate());
-                let s0 = if tn != tp { (ti - tp) / (tn - tp) } else { 0.5 };
-                let (s, d) = super::nearest_fraction(&|s: f64| on(s).distance(q), s0);
-                let p = on(s);
-                let after = p.distance(pos[fi][k][h]).min(p.distance(pos[fi][k][(i + 1) % n]));
-                if !(d <= sew && after >= (1.0 - SNAP_SHARE) * shorter) {
-                    continue;
-                }
-                // A node of this face's other side within sewing distance
-                // of q (a strip narrower than that) would be sewn to it too.
-                let w = DVec3::splat(sew);
-                if grid.in_box(q - w, q + w).any(|m| {
-                    m.0 as usize == fi
-                        && (m.1 as usize, m.2 as usize) != (k, i)
-                        && pos[fi][m.1 as usize][m.2 as usize].distance(q) <= sew
-                }) {
-                    continue;
-                }
-                let t = tp + (tn - tp) * s;
-                poly.uv[i] = c.point(t).truncate();
-                poly.at[i].t = t;
-                poly.seg[h].2 = t;
-                poly.seg[i].1 = t;
-                pos[fi][k][i] = p;
-            }
-        }
-    }
-}
-
 /// Each outline node's point on its face's surface.
-fn positions(faces: &[Option<(&dyn Surface, &mut Outline<'_>)>]) -> PerNode<DVec3> {
+pub(super) fn positions(faces: &[Option<(&dyn Surface, &mut Outline<'_>)>]) -> PerNode<DVec3> {
     faces
         .iter()
         .map(|item| {
@@ -719,89 +615,4 @@ fn name_nodes(
         }
     }
     ids.len() as u32
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::nurbs::{NurbsCurve, NurbsSurface};
-    use crate::tessellate::trim::{CurveRef, Loops};
-
-    /// A line in (u,v) from `p` to `q`, parameter 0 to 1.
-    fn line(p: (f64, f64), q: (f64, f64)) -> NurbsCurve {
-        let pts = alloc::vec![DVec3::new(p.0, p.1, 0.0), DVec3::new(q.0, q.1, 0.0)];
-        NurbsCurve::try_new(1, alloc::vec![0.0, 0.0, 1.0, 1.0], pts, None).unwrap()
-    }
-
-    /// The outline of a loop of `curves`, with nodes at the parameters `ts` of each.
-    fn outline<'a>(curves: &'a [NurbsCurve], ts: &[&[f64]]) -> Outline<'a> {
-        let mut poly = Polyline::default();
-        for (c, list) in ts.iter().enumerate() {
-            for (i, &t) in list.iter().enumerate() {
-                poly.uv.push(curves[c].point(t).truncate());
-                poly.at.push(CurveRef { curve: c as u32, t });
-                poly.seg.push((c as u32, t, list.get(i + 1).copied().unwrap_or(1.0)));
-            }
-        }
-        let gids = alloc::vec![alloc::vec![u32::MAX; poly.uv.len()]];
-        let loops = Loops { polys: alloc::vec![poly], curves: curves.iter().collect() };
-        Outline { loops, pu: alloc::vec![0.0, 2.0], pv: alloc::vec![0.0, 1.0], gids }
-    }
-
-    /// Nodes of `o` on the line u = 1 (the shared border), by v.
-    fn on_shared(o: &Outline<'_>) -> Vec<(f64, u32)> {
-        let p = &o.loops.polys[0];
-        let mut v: Vec<(f64, u32)> =
-            p.uv.iter().zip(&o.gids[0]).filter(|(q, _)| (q.x - 1.0).abs() < 1e-12).map(|(q, &g)| (q.y, g)).collect();
-        v.sort_by(|a, b| a.0.total_cmp(&b.0));
-        v
-    }
-
-    /// Two faces whose border nodes along the border they share sit 0.05
-    /// apart: a rebuilt face (paper 001) slides its nodes onto the other's,
-    /// whichever comes first; of two faces not rebuilt the first slides. The
-    /// shared border keeps five nodes, where sewing alone gave it eight.
-    #[test]
-    fn shared_border_nodes_slide_onto_one_faces() {
-        let pts = [[DVec3::ZERO, DVec3::Y], [DVec3::new(2.0, 0.0, 0.0), DVec3::new(2.0, 1.0, 0.0)]];
-        let pts: Vec<Vec<DVec3>> = pts.iter().map(|r| r.to_vec()).collect();
-        let plane =
-            NurbsSurface::try_new([1, 1], alloc::vec![0.0, 0.0, 2.0, 2.0], alloc::vec![0.0, 0.0, 1.0, 1.0], &pts, None)
-                .unwrap();
-        let a_curves = [
-            line((0.0, 0.0), (1.0, 0.0)),
-            line((1.0, 0.0), (1.0, 1.0)),
-            line((1.0, 1.0), (0.0, 1.0)),
-            line((0.0, 1.0), (0.0, 0.0)),
-        ];
-        let b_curves = [
-            line((1.0, 0.0), (2.0, 0.0)),
-            line((2.0, 0.0), (2.0, 1.0)),
-            line((2.0, 1.0), (1.0, 1.0)),
-            line((1.0, 1.0), (1.0, 0.0)),
-        ];
-        let b_nodes: &[&[f64]] = &[&[0.0], &[0.0], &[0.0], &[0.0, 0.2, 0.45, 0.8]];
-        let (a_ys, b_ys) = ([0.0, 0.25, 0.5, 0.75, 1.0], [0.0, 0.2, 0.55, 0.8, 1.0]);
-        // (A first, A rebuilt, the border A's)
-        for (a_first, rebuilt, keeps_a) in [(false, true, false), (true, false, false), (false, false, true)] {
-            let mut a = outline(&a_curves, &[&[0.0], &[0.0, 0.25, 0.5, 0.75], &[0.0], &[0.0]]);
-            let mut b = outline(&b_curves, b_nodes);
-            let moved = if rebuilt { 1e-3 } else { 0.0 };
-            let (sa, sb) = {
-                let fa = Some((&plane as &dyn Surface, &mut a));
-                let fb = Some((&plane as &dyn Surface, &mut b));
-                let (mut faces, moved) =
-                    if a_first { (alloc::vec![fa, fb], [moved, 0.0]) } else { (alloc::vec![fb, fa], [0.0, moved]) };
-                unify(&mut faces, &[], &moved, 0.01, 1e-6, 0.02);
-                drop(faces);
-                (on_shared(&a), on_shared(&b))
-            };
-            let want = if keeps_a { a_ys } else { b_ys };
-            assert_eq!(sa.len(), 5, "{sa:?}");
-            for (((va, ga), (vb, gb)), w) in sa.iter().zip(&sb).zip(want) {
-                assert!((va - w).abs() < 1e-9 && (vb - w).abs() < 1e-9, "{sa:?} {sb:?}");
-                assert!(ga == gb && *ga != u32::MAX, "{sa:?} {sb:?}");
-            }
-        }
-    }
 }
