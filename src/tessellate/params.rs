@@ -123,12 +123,18 @@ pub(crate) struct Probe<'e> {
     pub one_sided: bool,
 }
 
+/// Each of `evals` as a probe tested over the whole interval, on both sides.
+#[cfg(feature = "std")]
+fn whole_curves<'e>(evals: &[&'e dyn Fn(f64) -> (DVec3, DVec3)]) -> Vec<Probe<'e>> {
+    evals.iter().map(|&eval| Probe { eval, inside: None, one_sided: false }).collect()
+}
+
 /// Subdivides `[t0, t1]` (already split at `breaks`) until every interval passes
 /// for all curves in `evals`. Returns ascending parameters including both ends,
 /// and the largest sag left in an accepted interval.
 #[cfg(feature = "std")]
 pub(crate) fn subdivide(evals: &[&dyn Fn(f64) -> (DVec3, DVec3)], breaks: &[f64], lim: &Limits) -> (Vec<f64>, f64) {
-    let probes: Vec<Probe<'_>> = evals.iter().map(|&eval| Probe { eval, inside: None, one_sided: false }).collect();
+    let probes = whole_curves(evals);
     subdivide_probes(&probes, breaks, lim, MAX_PARAMS)
 }
 
@@ -398,7 +404,7 @@ pub(crate) fn subdivide_even(
     t1: f64,
     lim: &Limits,
 ) -> (Vec<f64>, f64) {
-    let probes: Vec<Probe<'_>> = evals.iter().map(|&eval| Probe { eval, inside: None, one_sided: false }).collect();
+    let probes = whole_curves(evals);
     equidistribute(&probes, t0, t1, lim, MAX_PARAMS, None)
 }
 
