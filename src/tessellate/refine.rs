@@ -23,6 +23,12 @@ use limits::{Packed, STALE};
 
 const NONE: u32 = u32::MAX;
 
+/// Twice the signed area of the (u,v) triangle `w`: positive when its
+/// corners run counter-clockwise.
+fn uv_area(w: [DVec2; 3]) -> f64 {
+    (w[1] - w[0]).perp_dot(w[2] - w[0])
+}
+
 /// A trim edge: the curve it follows and the parameters at its lower- and
 /// higher-numbered vertex.
 #[derive(Debug, Clone, Copy)]
@@ -544,10 +550,9 @@ impl WorkMesh {
             plan.push((t, [x0, x1, x2], [u0, u1, u2], uv_m, guess));
         }
         let mut p = m_pos?;
-        let area = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
         let folds = |u: [DVec2; 3], uv_m: DVec2| {
-            let whole = area(u[0], u[1], u[2]);
-            whole != 0.0 && (area(u[0], uv_m, u[2]) * whole <= 0.0 || area(uv_m, u[1], u[2]) * whole <= 0.0)
+            let whole = uv_area(u);
+            whole != 0.0 && (uv_area([u[0], uv_m, u[2]]) * whole <= 0.0 || uv_area([uv_m, u[1], u[2]]) * whole <= 0.0)
         };
         if target.is_some() {
             // A sewing target whose (u,v) would fold the children (a thin

@@ -12,7 +12,7 @@ use alloc::vec::Vec;
 use core::cmp::Reverse;
 use glam::{DVec2, DVec3};
 
-use super::{key, Criteria, Lift, WorkMesh, NONE, STALE};
+use super::{key, uv_area, Criteria, Lift, WorkMesh, NONE, STALE};
 use crate::nurbs::{project_to_surface, Surface};
 use crate::tessellate::measure::measure_projection;
 
@@ -119,13 +119,12 @@ impl WorkMesh {
         for _ in 0..WALK {
             let tv = self.tris[t as usize];
             let w = self.uv(t as usize);
-            let area = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
-            let whole = area(w[0], w[1], w[2]);
+            let whole = uv_area(w);
             if whole == 0.0 {
                 return None;
             }
             // The weight of each corner; the most negative names the side to cross.
-            let l: [f64; 3] = core::array::from_fn(|k| area(uv, w[(k + 1) % 3], w[(k + 2) % 3]) / whole);
+            let l: [f64; 3] = core::array::from_fn(|k| uv_area([uv, w[(k + 1) % 3], w[(k + 2) % 3]]) / whole);
             let (k, least) = (0..3).map(|k| (k, l[k])).min_by(|x, y| x.1.total_cmp(&y.1))?;
             if least >= 0.0 {
                 return Some(t);
@@ -158,12 +157,11 @@ impl WorkMesh {
     fn split_at(&mut self, surface: &dyn Surface, c: &Criteria, t: u32, uv: DVec2) -> Option<Vec<(u32, u32, u32)>> {
         let tv = self.tris[t as usize];
         let tuv = self.uv(t as usize);
-        let area = |w: [DVec2; 3]| (w[1] - w[0]).perp_dot(w[2] - w[0]);
-        let sense = area(tuv);
+        let sense = uv_area(tuv);
         let inside = (0..3).all(|k| {
             let mut w = tuv;
             w[k] = uv;
-            area(w) / sense >= INSIDE
+            uv_area(w) / sense >= INSIDE
         });
         let (x_pos, x_n): (DVec3, DVec3) = (surface.point(uv), surface.normal(uv));
         if !(sense != 0.0 && inside && x_pos.is_finite() && x_n.is_finite()) {

@@ -6,7 +6,7 @@
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
-use super::{key, Criteria, TriMeasure, WorkMesh, NONE};
+use super::{key, uv_area, Criteria, TriMeasure, WorkMesh, NONE};
 use crate::nurbs::Surface;
 #[cfg(feature = "std")]
 use {super::STALE, crate::nurbs::project_to_surface};
@@ -234,11 +234,10 @@ impl WorkMesh {
         if (qa - qa2).length() > 1e-9 * span || (qb - qb2).length() > 1e-9 * span {
             return None;
         }
-        let area = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
-        let sense = area(qb2, qa2, qd);
+        let sense = uv_area([qb2, qa2, qd]);
         let (t1, t2) = ([a, d, cv], [d, b, cv]);
         let (w1, w2) = ([qa, qd, qc], [qd, qb, qc]);
-        let uv_ok = area(w1[0], w1[1], w1[2]) * sense > 0.0 && area(w2[0], w2[1], w2[2]) * sense > 0.0;
+        let uv_ok = uv_area(w1) * sense > 0.0 && uv_area(w2) * sense > 0.0;
         // Sewing moves border nodes in space, not in (u,v): where it folded a
         // triangle, the flip that unfolds it can look folded in the stale
         // (u,v), so the new pair is judged in space against the surface's
@@ -297,8 +296,7 @@ impl WorkMesh {
         }
         let old_uv = at?;
         let new_uv = centre / n;
-        let area = |w: [DVec2; 3]| (w[1] - w[0]).perp_dot(w[2] - w[0]);
-        let signs: Vec<f64> = ring.iter().map(|&t| area(self.uv(t as usize))).collect();
+        let signs: Vec<f64> = ring.iter().map(|&t| uv_area(self.uv(t as usize))).collect();
         let sense = signs.iter().sum::<f64>();
         let (old_p, old_n) = (self.pos[x as usize], self.normal_at(x as usize));
         let set = |m: &mut Self, q: DVec2, p: DVec3, nn: DVec3| {
@@ -320,9 +318,8 @@ impl WorkMesh {
     /// `sense` (the sign of a (u,v) area), faces the surface's way and passes
     /// the deviation and turn limits.
     pub(super) fn holds(&self, surface: &dyn Surface, c: &Criteria, t: u32, sense: f64) -> bool {
-        let w = self.uv(t as usize);
         let (m, turn) = self.measure(surface, t as usize, c);
-        (w[1] - w[0]).perp_dot(w[2] - w[0]) * sense > 0.0
+        uv_area(self.uv(t as usize)) * sense > 0.0
             && !self.inverted(surface, t as usize)
             && m.max <= c.tol
             && self.turn_ok(c, &m, turn, t)
@@ -452,9 +449,9 @@ impl WorkMesh {
         };
         let (x0, x1, x2) = (old_t[k], old_t[(k + 1) % 3], old_t[(k + 2) % 3]);
         let (u0, u1, u2) = (old_uv[k], old_uv[(k + 1) % 3], old_uv[(k + 2) % 3]);
-        let area = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
-        let whole = area(u0, u1, u2);
-        let folds = |uv: DVec2| !uv.is_finite() || area(u0, uv, u2) * whole <= 0.0 || area(uv, u1, u2) * whole <= 0.0;
+        let whole = uv_area([u0, u1, u2]);
+        let folds =
+            |uv: DVec2| !uv.is_finite() || uv_area([u0, uv, u2]) * whole <= 0.0 || uv_area([uv, u1, u2]) * whole <= 0.0;
         // Its nearest point on this surface; where that folds the two (the
         // node lies past the surface's end), the edge's (u,v) at its chord
         // fraction, the node keeping its place for the weld.
