@@ -14,6 +14,8 @@ use super::{KnotVector, NurbsSurface, Surface};
 /// `None` when `c` is not strictly inside the domain or the edges at the old
 /// seam do not coincide (within `1e-7` of the surface's size).
 pub fn rotate_seam(s: &NurbsSurface, along_u: bool, c: f64) -> Option<NurbsSurface> {
+    let clamped = s.clamped(along_u);
+    let s = &clamped;
     let (left, right) = s.split(along_u, c)?;
     let [lo, hi] = s.domain();
     let axis = usize::from(!along_u);

@@ -482,3 +482,99 @@ fn shares_of_the_bodies_make_the_whole_mesh() {
     assert_eq!(empty.mesh.face_ranges.len(), 12, "every face is listed, with no triangles");
     assert!(mesh_model(&model, &options.clone().with_share(2, 2)).is_err(), "an index past the count is refused");
 }
+
+/// Area of the given faces' triangles.
+fn area(mesh: &Mesh, faces: std::ops::Range<usize>) -> f64 {
+    let m = sub_mesh(mesh, faces);
+    m.indices
+        .chunks_exact(3)
+        .map(|t| {
+            let [a, b, c] = [0, 1, 2].map(|k| m.positions[t[k] as usize]);
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .sum()
+}
+
+/// Closed surfaces as real files write them, each a solid: a cylinder whose
+/// two circles start half a turn apart (the seam cut lands where circle
+/// pieces meet), a cone cap past its apex (on the nappe of negative radius,
+/// its seam run out to the apex and back), a sphere wedge whose pole
+/// vertices lie a rounding off the axis. Watertight, within tolerance, with
+/// the exact solid's volume.
+#[test]
+fn closed_surfaces_written_awkwardly_mesh_as_solids() {
+    use std::f64::consts::PI;
+    let cases = [
+        ("step_cylinder_offset_circles.stp", 3, PI * 25.0 * 10.0),
+        ("step_cone_past_apex.stp", 2, PI * 25.0 * 5.0 / 3.0),
+        ("step_sphere_wedge_poles.stp", 3, PI * 60f64.powi(3) / 3.0),
+    ];
+    for (file, faces, exact) in cases {
+        let (model, shells) = read_step_with_shells(&data(file)).unwrap();
+        assert_eq!(model.faces.len(), faces, "{file}: {:?}", model.warnings);
+        for rel in [1e-2, 1e-3] {
+            let r = mesh_checked(file, &model, &shells, rel);
+            let v = volume(&r.mesh, 0..faces);
+            let slack = if rel < 2e-3 { 0.01 } else { 0.05 };
+            assert!((v - exact).abs() < slack * exact, "{file} at {rel}: volume {v}, exact {exact}");
+        }
+    }
+}
+
+/// A trimmed curve runs from its first trim to its second, against its
+/// basis where its sense is false (ISO 10303-42): the quarter cylinder's top
+/// arc goes from 90 back to 0 degrees, not three quarters of the way round.
+#[test]
+fn trimmed_curves_against_their_basis_bound_a_quarter_cylinder() {
+    let model = read_step(&data("step_trimmed_curve_sense.stp")).unwrap();
+    assert_eq!(model.faces.len(), 1, "{:?}", model.warnings);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-3)).unwrap();
+    assert!(r.report.max_deviation <= r.report.tolerance);
+    let exact = 5.0 * std::f64::consts::FRAC_PI_2 * 10.0;
+    let a = area(&r.mesh, 0..1);
+    assert!((a - exact).abs() < 0.005 * exact, "area {a}, exact {exact}");
+    for p in &r.mesh.positions {
+        assert!(p.x >= -1e-6 && p.y >= -1e-6 && (-1e-6..=10.0 + 1e-6).contains(&p.z), "{p} outside the quarter");
+    }
+}
+
+/// A face across the seam of a periodic B-spline surface whose knots are
+/// not clamped (as such surfaces come in files): the seam is moved into the
+/// face's gap after clamping, and the face has the area of its strip.
+#[test]
+fn a_face_across_the_seam_of_an_unclamped_periodic_surface_meshes() {
+    use surfmesh::NurbsCurve;
+    let model = read_step(&data("step_periodic_bspline_seam.stp")).unwrap();
+    assert_eq!(model.faces.len(), 1, "{:?}", model.warnings);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-3)).unwrap();
+    assert!(r.report.max_deviation <= r.report.tolerance);
+    // The tube's cross-section, built here from the file's data: its length
+    // over the face's range (0.85 to 1.15, across the seam) times the height 6.
+    let octagon: Vec<glam::DVec3> = (0..11)
+        .map(|k| {
+            let a = (k % 8) as f64 * std::f64::consts::FRAC_PI_4;
+            glam::DVec3::new(5.0 * a.cos(), 5.0 * a.sin(), 0.0)
+        })
+        .collect();
+    let knots = (0..15).map(|i| (i as f64 - 3.0) / 8.0).collect();
+    let ring = NurbsCurve::try_new(3, knots, octagon, None).unwrap();
+    let length = |a: f64, b: f64| -> f64 {
+        (0..2000)
+            .map(|k| {
+                ring.point(a + (b - a) * k as f64 / 2000.0).distance(ring.point(a + (b - a) * (k + 1) as f64 / 2000.0))
+            })
+            .sum()
+    };
+    let exact = 6.0 * (length(0.85, 1.0) + length(0.0, 0.15));
+    let a = area(&r.mesh, 0..1);
+    assert!((a - exact).abs() < 0.005 * exact, "area {a}, exact {exact}");
+    // Every vertex within the face's angles (its corners' on the ring) and heights.
+    let angle = |p: glam::DVec3| p.y.atan2(p.x);
+    let (from, to) = (angle(ring.point(0.85)), angle(ring.point(0.15)));
+    assert!(from < 0.0 && to > 0.0, "the face's corners lie either side of angle 0");
+    for p in &r.mesh.positions {
+        let a = angle(*p);
+        assert!(a >= from - 1e-3 && a <= to + 1e-3, "{p} at angle {a}, outside {from}..{to}");
+        assert!((2.0 - 1e-6..=8.0 + 1e-6).contains(&p.z), "{p} off the face's heights");
+    }
+}

@@ -353,7 +353,8 @@ fn resolve_windings(
             [] => {}
             [i] => {
                 let side = left.ok_or("a trim loop winds around the surface's seam (not supported)")?;
-                close_at_bound(&mut tracks[*i], k, windings[*i][k], side, bounds_of(def, natural, 1 - k))?;
+                let at = tracks[*i].first().and_then(|t| t.qs.first()).map_or(0.0, |q| q[1 - k]);
+                close_at_bound(&mut tracks[*i], k, windings[*i][k], side, bounds_of(def, natural, 1 - k, at))?;
                 windings[*i][k] = 0;
             }
             [i, j] if windings[*i][k] == -windings[*j][k] => {
@@ -376,8 +377,9 @@ fn resolve_windings(
 }
 
 /// The range native coordinate `k` is confined to: the entity's own, or
-/// for a cone's profile the side of its apex the cone is on.
-fn bounds_of(def: &SurfDef, natural: [Option<Range>; 2], k: usize) -> Option<Range> {
+/// for a cone's profile the side of its apex that holds `at` (a cone is
+/// both its nappes, and a loop may lie on either).
+fn bounds_of(def: &SurfDef, natural: [Option<Range>; 2], k: usize, at: f64) -> Option<Range> {
     if let Some(r) = natural[k] {
         return Some(r);
     }
@@ -389,7 +391,7 @@ fn bounds_of(def: &SurfDef, natural: [Option<Range>; 2], k: usize) -> Option<Ran
         SurfDef::Revolution(r) if k == 0 => match &r.profile {
             Profile::Line { p0, d } if d.x != 0.0 => {
                 let apex = -p0.x / d.x;
-                Some(if d.x > 0.0 { (apex, f64::INFINITY) } else { (f64::NEG_INFINITY, apex) })
+                Some(if at > apex { (apex, f64::INFINITY) } else { (f64::NEG_INFINITY, apex) })
             }
             _ => None,
         },
@@ -443,14 +445,23 @@ fn join_across_seam(
     let b_turn =
         b.last().and_then(|t| t.qs.last()).zip(b.first().and_then(|t| t.qs.first())).map_or(0.0, |(l, f)| l[k] - f[k]);
     let b_turn = libm::round(b_turn / p) * p;
-    // Rotate b to start where it crosses c (mod p).
-    let starts_there = b.first().and_then(|t| t.qs.first()).is_some_and(|q| {
+    // Rotate b to start where it crosses c (mod p): at a track's first
+    // sample when one lies on that line (pieces of a circle often meet
+    // exactly there), else inside the first track that crosses it.
+    let on_line = |q: &DVec2| {
         let r = (q[k] - c) - p * libm::floor((q[k] - c) / p);
-        r.min(p - r) <= 1e-12 * p
-    });
+        r.min(p - r) <= 1e-9 * p
+    };
     let mut rotated: Vec<Track> = Vec::with_capacity(b.len() + 1);
-    if starts_there {
-        rotated = b;
+    let mut shift = DVec2::ZERO;
+    shift[k] = b_turn;
+    if let Some(i) = b.iter().position(|t| t.qs.first().is_some_and(on_line)) {
+        rotated.extend(b[i..].iter().cloned());
+        for t in &b[..i] {
+            let mut t = t.clone();
+            t.shift(shift);
+            rotated.push(t);
+        }
     } else {
         let mut cut = None;
         for (i, t) in b.iter_mut().enumerate() {
@@ -462,8 +473,6 @@ fn join_across_seam(
         let Some((i, (head, tail))) = cut else {
             return Err("a trim loop going round the surface does not cross its partner's seam".into());
         };
-        let mut shift = DVec2::ZERO;
-        shift[k] = b_turn;
         rotated.push(tail);
         rotated.extend(b.iter().skip(i + 1).cloned());
         for t in b.iter().take(i).cloned().chain(core::iter::once(head)) {

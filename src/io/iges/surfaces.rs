@@ -245,7 +245,10 @@ impl Revolution {
         let (x, y) = self.frame();
         let r = radial.length();
         let scale = self.origin.length() + w.length() + 1e-300;
-        let on_axis = r <= 1e-10 * scale;
+        // A vertex meant to lie on the axis (a sphere's pole, a cone's apex)
+        // is written a few digits short of it: within 1e-7 of its distance
+        // from the origin its angle is noise, not a direction.
+        let on_axis = r <= 1e-10 * scale + 1e-7 * w.length();
         let mut theta = if on_axis { hint.map_or(0.0, |q| q.y) } else { libm::atan2(radial.dot(y), radial.dot(x)) };
         let t = match &self.profile {
             Profile::Line { p0, d } => {
@@ -257,14 +260,32 @@ impl Revolution {
                 };
                 let (t, e) = foot(DVec2::new(r, h));
                 let (t2, e2) = foot(DVec2::new(-r, h));
-                if e2 < e && !on_axis {
+                if on_axis && d.x != 0.0 {
+                    // On the axis means at the apex, exactly: the loop's
+                    // corner is then the pole, not a hair beside it.
+                    -p0.x / d.x
+                } else if e2 < e && !on_axis {
                     theta += if theta > 0.0 { -core::f64::consts::PI } else { core::f64::consts::PI };
                     t2
                 } else {
                     t
                 }
             }
-            Profile::Circle { c, .. } => libm::atan2(h - c.y, r - c.x),
+            Profile::Circle { c, rho, .. } => {
+                let t = libm::atan2(h - c.y, r - c.x);
+                // On the axis: exactly where the circle crosses it (a sphere's pole).
+                let cross = -c.x / rho.max(1e-300);
+                if on_axis && cross.abs() <= 1.0 {
+                    let pole = libm::acos(cross);
+                    if t < 0.0 {
+                        -pole
+                    } else {
+                        pole
+                    }
+                } else {
+                    t
+                }
+            }
             Profile::Curve(curve) => {
                 let q = self.origin + self.axis * h + x * r;
                 curve.project(q).0

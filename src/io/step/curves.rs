@@ -254,8 +254,10 @@ impl Geo<'_> {
             let prefer_param = a.enumeration(5).map(|m| m == "PARAMETER").unwrap_or(false);
             let t1 = self.trim_value(e, &inner.curve, &a, 2, prefer_param)?;
             let t2 = self.trim_value(e, &inner.curve, &a, 3, prefer_param)?;
+            // The trimmed curve runs from trim_1 to trim_2, along its basis
+            // when `sense` and against it otherwise (ISO 10303-42).
             let range = match (t1, t2) {
-                (Some(t1), Some(t2)) => Some(if sense { (t1, t2) } else { (t2, t1) }),
+                (Some(t1), Some(t2)) => Some((t1, t2)),
                 _ => None,
             };
             return Ok(CurveDef { curve: inner.curve, range, reversed: !sense ^ inner.reversed });
@@ -524,15 +526,21 @@ pub(super) fn pieces_between(c: &Curve3, t0: f64, t1: f64) -> Result<Vec<NurbsCu
                 }
                 return Ok(alloc::vec![seg(c, s0, s1)?]);
             }
-            // Wraps past the end: two pieces (parameters brought into the domain).
-            let wrap = |t: f64| a + (t - a) - per * libm::floor((t - a) / per);
-            let (s0, s1) = (wrap(t0), wrap(t1));
-            let mut out = Vec::new();
-            if b - s0 > tiny {
-                out.push(seg(c, s0, b)?);
+            // Wraps past the end: the start brought into the domain (a start
+            // at the domain's end is its beginning), then one piece or two.
+            let mut s0 = a + (t0 - a) - per * libm::floor((t0 - a) / per);
+            if b - s0 <= tiny {
+                s0 = a;
             }
-            if s1 - a > tiny {
-                out.push(seg(c, a, s1)?);
+            let s1 = s0 + (t1 - t0).min(per);
+            let mut out = Vec::new();
+            if s1 <= b + tiny {
+                out.push(seg(c, s0, s1.min(b))?);
+            } else {
+                out.push(seg(c, s0, b)?);
+                if s1 - per - a > tiny {
+                    out.push(seg(c, a, s1 - per)?);
+                }
             }
             if out.is_empty() {
                 return Err("empty closed-curve range".into());
@@ -563,4 +571,51 @@ pub(super) fn bounded_pieces(def: &CurveDef) -> Result<Vec<NurbsCurve>, String> 
         rev_all(&mut out)?;
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// A full circle as one B-spline over [0, 2] that starts and ends at (5, 0, 0).
+    fn closed_circle() -> Curve3 {
+        let x = DVec3::X * 5.0;
+        let y = DVec3::Y * 5.0;
+        let c = ellipse_arc(DVec3::ZERO, x, y, 0.0, core::f64::consts::TAU).unwrap();
+        Curve3::Nurbs { c: crate::nurbs::reparam::reparametrized(&c, 0.0, 2.0).unwrap(), closed: true }
+    }
+
+    fn span_of(pieces: &[NurbsCurve]) -> f64 {
+        pieces
+            .iter()
+            .map(|c| {
+                let (a, b) = c.domain();
+                (0..64)
+                    .map(|k| {
+                        c.point(a + (b - a) * k as f64 / 64.0).distance(c.point(a + (b - a) * (k + 1) as f64 / 64.0))
+                    })
+                    .sum::<f64>()
+            })
+            .sum()
+    }
+
+    /// An edge from the curve's closing point to its middle: where the start
+    /// is found at the end of the domain, the range wraps to the half after
+    /// it, not the whole turn and that half again.
+    #[test]
+    fn a_range_starting_at_the_domain_end_wraps_to_its_beginning() {
+        let c = closed_circle();
+        let half = core::f64::consts::PI * 5.0;
+        for (t0, t1) in [(2.0, 3.0), (0.0, 1.0), (1.5, 2.5), (2.0 - 1e-12, 3.0)] {
+            let pieces = pieces_between(&c, t0, t1).unwrap();
+            let len = span_of(&pieces);
+            assert!((len - half).abs() < 1e-3 * half, "{t0}..{t1}: length {len}, expected {half}");
+        }
+        let Curve3::Nurbs { c: n, .. } = &c else { unreachable!() };
+        let first = pieces_between(&c, 2.0, 3.0).unwrap();
+        let (a, b) = first[0].domain();
+        assert!(first[0].point(a).distance(n.point(0.0)) < 1e-9, "starts at the closing point");
+        assert!(first.last().unwrap().point(b.max(a)).distance(DVec3::new(-5.0, 0.0, 0.0)) < 1e-9);
+    }
 }
