@@ -46,7 +46,7 @@ pub use mesh::{
     angle_stats, edge_counts, edge_counts_in_bodies, weld_mesh, weld_positions, AngleStats, EdgeCounts, FaceRange,
     Mesh, Report,
 };
-pub use model::{Face, FaceSurface, Model, TrimLoop};
+pub use model::{Face, FaceSurface, Model, TessellatedFace, TrimLoop};
 pub use nurbs::{
     project_to_surface, Aabb, BasisDers, CurveDerivs, KnotVector, NurbsCurve, NurbsError, NurbsSurface, Projection,
     ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,

@@ -76,7 +76,8 @@ export interface MeshOutput {
   faceColors: Float32Array;
   /** Part names: one per part instance of a STEP assembly ("" when unnamed); one "" for other formats. */
   parts: string[];
-  /** The measured report (tolerance, triangles, max_deviation, warnings, ...). */
+  /** The measured report (tolerance, triangles, max_deviation, warnings, ...); `faces_tessellated`
+   * counts the faces given as triangles (STEP tessellated faces), which max_deviation does not cover. */
   report: Record<string, any>;
 }
 

@@ -642,6 +642,26 @@ fn step_assembly_parts_and_colours_reach_js() {
     assert!(bytes >= 65536.0 && bytes % 65536.0 == 0.0, "{bytes}");
 }
 
+/// A tessellated solid placed by an assembly: its four faces pass through
+/// with their part and colours, and the report counts them as tessellated.
+#[wasm_bindgen_test]
+fn step_tessellated_faces_reach_js_counted() {
+    let bytes = include_bytes!("data/step_tess_solid.stp");
+    let v =
+        binding::mesh(bytes.to_vec(), "step", JsValue::UNDEFINED).unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+    let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
+    assert_eq!(get("faceRanges").dyn_into::<Uint32Array>().expect("faceRanges").to_vec(), [0, 1, 1, 1, 2, 1, 3, 1]);
+    let parts: Vec<String> =
+        get("parts").dyn_into::<Array>().expect("parts").iter().map(|p| p.as_string().expect("name")).collect();
+    assert_eq!(parts, ["Tetra"]);
+    let colours = get("faceColors").dyn_into::<Float32Array>().expect("faceColors").to_vec();
+    assert_eq!(&colours[0..3], &[0.8, 0.2, 0.1]);
+    assert_eq!(&colours[9..12], &[0.0, 0.0, 1.0]);
+    let report = get("report");
+    let field = |f: &str| Reflect::get(&report, &f.into()).unwrap().as_f64().unwrap();
+    assert_eq!((field("faces"), field("faces_tessellated"), field("triangles")), (4.0, 4.0, 4.0));
+}
+
 /// Paper 001 by default: a crowded surface is flagged and rebuilt without
 /// the option, and `"off"` leaves it as it is.
 #[wasm_bindgen_test]

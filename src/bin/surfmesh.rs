@@ -108,8 +108,16 @@ fn mesh(m: &MeshArgs) -> Result<(), String> {
 
     let r = &result.report;
     let verdict = if r.max_deviation <= r.tolerance { "<=" } else { "EXCEEDS" };
+    // Faces without an exact surface are not measured: the line says so.
+    let unverified = match r.faces_tessellated {
+        0 => String::new(),
+        n if n == r.faces => format!(" (all {n} faces tessellated: not verified)"),
+        1 => " (1 tessellated face not verified)".into(),
+        n => format!(" ({n} tessellated faces not verified)"),
+    };
     eprintln!(
-        "surfmesh: {}: {} triangles, max deviation {:.3e} {verdict} tolerance {:.3e} {}, {:.1} ms (parse {:.1} ms)",
+        "surfmesh: {}: {} triangles, max deviation {:.3e} {verdict} tolerance {:.3e} {}{unverified}, {:.1} ms \
+         (parse {:.1} ms)",
         m.input.display(),
         r.triangles,
         r.max_deviation,

@@ -715,6 +715,12 @@ fn cli_meshes_step_by_extension_content_and_name() {
         assert_eq!(r["faces"], 3);
         assert_eq!(r["boundary_edges"], 0);
     }
+    // Tessellated faces: counted in the report, and the summary line says
+    // they are not verified.
+    let out = mesh_ok(&["mesh".as_ref(), data("step_tess_mixed.stp").as_os_str()]);
+    let r = check_report(&out.stdout);
+    assert_eq!((r["faces"].as_u64(), r["faces_tessellated"].as_u64()), (Some(2), Some(1)));
+    assert!(stderr(&out).contains("(1 tessellated face not verified)"), "{}", stderr(&out));
     let out = run(&["mesh".as_ref(), data("step_unclosed_string.stp").as_os_str()]);
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("STEP line 10, #7: string not closed by a quote"), "{}", stderr(&out));

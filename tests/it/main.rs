@@ -10,6 +10,7 @@ mod repair;
 mod reparam;
 mod shapes;
 mod step;
+mod tessellated;
 
 /// Triangles with two corners at one point (up to rounding): no area, a
 /// NaN normal for a viewer, and the worst of every quality measure.

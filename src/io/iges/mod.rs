@@ -157,7 +157,7 @@ pub fn read_iges(bytes: &[u8]) -> Result<Model, Error> {
             )
         }));
     }
-    Ok(Model { units: g.units, faces, warnings, tolerance: ctx.resolution, bodies })
+    Ok(Model { units: g.units, faces, warnings, tolerance: ctx.resolution, bodies, tessellated: Vec::new() })
 }
 
 /// The Global section: delimiters (fields 1–2), model space scale (13),
