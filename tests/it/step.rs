@@ -578,3 +578,51 @@ fn a_face_across_the_seam_of_an_unclamped_periodic_surface_meshes() {
         assert!((2.0 - 1e-6..=8.0 + 1e-6).contains(&p.z), "{p} off the face's heights");
     }
 }
+
+/// A band round a cylinder whose lower border overhangs in four waves
+/// (angle `t + 1.5 sin 4t`, height `3 + 2 sin 4t`): every line of constant
+/// angle crosses it three or five times, so the face is cut open along a
+/// line where two crossings face the upper circle, and the cut face spans
+/// more than one turn. Its area is the integral of the band's height along
+/// the unrolled border, 5 · 14π.
+#[test]
+fn a_band_whose_border_overhangs_is_cut_where_the_cut_crosses_nothing() {
+    let model = read_step(&data("step_cylinder_wavy_band.stp")).unwrap();
+    assert_eq!(model.faces.len(), 1, "{:?}", model.warnings);
+    for rel in [1e-2, 1e-3] {
+        let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(rel)).unwrap();
+        let rep = &r.report;
+        assert!(rep.max_deviation <= rep.tolerance && rep.inverted_triangles == 0 && rep.free_edges == 0, "{rep:?}");
+        let exact = 70.0 * std::f64::consts::PI;
+        let a = area(&r.mesh, 0..1);
+        let slack = if rel < 2e-3 { 0.005 } else { 0.03 };
+        assert!((a - exact).abs() < slack * exact, "at {rel}: area {a}, exact {exact}");
+        for p in &r.mesh.positions {
+            assert!(
+                (p.x.hypot(p.y) - 5.0).abs() < 0.1 && (1.0 - 1e-6..=10.0 + 1e-6).contains(&p.z),
+                "{p} off the band"
+            );
+        }
+    }
+}
+
+/// A band round a cylinder with a hole across the line where the band would
+/// first be cut open (its loops' common start angle): the cut moves to a
+/// line that crosses only the two circles, and the face keeps its hole (the
+/// unrolled ellipse of semi-axes 1.5 and 1.5 out of the 10 × 10π band).
+#[test]
+fn a_band_with_a_hole_on_the_first_cut_line_is_cut_beside_it() {
+    let model = read_step(&data("step_cylinder_band_hole.stp")).unwrap();
+    assert_eq!(model.faces.len(), 1, "{:?}", model.warnings);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-3)).unwrap();
+    let rep = &r.report;
+    assert!(rep.max_deviation <= rep.tolerance && rep.inverted_triangles == 0 && rep.free_edges == 0, "{rep:?}");
+    let exact = (100.0 - 2.25) * std::f64::consts::PI;
+    let a = area(&r.mesh, 0..1);
+    assert!((a - exact).abs() < 0.003 * exact, "area {a}, exact {exact}");
+    // No vertex inside the hole.
+    for p in &r.mesh.positions {
+        let (x, y) = (5.0 * p.y.atan2(p.x) / 1.5, (p.z - 5.0) / 1.5);
+        assert!(x * x + y * y > 0.95, "{p} inside the hole");
+    }
+}

@@ -20,6 +20,7 @@ mod lexer;
 pub(super) mod loops;
 pub(super) mod surfaces;
 mod untangle;
+mod wrap;
 mod xform;
 
 use alloc::string::String;

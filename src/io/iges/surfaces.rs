@@ -22,7 +22,7 @@ use crate::model::FaceSurface;
 use crate::nurbs::analytic::{bilinear, circle_arc, extrude, revolve, ruled, ArcParam};
 use crate::nurbs::join::join;
 use crate::nurbs::reparam::{reparametrized, segment};
-use crate::nurbs::seam::rotate_seam;
+use crate::nurbs::seam::{rotate_seam, unroll};
 use crate::nurbs::{project_to_surface, NurbsCurve, NurbsSurface, ProjectionOptions, Surface, MAX_DEGREE};
 use crate::Error;
 
@@ -156,6 +156,21 @@ impl SurfDef {
             }
             Self::Offset { base, distance } => {
                 Some(Self::Offset { base: Box::new(base.rotate_seam(along_u, c)?), distance: *distance })
+            }
+            _ => None,
+        }
+    }
+
+    /// The closed B-spline surface unrolled along u (`along_u`) or v over
+    /// native range `[a, b]`, which may exceed its period (see [`unroll`]).
+    pub fn unroll(&self, along_u: bool, a: f64, b: f64) -> Option<Self> {
+        match self {
+            Self::Nurbs { surface, periods, .. } => {
+                let s = unroll(surface, along_u, a, b)?;
+                Some(Self::Nurbs { surface: s, periods: *periods, natural: None })
+            }
+            Self::Offset { base, distance } => {
+                Some(Self::Offset { base: Box::new(base.unroll(along_u, a, b)?), distance: *distance })
             }
             _ => None,
         }
