@@ -482,3 +482,7 @@ fn shares_of_the_bodies_make_the_whole_mesh() {
     assert_eq!(empty.mesh.face_ranges.len(), 12, "every face is listed, with no triangles");
     assert!(mesh_model(&model, &options.clone().with_share(2, 2)).is_err(), "an index past the count is refused");
 }
+
+/// Flaws a tolerant reader forgives, in a file of their own.
+#[path = "step_lenient.rs"]
+mod lenient;

@@ -113,7 +113,7 @@ pub fn read_step_with_shells(bytes: &[u8]) -> Result<(Model, Vec<StepShell>), Er
 /// As [`read_step`].
 pub fn read_step_parts(bytes: &[u8]) -> Result<StepModel, Error> {
     let g = parser::parse(bytes)?;
-    let mut warnings = Vec::new();
+    let mut warnings = g.forgiven.warnings();
     let plan = assembly::plan(&g, &mut warnings)?;
     let shapes = shapes::read_shapes(&g, &plan, &mut warnings)?;
     if shapes.faces.is_empty() {
