@@ -250,7 +250,9 @@ fn cut(
 fn curve_scale(c: &Curve3) -> f64 {
     match c {
         Curve3::Line { d, .. } => d.length(),
-        Curve3::Conic { x, y, .. } => x.length().max(y.length()),
+        Curve3::Conic { x, y, .. } | Curve3::Hyperbola { x, y, .. } | Curve3::Parabola { x, y, .. } => {
+            x.length().max(y.length())
+        }
         Curve3::Nurbs { c, .. } => c.bbox().diagonal(),
     }
 }
