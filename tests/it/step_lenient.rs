@@ -72,3 +72,58 @@ fn a_string_that_never_closes_is_still_an_error() {
     let m = read_step(&data("step_unclosed_string.stp")).unwrap_err().to_string();
     assert_eq!(m, "STEP line 10, #7: string not closed by a quote");
 }
+
+/// The end vertex of the square's right edge is a reference to nothing
+/// (`#18446744073709551615`, a writer's -1): the top edge, next in the
+/// loop, starts there, so the face is whole.
+#[test]
+fn a_missing_vertex_is_taken_from_the_next_edge_of_its_loop() {
+    let w = square_warnings("step_lenient_dangling_vertex.stp");
+    assert_eq!(
+        w,
+        ["#51 EDGE_CURVE: its end vertex #18446744073709551615 is not defined; \
+          the point its neighbour in loop #70 gives is used"]
+    );
+    // With the top edge's vertex there gone too, nothing gives the corner:
+    // the face is skipped naming the reference, and with it the file.
+    let text = String::from_utf8(data("step_lenient_dangling_vertex.stp")).unwrap();
+    let broken = text.replace("#52=EDGE_CURVE('',#23,#22,", "#52=EDGE_CURVE('',#23,#998,");
+    let m = read_step(broken.as_bytes()).unwrap_err().to_string();
+    assert!(m.contains("#51") && m.contains("#18446744073709551615, which is not defined"), "{m}");
+}
+
+/// A file that parses but holds no face says what it holds instead.
+#[test]
+fn a_file_without_faces_says_what_it_holds() {
+    let file = |data: &str| {
+        format!(
+            "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION((''),'2;1');\nFILE_NAME('','',(''),(''),'','','');\n\
+             FILE_SCHEMA(('S'));\nENDSEC;\nDATA;\n{data}\nENDSEC;\nEND-ISO-10303-21;\n"
+        )
+    };
+    let message = |data: &str| read_step(file(data).as_bytes()).unwrap_err().to_string();
+    let lead = "STEP: no faces, shells, solids or surfaces in the file: ";
+    let line = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=DIRECTION('',(1.,0.,0.));\n#3=VECTOR('',#2,1.);\n\
+                #4=LINE('',#1,#3);\n#5=GEOMETRIC_CURVE_SET('',(#4));";
+    assert_eq!(message(line), format!("{lead}it holds only curves and points (1 curve)"));
+    let csg = "#1=CARTESIAN_POINT('',(0.,0.,0.));\n#2=AXIS1_PLACEMENT('',#1,$);\n\
+               #3=RIGHT_CIRCULAR_CYLINDER('',#2,2.,1.);\n#4=CSG_SOLID('',#3);";
+    assert_eq!(
+        message(csg),
+        format!(
+            "{lead}its solids are given by construction (2 operations: primitives, sweeps, Boolean operations), \
+             which this reader does not evaluate"
+        )
+    );
+    let assembly = "#1=PRODUCT('a','a','',());\n#2=PRODUCT_DEFINITION_FORMATION('','',#1);\n\
+                    #3=PRODUCT_DEFINITION('','',#2,$);\n#4=NEXT_ASSEMBLY_USAGE_OCCURRENCE('','','',#3,#3,$);\n\
+                    #5=DOCUMENT_FILE('part.stp','',$,$,'',$);";
+    assert_eq!(
+        message(assembly),
+        format!("{lead}it holds an assembly structure (1 placed component) whose parts' geometry is in another file ('part.stp')")
+    );
+    assert_eq!(
+        message("#1=PRODUCT('a','a','',());"),
+        format!("{lead}it holds no geometry (only product data and placements)")
+    );
+}

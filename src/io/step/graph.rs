@@ -514,6 +514,18 @@ impl Graph {
         }
     }
 
+    /// The text of a string value (also inside a typed value, `IDENTIFIER('…')`).
+    pub fn text(&self, v: Value) -> Option<&str> {
+        match v {
+            Value::Str { start, len } => Some(self.str_of(start, len)),
+            Value::Typed { at, .. } => match self.values.get(at as usize)? {
+                Value::Str { start, len } => Some(self.str_of(*start, *len)),
+                _ => None,
+            },
+            _ => None,
+        }
+    }
+
     /// The keyword of a typed value and its inner value.
     pub fn typed(&self, v: Value) -> Option<(&str, Value)> {
         match v {
