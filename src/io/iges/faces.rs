@@ -107,9 +107,17 @@ pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face
             _ => continue,
         };
         for (de, job) in jobs {
-            let Ok(fe) = ctx.entity(de) else {
-                skip(warnings, &mut first_error, e, ctx.entity(de).err().unwrap_or(Error::Internal("entity".into())));
-                continue;
+            let fe = match ctx.entity(de) {
+                Ok(fe) => fe,
+                // Damaged parameter data: the directory's warning named it already.
+                Err(err) if ctx.dir.get(de).is_some_and(|x| x.damage.is_some()) => {
+                    first_error.get_or_insert(err);
+                    continue;
+                }
+                Err(err) => {
+                    skip(warnings, &mut first_error, e, err);
+                    continue;
+                }
             };
             let mut local = Vec::new();
             let result =

@@ -89,8 +89,11 @@ impl Ctx<'_> {
     /// The entity at directory entry `de`.
     ///
     /// # Errors
-    /// No entity there (a bad pointer).
+    /// No entity there (a bad pointer), or one whose parameter data could not be read.
     fn entity(&self, de: usize) -> Result<&Entity, Error> {
+        if let Some(err) = self.dir.get(de).and_then(|e| e.damage.as_ref()) {
+            return Err(err.clone());
+        }
         self.dir.get(de).ok_or_else(|| {
             iges_error(
                 Section::Directory,
@@ -105,6 +108,24 @@ impl Ctx<'_> {
     }
 }
 
+/// Why a file gave no face at all: the entity types it holds instead.
+fn no_faces(dir: &Directory) -> String {
+    let mut kinds: Vec<(u32, usize)> = Vec::new();
+    for e in &dir.entities {
+        match kinds.iter_mut().find(|k| k.0 == e.kind) {
+            Some(k) => k.1 += 1,
+            None => kinds.push((e.kind, 1)),
+        }
+    }
+    kinds.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    let shown: Vec<String> = kinds.iter().take(6).map(|(k, n)| alloc::format!("{n} of type {k}")).collect();
+    let more = if kinds.len() > 6 { ", …" } else { "" };
+    alloc::format!(
+        "no surfaces or faces in the file, only curves, points, annotations or structure (entities: {}{more})",
+        shown.join(", ")
+    )
+}
+
 /// Units, scale and resolution from the Global section.
 struct Global {
     param: u8,
@@ -112,6 +133,13 @@ struct Global {
     scale: f64,
     units: String,
     resolution: Option<f64>,
+}
+
+impl Default for Global {
+    /// The standard's defaults: `,` and `;`, model space scale 1, millimetres.
+    fn default() -> Self {
+        Self { param: b',', record: b';', scale: 1.0, units: "mm".into(), resolution: None }
+    }
 }
 
 /// Reads an IGES file.
@@ -127,16 +155,33 @@ struct Global {
 /// [`Error::Iges`] for a malformed file (section, line and entity named),
 /// and when no face at all could be read (the first face's error).
 pub fn read_iges(bytes: &[u8]) -> Result<Model, Error> {
-    let sections = split_sections(bytes)?;
-    if sections.global.is_empty() {
-        return Err(iges_error(Section::Global, 0, 0, "no Global section (not an IGES file?)"));
-    }
-    let g = global(&sections.global)?;
+    let mut sections = split_sections(bytes)?;
     if sections.directory.is_empty() {
-        return Err(iges_error(Section::Directory, 0, 0, "no Directory entries: the file holds no entities"));
+        return Err(iges_error(
+            Section::Directory,
+            0,
+            0,
+            if sections.global.is_empty() {
+                "no Global section and no Directory entries (not an IGES file?)"
+            } else {
+                "no Directory entries: the file holds no entities"
+            },
+        ));
     }
-    let dir = Directory::parse(&sections.directory, &sections.parameter, g.param, g.record)?;
-    let mut warnings = Vec::new();
+    let mut warnings = core::mem::take(&mut sections.notes);
+    // Nothing the Global section holds is needed to read the entities: its
+    // defaults (delimiters `,` and `;`, scale 1, millimetres) stand in.
+    let g = if sections.global.is_empty() {
+        warnings.push("no Global section: the default delimiters, scale and unit are used".into());
+        Global::default()
+    } else {
+        global(&sections.global).unwrap_or_else(|e| {
+            warnings.push(alloc::format!("{e}; the default delimiters, scale and unit are used"));
+            Global::default()
+        })
+    };
+    let mut dir = Directory::parse(&sections.directory, &sections.parameter, g.param, g.record)?;
+    warnings.append(&mut dir.notes);
     if let Some(line) = sections.truncated {
         warnings.push(alloc::format!("line {line} is cut short (file truncated?): ignored"));
     }
@@ -148,14 +193,7 @@ pub fn read_iges(bytes: &[u8]) -> Result<Model, Error> {
     };
     let (faces, bodies, first_error) = faces::read_faces(&ctx, &mut warnings);
     if faces.is_empty() {
-        return Err(first_error.unwrap_or_else(|| {
-            iges_error(
-                Section::Directory,
-                0,
-                0,
-                "no surfaces or faces in the file (only curves, points or annotations?)",
-            )
-        }));
+        return Err(first_error.unwrap_or_else(|| iges_error(Section::Directory, 0, 0, no_faces(&dir))));
     }
     Ok(Model { units: g.units, faces, warnings, tolerance: ctx.resolution, bodies })
 }
