@@ -20,10 +20,15 @@ fn meshed_area(model: &Model) -> f64 {
 
 /// Reads `bytes`, checks it is the square, and returns its warnings.
 fn square_warnings(name: &str, bytes: &[u8]) -> Vec<String> {
+    one_face_warnings(name, bytes, 100.0)
+}
+
+/// Reads `bytes`, checks it is one face of area `area`, and returns its warnings.
+fn one_face_warnings(name: &str, bytes: &[u8], area: f64) -> Vec<String> {
     let model = read_iges(bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
     assert_eq!(model.faces.len(), 1, "{name}: {:?}", model.warnings);
-    let area = meshed_area(&model);
-    assert!((area - 100.0).abs() < 1e-9, "{name}: area {area}");
+    let meshed = meshed_area(&model);
+    assert!((meshed - area).abs() < 1e-9, "{name}: area {meshed}, {area} expected");
     model.warnings
 }
 
@@ -86,4 +91,22 @@ fn lower_case_section_letters_are_read() {
         .collect();
     let w = square_warnings("lower case", text.as_bytes());
     assert_eq!(w, ["line 1: the section letter in lower case; read as upper case (and 8 more like it)"]);
+}
+
+/// The square trimmed to [2, 8]² by four 126 lines whose parameter ranges
+/// are all [0, 0]: each curve is read over its knots' whole domain, one
+/// warning for the four.
+#[test]
+fn an_empty_curve_range_is_read_as_the_whole_curve() {
+    let w = one_face_warnings("empty range", &data("iges_lenient_empty_range.igs"), 36.0);
+    assert_eq!(
+        w,
+        ["IGES Parameter section line 23, entity DE 3: B-spline curve's parameter range [0, 0] holds none of the \
+          curve; its whole domain [0, 1] is used (and 3 more like it)"]
+    );
+    // Inverted ranges, [1, 0]: read the other way round, the same face.
+    let text = String::from_utf8(data("iges_lenient_empty_range.igs")).unwrap().replace(",0,0,0,0,1;", ",1,0,0,0,1;");
+    let w = one_face_warnings("inverted range", text.as_bytes(), 36.0);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].contains("range [1, 0] is inverted; read as [0, 1] (and 3 more like it)"), "{w:?}");
 }

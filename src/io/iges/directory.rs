@@ -7,7 +7,7 @@ use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 
 use super::lexer::{Record, Tokenizer, Value};
-use super::{iges_error, Section, MAX_ENTITIES, MAX_PARAMS};
+use super::{iges_error, Notes, Section, MAX_ENTITIES, MAX_PARAMS};
 use crate::Error;
 
 /// One entity: its directory entry fields and parameters.
@@ -43,28 +43,6 @@ pub(super) struct Directory {
     pub notes: Vec<String>,
 }
 
-/// Notes of one kind: the first's message and how many followed it.
-#[derive(Default)]
-struct Notes {
-    kinds: Vec<(&'static str, String, usize)>,
-}
-
-impl Notes {
-    fn note(&mut self, kind: &'static str, message: impl FnOnce() -> String) {
-        match self.kinds.iter_mut().find(|k| k.0 == kind) {
-            Some(k) => k.2 += 1,
-            None => self.kinds.push((kind, message(), 0)),
-        }
-    }
-
-    fn into_warnings(self) -> Vec<String> {
-        self.kinds
-            .into_iter()
-            .map(|(_, m, more)| if more == 0 { m } else { alloc::format!("{m} (and {more} more like it)") })
-            .collect()
-    }
-}
-
 impl Directory {
     /// Parses the D and P sections with the file's delimiters.
     ///
@@ -76,7 +54,7 @@ impl Directory {
         let d = if d.len() % 2 != 0 && d.len() > 1 {
             // The last entry lost its second line (a truncated file): the others stand.
             let line = d.last().map_or(0, |r| r.line);
-            notes.note("odd", || {
+            notes.note("odd", 0, || {
                 let m = "odd number of directory records: the last entry's second line is missing \
                          (file truncated?); that entry is skipped";
                 iges_error(Section::Directory, line, d.len(), m).to_string()
@@ -158,7 +136,7 @@ impl Directory {
             let (pline, params, damage) = match parameters(p, de, kind, pstart, pcount, param, record, &mut notes) {
                 Ok((pline, params)) => (pline, params, None),
                 Err(err) => {
-                    notes.note(damage_kind(&err), || alloc::format!("{err}; the entity is skipped"));
+                    notes.note(damage_kind(&err), de, || alloc::format!("{err}; the entity is skipped"));
                     (0, alloc::vec![Value::Int(kind)], Some(err))
                 }
             };
@@ -174,7 +152,7 @@ impl Directory {
                 damage,
             });
         }
-        Ok(Self { entities, notes: notes.into_warnings() })
+        Ok(Self { entities, notes: notes.warnings() })
     }
 
     /// The entity with directory entry number `de`, if there is one.
@@ -257,7 +235,7 @@ fn parameters(
         ));
     }
     if by_count > p.len() {
-        notes.note("overrun", || {
+        notes.note("overrun", de, || {
             let m = alloc::format!(
                 "parameter data lines {first}..{by_count} run past the Parameter section's {} lines; \
                  read up to the entity's ';'",

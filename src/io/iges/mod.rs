@@ -76,6 +76,36 @@ fn iges_error(section: Section, line: usize, entity: usize, message: impl Into<S
     Error::Iges { section: section.name(), line, entity, message: message.into() }
 }
 
+/// What the reader forgave, one warning per kind: the first occurrence's
+/// message and how many more entities of that kind followed (an entity read
+/// twice, as a curve two faces share is, counts once).
+#[derive(Default)]
+struct Notes {
+    kinds: Vec<(&'static str, String, usize)>,
+    seen: crate::collections::HashSet<(&'static str, usize)>,
+}
+
+impl Notes {
+    /// Notes `kind` for entity `de` (0: none); `message` is made only for the first.
+    fn note(&mut self, kind: &'static str, de: usize, message: impl FnOnce() -> String) {
+        if de != 0 && !self.seen.insert((kind, de)) {
+            return;
+        }
+        match self.kinds.iter_mut().find(|k| k.0 == kind) {
+            Some(k) => k.2 += 1,
+            None => self.kinds.push((kind, message(), 0)),
+        }
+    }
+
+    /// One warning per kind, in the order the kinds were first met.
+    fn warnings(&self) -> Vec<String> {
+        self.kinds
+            .iter()
+            .map(|(_, m, more)| if *more == 0 { m.clone() } else { alloc::format!("{m} (and {more} more like it)") })
+            .collect()
+    }
+}
+
 /// What the readers of entities share.
 struct Ctx<'a> {
     dir: &'a Directory,
@@ -83,6 +113,8 @@ struct Ctx<'a> {
     world: DAffine3,
     /// Minimum resolution, output units.
     resolution: Option<f64>,
+    /// Repairs made while reading entities (see [`Notes`]).
+    notes: core::cell::RefCell<Notes>,
 }
 
 impl Ctx<'_> {
@@ -190,8 +222,10 @@ pub fn read_iges(bytes: &[u8]) -> Result<Model, Error> {
         dir: &dir,
         world: DAffine3::from_scale(glam::DVec3::splat(1.0 / g.scale)),
         resolution: g.resolution.map(|r| r / g.scale),
+        notes: core::cell::RefCell::default(),
     };
     let (faces, bodies, first_error) = faces::read_faces(&ctx, &mut warnings);
+    warnings.extend(ctx.notes.borrow().warnings());
     if faces.is_empty() {
         return Err(first_error.unwrap_or_else(|| iges_error(Section::Directory, 0, 0, no_faces(&dir))));
     }
