@@ -110,3 +110,52 @@ fn an_empty_curve_range_is_read_as_the_whole_curve() {
     assert_eq!(w.len(), 1, "{w:?}");
     assert!(w[0].contains("range [1, 0] is inverted; read as [0, 1] (and 3 more like it)"), "{w:?}");
 }
+
+/// A 308 definition holding the 10 × 10 square, placed by three 408
+/// instances: moved by (20, 0, 0) and scaled 2; moved by (0, 30, 0) then
+/// turned a quarter about z by the instance's matrix; and through a second
+/// definition that raises it by 5, moved by (100, 0, 0). The square itself
+/// is not a face of its own.
+#[test]
+fn subfigure_instances_place_their_definitions() {
+    let model = read_iges(&data("iges_subfigures.igs")).unwrap();
+    assert_eq!(model.faces.len(), 3, "{:?}", model.warnings);
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-3)).unwrap();
+    let boxes: Vec<([f64; 3], [f64; 3], f64)> = r
+        .mesh
+        .face_ranges
+        .iter()
+        .map(|fr| {
+            let (mut lo, mut hi, mut area) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3], 0.0);
+            for t in fr.first as usize..(fr.first + fr.count) as usize {
+                let [a, b, c] = r.mesh.triangle(t);
+                area += 0.5 * (b - a).cross(c - a).length();
+                for p in [a, b, c] {
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(p[k]);
+                        hi[k] = hi[k].max(p[k]);
+                    }
+                }
+            }
+            (lo, hi, area)
+        })
+        .collect();
+    let want = [
+        ([20.0, 0.0, 0.0], [40.0, 20.0, 0.0], 400.0),
+        ([-40.0, 0.0, 0.0], [-30.0, 10.0, 0.0], 100.0),
+        ([100.0, 0.0, 5.0], [110.0, 10.0, 5.0], 100.0),
+    ];
+    for (got, want) in boxes.iter().zip(&want) {
+        for k in 0..3 {
+            assert!((got.0[k] - want.0[k]).abs() < 1e-9 && (got.1[k] - want.1[k]).abs() < 1e-9, "{got:?} vs {want:?}");
+        }
+        assert!((got.2 - want.2).abs() < 1e-9, "{got:?} vs {want:?}");
+    }
+    // A definition that instances itself: that instance is skipped naming the cycle, the others read.
+    let text = String::from_utf8(data("iges_subfigures.igs")).unwrap().replace("408,3,0,0,5; ", "408,11,0,0,5;");
+    let model = read_iges(text.as_bytes()).unwrap();
+    assert_eq!(model.faces.len(), 2, "{:?}", model.warnings);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(model.warnings[0].starts_with("DE 15 (type 408): skipped") && model.warnings[0].contains("(a cycle?)"));
+}
