@@ -318,3 +318,29 @@ mod corpus;
 /// Flaws a tolerant reader forgives, in a file of their own.
 #[path = "iges_lenient.rs"]
 mod lenient;
+
+/// Conic arcs (104) of hyperbolic and parabolic form, each closed by a
+/// chord on a plane: the border follows the exact conic (every vertex in the
+/// exact region, up to the trim fit) and the areas are the closed forms'.
+#[test]
+fn hyperbola_and_parabola_conic_arcs_are_exact() {
+    let model = read_iges(&data("iges_conic_arcs.igs")).unwrap();
+    assert_eq!(model.faces.len(), 2, "{:?}", model.warnings);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-4)).unwrap();
+    let tol = r.report.tolerance;
+    assert!(r.report.max_deviation <= tol);
+    // x²/16 − y²/9 = 1 from t = −1 to 1, closed by x = 4 cosh 1.
+    let (a, b, ch, sh) = (4.0_f64, 3.0_f64, 1f64.cosh(), 1f64.sinh());
+    let want = a * b * (ch * sh - 1.0);
+    assert!((face_area(&r.mesh, 0) - want).abs() < 30.0 * tol, "hyperbola: {} vs {want}", face_area(&r.mesh, 0));
+    for p in face_vertices(&r.mesh, 0) {
+        let gap = a * (1.0 + (p.y / b).powi(2)).sqrt() - p.x;
+        assert!(gap <= 0.1 * tol && p.x <= a * ch + 1e-9, "vertex {p} outside the hyperbola's segment");
+    }
+    // y² = 6 (x − 20), closed by x = 21.5: area 2/3 of the 6 × 1.5 rectangle.
+    assert!((face_area(&r.mesh, 1) - 6.0).abs() < 30.0 * tol, "parabola: {}", face_area(&r.mesh, 1));
+    for p in face_vertices(&r.mesh, 1) {
+        let gap = 20.0 + p.y * p.y / 6.0 - p.x;
+        assert!(gap <= 0.1 * tol && p.x <= 21.5 + 1e-9, "vertex {p} outside the parabola's segment");
+    }
+}
