@@ -15,9 +15,9 @@ use super::xform::own_transform;
 use super::{Ctx, MAX_DEPTH};
 use crate::Error;
 
-/// Most entities all instances place together: a file whose instances nest
-/// a hundred deep, ten to a level, must not expand without bound.
-pub(super) const MAX_PLACED: usize = 1_000_000;
+/// Most entities and instances all instances place together: a file whose
+/// instances nest sixty deep, ten to a level, must not expand without bound.
+pub(super) const MAX_PLACED: usize = 100_000;
 
 /// Which entities subfigures hold, found in one pass over the directory.
 #[derive(Default)]
@@ -120,6 +120,12 @@ impl Subfigures {
         }
         let local = DAffine3::from_scale_rotation_translation(DVec3::splat(s), glam::DQuat::IDENTITY, t);
         let m = parent * own_transform(ctx.dir, de)? * local * own_transform(ctx.dir, def_de)?;
+        // Instances count against the budget too: nested ones that place
+        // nothing must not multiply without bound either.
+        if count.left == 0 {
+            return Err(inst.error(alloc::format!("subfigure instances place more than {MAX_PLACED} entities")));
+        }
+        count.left -= 1;
         count.instances += 1;
         let instance = count.instances;
         for member in members(def) {
