@@ -626,3 +626,48 @@ fn a_band_with_a_hole_on_the_first_cut_line_is_cut_beside_it() {
         assert!(x * x + y * y > 0.95, "{p} inside the hole");
     }
 }
+
+/// Flaws a tolerant reader forgives, in a file of their own.
+#[path = "step_lenient.rs"]
+mod lenient;
+
+/// A hyperbola arc and a parabola arc, each closed by a chord on a plane,
+/// read as exact conics: every mesh vertex lies in the exact region (up to
+/// the trim curves' fit, a small part of the tolerance), the border follows
+/// the conic, and the areas are the closed forms' within the inscribed error.
+#[test]
+fn hyperbola_and_parabola_edges_are_exact() {
+    let model = read_step(&data("step_hyperbola_parabola.stp")).unwrap();
+    assert_eq!(model.faces.len(), 2, "{:?}", model.warnings);
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-4)).unwrap();
+    let tol = r.report.tolerance;
+    assert!(r.report.max_deviation <= tol);
+    let (a, b, f) = (4.0_f64, 3.0_f64, 1.5_f64);
+    let (ch, sh) = (1f64.cosh(), 1f64.sinh());
+    let face = |k: usize| {
+        let fr = r.mesh.face_ranges[k];
+        (fr.first as usize..(fr.first + fr.count) as usize).map(|t| r.mesh.triangle(t)).collect::<Vec<_>>()
+    };
+    let area =
+        |tris: &[[glam::DVec3; 3]]| tris.iter().map(|[p, q, s]| 0.5 * (*q - *p).cross(*s - *p).length()).sum::<f64>();
+    // Hyperbola (x/a)² − (y/b)² = 1 from t = −1 to 1, closed by x = a·cosh 1;
+    // `gap`: how far a point lies outside the branch along x.
+    let hyp = face(0);
+    let want = a * b * (ch * sh - 1.0);
+    assert!((area(&hyp) - want).abs() < 30.0 * tol, "hyperbola face area {} vs {want}", area(&hyp));
+    let gap = |p: &glam::DVec3| a * (1.0 + (p.y / b).powi(2)).sqrt() - p.x;
+    for p in hyp.iter().flatten() {
+        assert!(gap(p) <= 0.1 * tol && p.x <= a * ch + 1e-9, "vertex {p} outside the hyperbola's segment");
+    }
+    let on_curve = hyp.iter().flatten().filter(|p| gap(p).abs() <= 0.1 * tol).count();
+    assert!(on_curve > 10, "the border follows the hyperbola ({on_curve} vertices on it)");
+    // Parabola x − 20 = y² / 4f from y = −2f to 2f, closed by x = 20 + f.
+    let par = face(1);
+    let want = 8.0 * f * f / 3.0;
+    assert!((area(&par) - want).abs() < 30.0 * tol, "parabola face area {} vs {want}", area(&par));
+    for p in par.iter().flatten() {
+        let gap = 20.0 + p.y * p.y / (4.0 * f) - p.x;
+        assert!(gap <= 0.1 * tol && p.x <= 20.0 + f + 1e-9, "vertex {p} outside the parabola's segment");
+    }
+}

@@ -53,9 +53,9 @@ pub(super) fn shell_faces(ctx: &Ctx<'_>, de: usize) -> Result<Vec<usize>, Error>
     Ok(faces)
 }
 
-/// The transformation of the 186/514 chain a face sits in, as `parent`.
-pub(super) fn chain_transform(ctx: &Ctx<'_>, parents: &[usize]) -> Result<DAffine3, Error> {
-    let mut m = ctx.world;
+/// The transformation of the 186/514 chain a face sits in, after `base`, as `parent`.
+pub(super) fn chain_transform(ctx: &Ctx<'_>, base: DAffine3, parents: &[usize]) -> Result<DAffine3, Error> {
+    let mut m = base;
     for &p in parents {
         m *= own_transform(ctx.dir, p)?;
     }

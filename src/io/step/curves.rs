@@ -10,7 +10,7 @@ use glam::{DAffine3, DMat3, DVec3};
 
 use super::graph::{Ent, Graph};
 use super::{MAX_CONTROL_POINTS, MAX_DEPTH};
-use crate::nurbs::analytic::{ellipse_arc, line};
+use crate::nurbs::analytic::{ellipse_arc, hyperbola_arc, line, parabola_arc};
 use crate::nurbs::join::join;
 use crate::nurbs::reparam::{reversed, segment, with_end_points, RawCurve};
 use crate::nurbs::{NurbsCurve, MAX_DEGREE};
@@ -51,6 +51,10 @@ pub(super) enum Curve3 {
     Line { p: DVec3, d: DVec3 },
     /// `c + cos t·x + sin t·y` (`x`, `y` orthogonal, lengths the semi-axes), `t` in radians.
     Conic { c: DVec3, x: DVec3, y: DVec3 },
+    /// `c + cosh t·x + sinh t·y` (`x`, `y` orthogonal, lengths the semi-axes).
+    Hyperbola { c: DVec3, x: DVec3, y: DVec3 },
+    /// `c + t²·x + t·y` (`x` the focal distance along the axis, `y` twice it across).
+    Parabola { c: DVec3, x: DVec3, y: DVec3 },
     /// A B-spline; `closed` when it ends where it starts.
     Nurbs { c: NurbsCurve, closed: bool },
 }
@@ -223,6 +227,24 @@ impl Geo<'_> {
                 return Err(e.error("conic with a radius that is not positive"));
             }
             return basis(Curve3::Conic { c: f.o, x: f.x * r1, y: f.y * r2 });
+        }
+        if e.has("HYPERBOLA") {
+            let a = e.chain(&[("REPRESENTATION_ITEM", 1), ("CONIC", 1), ("HYPERBOLA", 2)])?;
+            let f = self.placement(a.ent(1)?)?;
+            let (r1, r2) = (a.real(2)?, a.real(3)?);
+            if !(r1 > 0.0 && r2 > 0.0 && r1.is_finite() && r2.is_finite()) {
+                return Err(e.error("hyperbola with a semi-axis that is not positive"));
+            }
+            return basis(Curve3::Hyperbola { c: f.o, x: f.x * r1, y: f.y * r2 });
+        }
+        if e.has("PARABOLA") {
+            let a = e.chain(&[("REPRESENTATION_ITEM", 1), ("CONIC", 1), ("PARABOLA", 1)])?;
+            let f = self.placement(a.ent(1)?)?;
+            let focal = a.real(2)?;
+            if !(focal.is_finite() && focal != 0.0) {
+                return Err(e.error("parabola with a zero focal distance"));
+            }
+            return basis(Curve3::Parabola { c: f.o, x: f.x * focal, y: f.y * (2.0 * focal) });
         }
         if is_bspline_curve(e) {
             let c = self.bspline_curve(e)?;
@@ -489,6 +511,8 @@ pub(super) fn param_of(c: &Curve3, p: DVec3) -> f64 {
             let w = p - *c;
             libm::atan2(w.dot(*y) / y.length_squared().max(1e-300), w.dot(*x) / x.length_squared().max(1e-300))
         }
+        Curve3::Hyperbola { c, y, .. } => libm::asinh((p - *c).dot(*y) / y.length_squared().max(1e-300)),
+        Curve3::Parabola { c, y, .. } => (p - *c).dot(*y) / y.length_squared().max(1e-300),
         Curve3::Nurbs { c, .. } => c.project(p).0,
     }
 }
@@ -496,7 +520,7 @@ pub(super) fn param_of(c: &Curve3, p: DVec3) -> f64 {
 /// Period of the curve's parameter, if it closes.
 pub(super) fn period(c: &Curve3) -> Option<f64> {
     match c {
-        Curve3::Line { .. } => None,
+        Curve3::Line { .. } | Curve3::Hyperbola { .. } | Curve3::Parabola { .. } => None,
         Curve3::Conic { .. } => Some(TAU),
         Curve3::Nurbs { c, closed } => closed.then(|| {
             let (a, b) = c.domain();
@@ -515,6 +539,8 @@ pub(super) fn pieces_between(c: &Curve3, t0: f64, t1: f64) -> Result<Vec<NurbsCu
     match c {
         Curve3::Line { p, d } => Ok(alloc::vec![line(*p + *d * t0, *p + *d * t1, 0.0, 1.0).map_err(err)?]),
         Curve3::Conic { c, x, y } => Ok(alloc::vec![ellipse_arc(*c, *x, *y, t0, t1).map_err(err)?]),
+        Curve3::Hyperbola { c, x, y } => Ok(alloc::vec![hyperbola_arc(*c, *x, *y, t0, t1).map_err(err)?]),
+        Curve3::Parabola { c, x, y } => Ok(alloc::vec![parabola_arc(*c, *x, *y, t0, t1).map_err(err)?]),
         Curve3::Nurbs { c, closed } => {
             let (a, b) = c.domain();
             let per = b - a;
@@ -558,6 +584,9 @@ pub(super) fn bounded_pieces(def: &CurveDef) -> Result<Vec<NurbsCurve>, String> 
         (None, Curve3::Nurbs { c, .. }) => c.domain(),
         (None, Curve3::Conic { .. }) => (0.0, TAU),
         (None, Curve3::Line { .. }) => return Err("an unbounded line in a composite curve".into()),
+        (None, Curve3::Hyperbola { .. } | Curve3::Parabola { .. }) => {
+            return Err("an unbounded hyperbola or parabola in a composite curve".into())
+        }
     };
     // The range runs from the start to the end of the trimmed curve; along
     // the basis parameter that is increasing unless `reversed`.

@@ -25,6 +25,7 @@ mod styles;
 mod surfaces;
 mod tessellated;
 
+use alloc::format;
 use alloc::string::String;
 use alloc::vec::Vec;
 use core::ops::Range;
@@ -119,7 +120,7 @@ pub fn read_step_with_shells(bytes: &[u8]) -> Result<(Model, Vec<StepShell>), Er
 /// As [`read_step`].
 pub fn read_step_parts(bytes: &[u8]) -> Result<StepModel, Error> {
     let g = parser::parse(bytes)?;
-    let mut warnings = Vec::new();
+    let mut warnings = g.forgiven.warnings();
     let assembly::Plan { placed, units, tolerance } = assembly::plan(&g, &mut warnings)?;
     // Exact shapes and tessellated ones are read apart, each with its own
     // share of the placements.
@@ -135,9 +136,7 @@ pub fn read_step_parts(bytes: &[u8]) -> Result<StepModel, Error> {
     };
     let facets = tessellated::read(&g, &tess_plan, &exact, &mut warnings);
     if shapes.faces.is_empty() && facets.faces.is_empty() {
-        return Err(shapes.first_error.unwrap_or_else(|| {
-            step_error(0, 0, "no faces, shells, solids or surfaces in the file (only curves, points or annotations?)")
-        }));
+        return Err(shapes.first_error.unwrap_or_else(|| step_error(0, 0, no_faces(&g))));
     }
     let part_name = |f: &mut Option<String>, placed: Option<&assembly::Placed>| {
         let part = placed.and_then(|p| p.name.as_ref());
@@ -220,4 +219,104 @@ pub fn read_step_parts(bytes: &[u8]) -> Result<StepModel, Error> {
     face_colours.extend(facets.colours);
     let model = Model { units, faces, warnings, tolerance, bodies, tessellated };
     Ok(StepModel { model, shells, parts, face_parts, face_colours })
+}
+
+/// Why a file that parsed gave no face at all: what it holds instead.
+fn no_faces(g: &graph::Graph) -> String {
+    let count = |names: &[&str]| g.all().filter(|e| names.iter().any(|n| e.has(n))).count();
+    let lead = "no faces, shells, solids or surfaces in the file";
+    let tessellated = count(&[
+        "TRIANGULATED_FACE",
+        "COMPLEX_TRIANGULATED_FACE",
+        "TRIANGULATED_SURFACE_SET",
+        "COMPLEX_TRIANGULATED_SURFACE_SET",
+        "TESSELLATED_SHELL",
+        "TESSELLATED_SOLID",
+    ]);
+    if tessellated > 0 {
+        return format!(
+            "{lead}: its shapes are tessellated ({}) and none of them could be read",
+            plural(tessellated, "triangulated item")
+        );
+    }
+    let csg = count(&[
+        "BOOLEAN_RESULT",
+        "CSG_SOLID",
+        "EXTRUDED_AREA_SOLID",
+        "EXTRUDED_FACE_SOLID",
+        "REVOLVED_AREA_SOLID",
+        "REVOLVED_FACE_SOLID",
+        "SWEPT_DISK_SOLID",
+        "BLOCK",
+        "RIGHT_ANGULAR_WEDGE",
+        "RIGHT_CIRCULAR_CONE",
+        "RIGHT_CIRCULAR_CYLINDER",
+        "SPHERE",
+        "TORUS",
+        "HALF_SPACE_SOLID",
+    ]);
+    if csg > 0 {
+        return format!(
+            "{lead}: its solids are given by construction ({}: primitives, sweeps, Boolean operations), \
+             which this reader does not evaluate",
+            plural(csg, "operation")
+        );
+    }
+    let placed = count(&["NEXT_ASSEMBLY_USAGE_OCCURRENCE"]);
+    if placed > 0 {
+        // The parts' files, where the file names them (an external source's
+        // or a document's name ending like a STEP file).
+        let mut files: Vec<&str> = Vec::new();
+        for e in g.all().filter(|e| e.has("EXTERNAL_SOURCE") || e.has("DOCUMENT_FILE")) {
+            for v in e.attrs().vals.iter().take(2) {
+                let Some(name) = g.text(*v) else { continue };
+                let lower = name.trim().to_ascii_lowercase();
+                let step = [".stp", ".step", ".p21"].iter().any(|x| lower.ends_with(x));
+                if step && !files.contains(&name.trim()) {
+                    files.push(name.trim());
+                }
+            }
+        }
+        let what = format!("{lead}: it holds an assembly structure ({})", plural(placed, "placed component"));
+        return match files.as_slice() {
+            [] if count(&["DOCUMENT_FILE"]) > 0 => format!("{what} whose parts' geometry is in other files"),
+            [] => format!("{what} without geometry"),
+            [one] => format!("{what} whose parts' geometry is in another file ('{one}')"),
+            [first, rest @ ..] => {
+                format!("{what} whose parts' geometry is in {} other files ('{first}', …)", rest.len() + 1)
+            }
+        };
+    }
+    let curves = count(&[
+        "LINE",
+        "CIRCLE",
+        "ELLIPSE",
+        "HYPERBOLA",
+        "PARABOLA",
+        "POLYLINE",
+        "TRIMMED_CURVE",
+        "COMPOSITE_CURVE",
+        "B_SPLINE_CURVE",
+        "B_SPLINE_CURVE_WITH_KNOTS",
+        "BEZIER_CURVE",
+    ]);
+    let annotations = count(&["ANNOTATION_OCCURRENCE", "ANNOTATION_CURVE_OCCURRENCE", "ANNOTATION_TEXT_OCCURRENCE"]);
+    match (curves, annotations) {
+        (0, 0) => format!("{lead}: it holds no geometry (only product data and placements)"),
+        (c, 0) => format!("{lead}: it holds only curves and points ({})", plural(c, "curve")),
+        (c, a) => format!(
+            "{lead}: it holds only curves, points and annotations ({}, {})",
+            plural(c, "curve"),
+            plural(a, "annotation")
+        ),
+    }
+}
+
+/// `n thing` or `n things`.
+fn plural(n: usize, thing: &str) -> String {
+    if n == 1 {
+        format!("1 {thing}")
+    } else {
+        format!("{n} {thing}s")
+    }
 }
