@@ -43,10 +43,10 @@ pub use io::{
 };
 pub use measure::{measure_mesh, MeasureOptions, MeshMeasure};
 pub use mesh::{
-    angle_stats, edge_counts, edge_counts_in_bodies, weld_mesh, weld_positions, AngleStats, EdgeCounts, FaceRange,
-    Mesh, Report,
+    angle_stats, edge_counts, edge_counts_around_skipped, edge_counts_in_bodies, weld_mesh, weld_positions, AngleStats,
+    EdgeCounts, FaceRange, Mesh, Report,
 };
-pub use model::{Face, FaceSurface, Model, TrimLoop};
+pub use model::{Face, FaceSurface, Model, SkippedFace, TrimLoop};
 pub use nurbs::{
     project_to_surface, Aabb, BasisDers, CurveDerivs, KnotVector, NurbsCurve, NurbsError, NurbsSurface, Projection,
     ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,

@@ -42,6 +42,7 @@ fn model(loops: Vec<TrimLoop>) -> Model {
         warnings: Vec::new(),
         tolerance: None,
         bodies: Vec::new(),
+        ..Model::default()
     }
 }
 
@@ -221,6 +222,7 @@ fn reparam_force_on_degenerate_faces_falls_back_or_holds_tolerance() {
         warnings: Vec::new(),
         tolerance: None,
         bodies: Vec::new(),
+        ..Model::default()
     };
     let r = mesh_model(&m, &MeshOptions::default().with_tolerance(0.01).with_reparam(Reparam::Force));
     let r = r.unwrap();
@@ -322,6 +324,7 @@ fn flagged_face(m: &Model, file: &str, index: usize) -> Model {
         warnings: Vec::new(),
         tolerance: None,
         bodies: Vec::new(),
+        ..Model::default()
     };
     assert!(step_ratio(&one.faces[0].surface) > RATIO_LIMIT, "{file} face {index}");
     one
@@ -429,6 +432,7 @@ fn sews_part(m: &Model, faces: &[usize], least: usize) {
         warnings: Vec::new(),
         tolerance: m.tolerance,
         bodies: Vec::new(),
+        ..Model::default()
     };
     for rel in [1e-2, 1e-3] {
         // The whole model's tolerance, as these faces get it there.

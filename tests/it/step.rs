@@ -219,6 +219,60 @@ fn a_bad_face_is_skipped_with_its_id_and_the_rest_is_read() {
     assert!(w[0].starts_with("#53 ADVANCED_FACE: skipped") && w[0].contains("expected an axis placement"), "{}", w[0]);
 }
 
+/// A closed box whose bottom face cannot be read: the mesh has a hole
+/// there, and the report says so. The edges the four side faces leave open
+/// along the missing face's border are cracks (free edges), not the model's
+/// own boundary, and the faces of the file are counted with the missing one.
+#[test]
+fn a_skipped_face_of_a_closed_box_leaves_free_edges_and_a_warning() {
+    let model = read_step(&data("step_bad_face.stp")).unwrap();
+    assert_eq!((model.faces.len(), model.skipped.len()), (5, 1));
+    // Its border: the four edges of the unit square at z = 0.
+    let border = &model.skipped[0].border;
+    assert_eq!(border.len(), 4);
+    for c in border {
+        let (a, b) = c.domain();
+        assert!(c.point(a).z.abs() < 1e-12 && c.point(b).z.abs() < 1e-12);
+    }
+    for rel in [1e-2, 1e-3] {
+        let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(rel)).unwrap();
+        let rep = &r.report;
+        assert_eq!((rep.faces, rep.faces_unread, rep.faces_skipped), (5, 1, 0));
+        // Every open edge runs round the hole: at least one per side.
+        assert!(rep.boundary_edges >= 4, "rel {rel}: {} boundary edges", rep.boundary_edges);
+        assert_eq!(rep.free_edges, rep.boundary_edges, "rel {rel}: every open edge is a crack");
+        let on_hole = hole_edges_at_z0(&r.mesh, rep.tolerance);
+        assert_eq!(on_hole, rep.boundary_edges, "rel {rel}: the open edges are the missing face's border");
+        assert!(
+            rep.warnings.iter().any(|w| w.starts_with("1 face(s) of the file could not be read: the mesh has holes")),
+            "{:?}",
+            rep.warnings
+        );
+        assert!(rep.max_deviation <= rep.tolerance && rep.inverted_triangles == 0);
+    }
+    // The same box whole: no hole, no crack, no warning about one.
+    let whole = read_step(&data("step_box_inch.stp")).unwrap();
+    let r = mesh_model(&whole, &MeshOptions::default().with_relative_tolerance(1e-2)).unwrap();
+    assert_eq!((r.report.faces_unread, r.report.free_edges, r.report.boundary_edges), (0, 0, 0));
+    assert!(!r.report.warnings.iter().any(|w| w.contains("could not be read")));
+}
+
+/// Edges of `mesh` with one triangle after welding whose two ends lie on the plane z = 0.
+fn hole_edges_at_z0(mesh: &Mesh, tol: f64) -> usize {
+    let (map, _) = surfmesh::weld_positions(&mesh.positions, tol * 1e-3);
+    // Per welded edge: how many triangles use it, and one of its two vertices' heights.
+    let mut uses: std::collections::HashMap<(u32, u32), (usize, f64, f64)> = std::collections::HashMap::new();
+    for t in mesh.indices.chunks_exact(3) {
+        for k in 0..3 {
+            let (p, q) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            let key = (map[p].min(map[q]), map[p].max(map[q]));
+            let e = uses.entry(key).or_insert((0, mesh.positions[p].z, mesh.positions[q].z));
+            e.0 += 1;
+        }
+    }
+    uses.values().filter(|(n, za, zb)| *n == 1 && za.abs() < tol && zb.abs() < tol).count()
+}
+
 #[test]
 fn hostile_and_malformed_files_are_errors_naming_the_instance() {
     let m = read_step(&data("step_hostile_knots.stp")).unwrap_err().to_string();

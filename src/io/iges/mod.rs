@@ -146,7 +146,8 @@ pub fn read_iges(bytes: &[u8]) -> Result<Model, Error> {
         world: DAffine3::from_scale(glam::DVec3::splat(1.0 / g.scale)),
         resolution: g.resolution.map(|r| r / g.scale),
     };
-    let (faces, bodies, first_error) = faces::read_faces(&ctx, &mut warnings);
+    let mut skipped = Vec::new();
+    let (faces, bodies, first_error) = faces::read_faces(&ctx, &mut warnings, &mut skipped);
     if faces.is_empty() {
         return Err(first_error.unwrap_or_else(|| {
             iges_error(
@@ -157,7 +158,7 @@ pub fn read_iges(bytes: &[u8]) -> Result<Model, Error> {
             )
         }));
     }
-    Ok(Model { units: g.units, faces, warnings, tolerance: ctx.resolution, bodies })
+    Ok(Model { units: g.units, faces, warnings, tolerance: ctx.resolution, bodies, skipped })
 }
 
 /// The Global section: delimiters (fields 1–2), model space scale (13),

@@ -27,6 +27,7 @@ use alloc::string::String;
 use alloc::vec::Vec;
 use core::ops::Range;
 
+use crate::model::SkippedFace;
 use crate::{Error, Model};
 
 /// Deepest chain of references followed (composite curves, offsets,
@@ -152,6 +153,12 @@ pub fn read_step_parts(bytes: &[u8]) -> Result<StepModel, Error> {
             }
         }
     }
-    let model = Model { units: plan.units.clone(), faces, warnings, tolerance: plan.tolerance, bodies };
+    // A skipped face is in its shell's body; it is counted, and its border kept.
+    let skipped = shapes
+        .skipped
+        .into_iter()
+        .map(|(k, border)| SkippedFace { body: if k < shapes.shells.len() { k as u32 } else { 0 }, border })
+        .collect();
+    let model = Model { units: plan.units.clone(), faces, warnings, tolerance: plan.tolerance, bodies, skipped };
     Ok(StepModel { model, shells: shapes.shells, parts, face_parts, face_colours: shapes.colours })
 }
