@@ -532,9 +532,11 @@ fn cli_help_prints_usage() {
 
 // ---------------------------------------------------------------- command line, success
 
-const REPORT_FIELDS: [&str; 13] = [
+const REPORT_FIELDS: [&str; 15] = [
+    "units",
     "tolerance",
     "faces",
+    "faces_unread",
     "triangles",
     "vertices",
     "max_deviation",
@@ -625,6 +627,69 @@ fn cli_meshes_the_plane_to_every_format() {
     }
     // Only the requested files, no temporaries left.
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 6);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `--units` scales the mesh and the report's lengths from the file's unit
+/// (the box is 2 × 1 × 0.5 inches) and names the unit; the GLB is in metres
+/// whatever the unit of the mesh, as glTF defines its lengths.
+#[test]
+fn cli_units_scale_the_mesh_and_the_glb_is_in_metres() {
+    let dir = scratch("units");
+    let input = data("step_box_inch.stp");
+    let mut runs = Vec::new();
+    for units in ["file", "mm", "m"] {
+        let (stl, glb, rep) = (dir.join(format!("{units}.stl")), dir.join(format!("{units}.glb")), dir.join("r.json"));
+        for out in [&stl, &glb] {
+            let os = |s: &'static str| std::ffi::OsStr::new(s);
+            let mut args = vec![os("mesh"), input.as_os_str(), os("--tol-rel"), os("0.01"), os("-o"), out.as_os_str()];
+            args.extend([os("--report"), rep.as_os_str()]);
+            if units != "file" {
+                args.extend([os("--units"), os(units)]);
+            }
+            mesh_ok(&args);
+        }
+        let report = check_report(&std::fs::read(&rep).unwrap());
+        // Binary STL: the mesh's own coordinates, in the unit asked for.
+        let bytes = std::fs::read(&stl).unwrap();
+        let n = u32_at(&bytes, 80) as usize;
+        let mut max = [f32::NEG_INFINITY; 3];
+        for t in 0..n {
+            for v in 0..3 {
+                for (k, m) in max.iter_mut().enumerate() {
+                    let at = 84 + 50 * t + 12 + 12 * v + 4 * k;
+                    *m = m.max(f32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()));
+                }
+            }
+        }
+        let (doc, _) = open_glb(&std::fs::read(&glb).unwrap());
+        let glb_max: Vec<f64> =
+            doc["accessors"][0]["max"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        runs.push((units, report, max, glb_max));
+    }
+    let inch_mm = 25.4;
+    for (units, report, max, glb_max) in &runs {
+        let (name, per_inch) = match *units {
+            "file" => ("in", 1.0),
+            "mm" => ("mm", inch_mm),
+            _ => ("m", inch_mm / 1000.0),
+        };
+        assert_eq!(report["units"], name, "{units}");
+        for (k, size) in [2.0, 1.0, 0.5].iter().enumerate() {
+            let want = size * per_inch;
+            assert!((max[k] as f64 - want).abs() <= 1e-6 * want, "{units}: box corner {k} at {} not {want}", max[k]);
+            let metres = size * inch_mm / 1000.0;
+            assert!((glb_max[k] - metres).abs() <= 1e-6 * metres, "{units}: GLB corner {k} at {} m", glb_max[k]);
+        }
+        // The tolerance scales with the mesh: the same relative tolerance of the same box.
+        let tol_in = runs[0].1["tolerance"].as_f64().unwrap();
+        let tol = report["tolerance"].as_f64().unwrap();
+        assert!((tol - tol_in * per_inch).abs() <= 1e-9 * tol, "{units}: tolerance {tol}");
+        assert_eq!(report["triangles"], runs[0].1["triangles"], "{units}: the same mesh, scaled");
+    }
+    let bad = run(&["mesh".as_ref(), input.as_os_str(), "--units".as_ref(), "yd".as_ref()]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(stderr(&bad).contains("option units: expected"), "{}", stderr(&bad));
     std::fs::remove_dir_all(dir).unwrap();
 }
 

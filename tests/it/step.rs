@@ -7,8 +7,8 @@
 use std::path::{Path, PathBuf};
 
 use surfmesh::{
-    edge_counts, mesh_model, read_model, read_step, read_step_parts, read_step_with_shells, Format, Mesh, MeshOptions,
-    MeshResult, Model, StepShell,
+    edge_counts, mesh_model, mesh_model_in_units, read_model, read_step, read_step_parts, read_step_with_shells,
+    Format, Mesh, MeshOptions, MeshResult, Model, StepShell, Units,
 };
 
 fn data(name: &str) -> Vec<u8> {
@@ -217,6 +217,43 @@ fn a_bad_face_is_skipped_with_its_id_and_the_rest_is_read() {
     let w: Vec<&String> = model.warnings.iter().filter(|w| w.contains("skipped")).collect();
     assert_eq!(w.len(), 1, "{:?}", model.warnings);
     assert!(w[0].starts_with("#53 ADVANCED_FACE: skipped") && w[0].contains("expected an axis placement"), "{}", w[0]);
+}
+
+/// Meshing in another unit is the file's mesh scaled: an absolute
+/// tolerance given in millimetres for the inch box meshes as the same
+/// tolerance in inches does, every position and length 25.4 times larger.
+#[test]
+fn meshing_in_millimetres_scales_the_inch_box() {
+    let model = read_step(&data("step_box_inch.stp")).unwrap();
+    assert_eq!(model.units, "in");
+    let inch = mesh_model(&model, &MeshOptions::default().with_tolerance(0.01)).unwrap();
+    let options = MeshOptions::default().with_tolerance(0.254);
+    let mm = mesh_model_in_units(&model, &options, Units::Mm, &mut |_, _| true).unwrap();
+    assert_eq!((inch.report.units.as_str(), mm.report.units.as_str()), ("in", "mm"));
+    assert_eq!(mm.mesh.indices, inch.mesh.indices);
+    for (a, b) in mm.mesh.positions.iter().zip(&inch.mesh.positions) {
+        assert!(a.distance(*b * 25.4) < 1e-9, "{a} vs {b}");
+    }
+    let top = mm.mesh.positions.iter().map(|p| p.x).fold(f64::NEG_INFINITY, f64::max);
+    assert!((top - 50.8).abs() < 1e-9, "{top}");
+    assert!((mm.report.tolerance - 0.254).abs() < 1e-12);
+    assert!((mm.report.max_deviation - 25.4 * inch.report.max_deviation).abs() <= 1e-9);
+    // `File` changes nothing; a JSON model in metres comes out in millimetres.
+    let same = mesh_model_in_units(&model, &MeshOptions::default().with_tolerance(0.01), Units::File, &mut |_, _| true);
+    assert_eq!(same.unwrap().mesh.positions, inch.mesh.positions);
+    let json =
+        String::from_utf8(std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/plane.json")).unwrap())
+            .unwrap();
+    let mut metres = surfmesh::read_json(json.as_bytes()).unwrap();
+    metres.units = "m".into();
+    let a = mesh_model(&metres, &MeshOptions::default()).unwrap();
+    let b = mesh_model_in_units(&metres, &MeshOptions::default(), Units::Mm, &mut |_, _| true).unwrap();
+    assert_eq!(b.report.units, "mm");
+    assert!((b.report.tolerance - 1000.0 * a.report.tolerance).abs() <= 1e-9 * b.report.tolerance);
+    // A unit this does not know cannot be converted, and says so.
+    metres.units = "furlong".into();
+    let e = mesh_model_in_units(&metres, &MeshOptions::default(), Units::Mm, &mut |_, _| true).unwrap_err();
+    assert!(e.to_string().contains("'furlong'"), "{e}");
 }
 
 /// A closed box whose bottom face cannot be read: the mesh has a hole
