@@ -3,6 +3,8 @@
 
 #[path = "surfmesh/args.rs"]
 mod args;
+#[path = "surfmesh/check.rs"]
+mod check;
 #[path = "surfmesh/fit.rs"]
 mod fit;
 #[path = "surfmesh/repair.rs"]
@@ -26,7 +28,7 @@ use surfmesh::{
 fn main() -> ExitCode {
     match args::parse(std::env::args_os().skip(1).collect()) {
         Ok(Command::Help) => {
-            print!("{}\n{}\n{}\n{}", args::USAGE, repair::USAGE, fit::USAGE, reparam::USAGE);
+            print!("{}\n{}\n{}\n{}\n{}", args::USAGE, check::USAGE, repair::USAGE, fit::USAGE, reparam::USAGE);
             ExitCode::SUCCESS
         }
         Ok(Command::Version) => {
@@ -44,6 +46,14 @@ fn main() -> ExitCode {
         Ok(Command::Repair(a)) => finish(&a.input, repair::run_repair(&a)),
         Ok(Command::Fit(a)) => finish(&a.input, fit::run(&a)),
         Ok(Command::Reparam(a)) => finish(&a.input, reparam::run(&a)),
+        Ok(Command::Check(a)) => match check::run(&a) {
+            Ok(true) => ExitCode::SUCCESS,
+            Ok(false) => ExitCode::from(1),
+            Err(message) => {
+                eprintln!("surfmesh: {}: {}", a.dir.display(), one_line(&message));
+                ExitCode::from(1)
+            }
+        },
         Err(message) => {
             eprintln!("surfmesh: {}", one_line(&message));
             ExitCode::from(2)

@@ -693,6 +693,69 @@ fn cli_units_scale_the_mesh_and_the_glb_is_in_metres() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// `check` meshes every model file of a folder (and its folders, not hidden
+/// ones; notes such as SOURCES.md are not models), one row per file sorted
+/// by name: a file that fails has its error in its row and makes the exit
+/// status 1; a face the reader could not build counts among the file's
+/// faces, and the edges left open along it as cracks.
+#[test]
+fn cli_check_sweeps_a_folder_into_rows() {
+    let dir = scratch("check");
+    let models = dir.join("models");
+    std::fs::create_dir_all(models.join("sub")).unwrap();
+    std::fs::create_dir_all(models.join(".hidden")).unwrap();
+    for (from, to) in [
+        ("plane.json", "b_plane.json"),
+        ("step_bad_face.stp", "a_box.stp"),
+        ("bad_syntax.json", "c_bad.json"),
+        ("iges_plate.igs", "sub/plate.igs"),
+        ("plane.json", ".hidden/plane.json"),
+        ("plane.json", ".dot.json"),
+    ] {
+        std::fs::copy(data(from), models.join(to)).unwrap();
+    }
+    // No extension: found by its first bytes; a note is not a model.
+    std::fs::copy(data("step_box_inch.stp"), models.join("BOX")).unwrap();
+    std::fs::write(models.join("SOURCES.md"), "# where the files come from\n").unwrap();
+    let json = dir.join("rows.json");
+    let os = |s: &'static str| std::ffi::OsStr::new(s);
+    let out = run(&[os("check"), models.as_os_str(), os("--tol-rel"), os("0.01"), os("--json"), json.as_os_str()]);
+    assert_eq!(out.status.code(), Some(1), "one file fails: {}", stderr(&out));
+    let table = String::from_utf8(out.stdout).unwrap();
+    let sweep: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(sweep["tolerance"], "relative 0.01");
+    let rows = sweep["files"].as_array().unwrap();
+    let names: Vec<&str> = rows.iter().map(|r| r["file"].as_str().unwrap()).collect();
+    assert_eq!(names, ["BOX", "a_box.stp", "b_plane.json", "c_bad.json", "sub/plate.igs"], "{table}");
+    let row = |name: &str| rows.iter().find(|r| r["file"] == name).unwrap();
+    let bad = row("c_bad.json");
+    assert_eq!(bad["ok"], false);
+    assert!(bad["error"].as_str().unwrap().starts_with("JSON line 3"), "{bad}");
+    assert!(table.lines().any(|l| l.starts_with("c_bad.json") && l.contains("ERROR JSON line 3")), "{table}");
+    let open_box = row("a_box.stp");
+    assert_eq!((open_box["faces_in_file"].as_u64(), open_box["faces_meshed"].as_u64()), (Some(6), Some(5)));
+    assert_eq!(open_box["faces_unread"], 1);
+    assert!(open_box["cracks"].as_u64().unwrap() >= 4, "{open_box}");
+    assert!(open_box["first_warning"].as_str().unwrap().starts_with("#53 ADVANCED_FACE: skipped"), "{open_box}");
+    let whole = row("BOX");
+    assert_eq!((whole["ok"].as_bool(), whole["faces_meshed"].as_u64()), (Some(true), Some(6)));
+    assert_eq!((whole["cracks"].as_u64(), whole["units"].as_str()), (Some(0), Some("in")));
+    for r in rows.iter().filter(|r| r["ok"] == true) {
+        assert!(r["deviation_ratio"].as_f64().unwrap() <= 1.0, "{r}");
+        assert!(r["tolerance"].as_f64().unwrap() > 0.0 && r["time_ms"].as_f64().unwrap() >= 0.0, "{r}");
+    }
+    let totals = table.lines().last().unwrap();
+    assert!(totals.starts_with("total: 5 files, 4 meshed, 1 failed; faces 14/15 (1 unread, 0 empty)"), "{totals}");
+    // Every file meshing: exit status 0.
+    std::fs::remove_file(models.join("c_bad.json")).unwrap();
+    let out = run(&[os("check"), models.as_os_str(), os("--tol-rel"), os("0.01"), os("--jobs"), os("1")]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    // Usage errors: exit status 2.
+    assert_eq!(run(&[os("check")]).status.code(), Some(2));
+    assert_eq!(run(&[os("check"), models.as_os_str(), os("--timeout"), os("0")]).status.code(), Some(2));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 #[test]
 fn cli_prints_the_report_without_outputs_and_honours_tol_rel() {
     let out = mesh_ok(&["mesh".as_ref(), data("plane.json").as_os_str(), "--tol-rel".as_ref(), "0.001".as_ref()]);

@@ -22,6 +22,8 @@ pub enum Command {
     Fit(crate::fit::FitArgs),
     /// Rebuild poorly parameterized faces and write IGES (paper 001).
     Reparam(crate::reparam::ReparamArgs),
+    /// Mesh every model file of a folder and tabulate the results.
+    Check(crate::check::CheckArgs),
 }
 
 /// Arguments of `surfmesh mesh`.
@@ -61,6 +63,7 @@ surfmesh: triangle meshes of trimmed NURBS surfaces within a verified tolerance
 
 Usage:
   surfmesh mesh INPUT [options]
+  surfmesh check DIR [options]            (see Sweeping a folder, below)
   surfmesh --help | --version
 
 Options of `mesh`:
@@ -115,6 +118,7 @@ pub fn parse(args: Vec<OsString>) -> Result<Command, String> {
         Some("repair") => crate::repair::parse_repair(args).map(Command::Repair),
         Some("fit") => crate::fit::parse(args).map(Command::Fit),
         Some("reparam") => crate::reparam::parse(args).map(Command::Reparam),
+        Some("check") => crate::check::parse(args).map(Command::Check),
         _ => Err(format!("unknown command '{}'; try 'surfmesh --help'", first.to_string_lossy())),
     }
 }
