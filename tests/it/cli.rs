@@ -892,11 +892,7 @@ fn strictly_inside(polygon: &[glam::DVec2], p: glam::DVec2, margin: f64) -> bool
 /// afresh in each process, and each run wrote another OBJ.
 #[test]
 fn two_runs_write_the_same_mesh() {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus/trj7_b1-ec-214.stp");
-    if !file.exists() {
-        eprintln!("SKIPPED: no corpus file {} (needs ../shared/corpus)", file.display());
-        return;
-    }
+    let file = crate::corpus_files::corpus_path("trj7_b1-ec-214.stp");
     let dir = scratch("two-runs");
     let outs: Vec<PathBuf> = (0..2).map(|i| dir.join(format!("run{i}.obj"))).collect();
     // Both processes at once: a debug build takes a while on this file.

@@ -1,22 +1,20 @@
 //! STEP: small files written for these tests (tests/data/step_*.stp) check
 //! units, assemblies, analytic surfaces, seams, poles and apexes, skipped
-//! faces and hostile input; the shared corpus (`../shared/corpus`, see its
+//! faces and hostile input; the test corpus (`tests/corpus`, see its
 //! SOURCES.md) checks real files: every face read, and the files listed in
 //! [`MESHED`] meshed within tolerance and watertight.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use surfmesh::{
     edge_counts, mesh_model, mesh_model_in_units, read_model, read_step, read_step_parts, read_step_with_shells,
     Format, Mesh, MeshOptions, MeshResult, Model, StepShell, Units,
 };
 
+use crate::corpus_files::{corpus_bytes, corpus_names};
+
 fn data(name: &str) -> Vec<u8> {
     std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join("data").join(name)).unwrap()
-}
-
-fn corpus_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("shared").join("corpus")
 }
 
 /// The triangles of the given faces as one mesh.
@@ -349,14 +347,9 @@ const MESHED_BUT_STRIPS: [&str; 1] = ["trj7_b1-ec-214.stp"];
 /// unoptimized); `cargo test --release` takes them all.
 const DEBUG_MAX_BYTES: usize = 200_000;
 
-fn corpus_files() -> Option<Vec<PathBuf>> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(corpus_dir())
-        .ok()?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().and_then(|e| e.to_str()).is_some_and(|e| e == "stp" || e == "step"))
-        .collect();
-    files.sort();
-    Some(files)
+/// STEP files of the test corpus, sorted by name.
+fn corpus_files() -> Vec<String> {
+    corpus_names(&["stp", "step"])
 }
 
 /// Faces the file lists (ADVANCED_FACE / FACE_SURFACE instances).
@@ -368,14 +361,10 @@ fn faces_in_file(text: &str) -> usize {
 
 #[test]
 fn corpus_reads_every_face() {
-    let Some(files) = corpus_files() else {
-        eprintln!("no corpus at {}: STEP corpus test not run", corpus_dir().display());
-        return;
-    };
+    let files = corpus_files();
     assert!(files.len() >= 16, "the corpus holds {} STEP files", files.len());
-    for path in files {
-        let name = path.file_name().unwrap().to_string_lossy().to_string();
-        let bytes = std::fs::read(&path).unwrap();
+    for name in files {
+        let bytes = corpus_bytes(&name);
         if cfg!(debug_assertions) && bytes.len() > DEBUG_MAX_BYTES {
             eprintln!("{name}: not read in an unoptimized build (run the tests with --release)");
             continue;
@@ -398,20 +387,19 @@ fn corpus_reads_every_face() {
 /// with no triangle that has two corners at one point.
 #[test]
 fn corpus_meshes_within_tolerance_watertight() {
-    let Some(files) = corpus_files() else {
-        eprintln!("no corpus at {}: STEP corpus test not run", corpus_dir().display());
-        return;
-    };
+    let files = corpus_files();
+    for m in MESHED.iter().chain(&MESHED_BUT_STRIPS) {
+        assert!(files.iter().any(|n| n == m), "{m} is not in the corpus");
+    }
     let mut failures = Vec::new();
     println!(
         "{:<30} {:>9} {:>8} {:>10} {:>10} {:>4} {:>5} {:>6} {:>5} {:>7}",
         "file", "faces", "tris", "max dev", "tolerance", "inv", "free", "shellB", "misor", "ms"
     );
-    for path in files {
-        let name = path.file_name().unwrap().to_string_lossy().to_string();
+    for name in files {
         let strips_allowed = MESHED_BUT_STRIPS.contains(&name.as_str());
         let must = MESHED.contains(&name.as_str()) || strips_allowed;
-        let bytes = std::fs::read(&path).unwrap();
+        let bytes = corpus_bytes(&name);
         if cfg!(debug_assertions) && bytes.len() > DEBUG_MAX_BYTES {
             continue;
         }
@@ -505,11 +493,7 @@ fn corpus_meshes_within_tolerance_watertight() {
 /// never split where a neighbour's nodes are, and the closed shell opens.
 #[test]
 fn corpus_fuselage_rebuilt_faces_keep_the_shell_closed() {
-    let path = corpus_dir().join("bug28366_fuselage.stp");
-    let Ok(bytes) = std::fs::read(&path) else {
-        eprintln!("no corpus at {}: test not run", corpus_dir().display());
-        return;
-    };
+    let bytes = corpus_bytes("bug28366_fuselage.stp");
     let (model, shells) = read_step_with_shells(&bytes).expect("reads");
     let options = MeshOptions::default().with_relative_tolerance(1e-3).with_reparam(surfmesh::Reparam::Auto);
     let r = mesh_model(&model, &options).expect("meshes");
