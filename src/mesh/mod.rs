@@ -54,7 +54,7 @@ impl Mesh {
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct Report {
     /// Length unit of the mesh and of every length here (the file's own
-    /// unit, or the one asked for: see [`crate::MeshResult::convert_units`]).
+    /// unit, or the one asked for: see [`crate::mesh_model_in_units`]).
     pub units: String,
     /// Absolute chordal tolerance used, model units.
     pub tolerance: f64,
