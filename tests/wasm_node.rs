@@ -12,9 +12,9 @@ extern crate alloc;
 // Names `src/wasm.rs` reaches through `crate::`.
 #[allow(unused_imports)]
 use surfmesh::{
-    fit_points, mesh_model, offset_mesh, read_mesh, read_model, read_points, read_step_parts, repair_mesh_timed,
-    Bucketing, Error, FitOptions, FitResult, Format, MeshFormat, MeshMode, MeshOptions, MeshResult, PointFormat,
-    QualityMethod, RepairOptions,
+    fit_points, mesh_model, mesh_model_in_units, offset_mesh, read_mesh, read_model, read_points, read_step_parts,
+    repair_mesh_timed, Bucketing, Error, FitOptions, FitResult, Format, MeshFormat, MeshMode, MeshOptions, MeshResult,
+    PointFormat, QualityMethod, RepairOptions, Units,
 };
 
 #[path = "../src/wasm.rs"]
@@ -660,6 +660,36 @@ fn step_tessellated_faces_reach_js_counted() {
     let report = get("report");
     let field = |f: &str| Reflect::get(&report, &f.into()).unwrap().as_f64().unwrap();
     assert_eq!((field("faces"), field("faces_tessellated"), field("triangles")), (4.0, 4.0, 4.0));
+}
+
+/// The `units` option scales the inch box into millimetres (positions and
+/// the report's tolerance), and the result names its unit; the default is
+/// the file's own unit; a unit that is not offered throws.
+#[wasm_bindgen_test]
+fn units_option_scales_the_result_and_names_its_unit() {
+    let bytes = include_bytes!("data/step_box_inch.stp");
+    let run = |opts: JsValue| {
+        let v = binding::mesh(bytes.to_vec(), "step", opts).unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+        let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
+        let positions = get("positions").dyn_into::<Float32Array>().expect("positions").to_vec();
+        let max_x = positions.chunks(3).map(|p| p[0]).fold(f32::NEG_INFINITY, f32::max);
+        let report = get("report");
+        let tol = Reflect::get(&report, &"tolerance".into()).unwrap().as_f64().unwrap();
+        let units = get("units").as_string().expect("units");
+        assert_eq!(Reflect::get(&report, &"units".into()).unwrap().as_string().as_deref(), Some(units.as_str()));
+        (units, max_x, tol)
+    };
+    let (file_units, file_x, file_tol) = run(options(&[("toleranceRel", num(1e-2))]));
+    assert_eq!((file_units.as_str(), file_x), ("in", 2.0));
+    let (mm, mm_x, mm_tol) = run(options(&[("toleranceRel", num(1e-2)), ("units", "mm".into())]));
+    assert_eq!(mm, "mm");
+    assert!((mm_x - 50.8).abs() < 1e-4, "{mm_x}");
+    assert!((mm_tol - 25.4 * file_tol).abs() < 1e-9 * mm_tol, "{mm_tol} vs {file_tol}");
+    let m = match binding::mesh(bytes.to_vec(), "step", options(&[("units", "yd".into())])) {
+        Ok(_) => panic!("units yd accepted"),
+        Err(e) => String::from(JsValue::from(e).unchecked_into::<js_sys::Error>().message()),
+    };
+    assert!(m.starts_with("option units: expected"), "{m}");
 }
 
 /// Paper 001 by default: a crowded surface is flagged and rebuilt without

@@ -4,6 +4,8 @@ use alloc::vec::Vec;
 use glam::DVec3;
 
 use super::{weld::weld_positions, Mesh};
+use crate::model::SkippedFace;
+use crate::nurbs::{Aabb, NurbsCurve};
 
 /// Edge census after welding coincident vertices.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -19,6 +21,9 @@ pub struct EdgeCounts {
     pub nonmanifold_edges: usize,
     /// Edges whose two triangles run the same way (orientation flips).
     pub misoriented_edges: usize,
+    /// Of the free edges, those that run along the border of a face the
+    /// reader skipped: the hole it leaves.
+    pub hole_edges: usize,
 }
 
 /// Counts boundary, crack and non-manifold edges after welding vertices closer
@@ -32,6 +37,21 @@ pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
 /// crack only next to another border of its own body, so parts of an
 /// assembly that touch are counted each on its own.
 pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol: f64) -> EdgeCounts {
+    edge_counts_around_skipped(mesh, bodies, &[], weld_tol, sew_tol)
+}
+
+/// As [`edge_counts_in_bodies`], where `skipped` are the faces the reader
+/// could not build: a boundary edge that runs along one's border (its
+/// quarter, half and three-quarter points within twice `sew_tol` of it, in
+/// the same body) is a crack too, the hole the missing face leaves, and not
+/// the model's own boundary.
+pub fn edge_counts_around_skipped(
+    mesh: &Mesh,
+    bodies: &[u32],
+    skipped: &[SkippedFace],
+    weld_tol: f64,
+    sew_tol: f64,
+) -> EdgeCounts {
     let (mut map, mut nverts) = weld_positions(&mesh.positions, weld_tol);
     let face_of = face_lookup(mesh);
     let body_of_face = |f: u32| crate::model::body_of(bodies, f as usize);
@@ -133,8 +153,27 @@ pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol
     }
     drop((at, start, around));
     out.boundary_edges = free.len();
-    out.free_edges = count_cracks(&free, &pos, sew_tol, &body_of_face);
+    let (cracks, holes) = count_cracks(&free, &pos, sew_tol, &body_of_face, skipped);
+    out.free_edges = cracks;
+    out.hole_edges = holes;
     out
+}
+
+/// The report's line about faces the reader skipped, if any: how many, and
+/// how many edges of the mesh run open along them (`holes`).
+pub(crate) fn holes_warning(skipped: &[SkippedFace], holes: usize, warnings: &mut Vec<alloc::string::String>) {
+    if skipped.is_empty() {
+        return;
+    }
+    let n = skipped.len();
+    warnings.push(if holes > 0 {
+        alloc::format!(
+            "{n} face(s) of the file could not be read: the mesh has holes there, \
+             {holes} open edges along their borders (counted as cracks)"
+        )
+    } else {
+        alloc::format!("{n} face(s) of the file could not be read: the mesh lacks them")
+    });
 }
 
 /// Face index of each triangle, from the mesh's face ranges (0 when absent).
@@ -147,10 +186,18 @@ fn face_lookup(mesh: &Mesh) -> impl Fn(usize) -> u32 + '_ {
 
 /// A free edge is a crack when a vertex or midpoint of a free edge of another
 /// face of its body lies within `sew` (and within a fifth of the edge's
-/// length) of its quarter, half or three-quarter point.
-fn count_cracks(free: &[(u32, u32, u32)], pos: &dyn Fn(u32) -> DVec3, sew: f64, body: &dyn Fn(u32) -> u32) -> usize {
+/// length) of its quarter, half or three-quarter point, or when it runs
+/// along the border of a skipped face of its body ([`Holes::along`]).
+/// Returns the cracks and, of them, those along skipped faces.
+fn count_cracks(
+    free: &[(u32, u32, u32)],
+    pos: &dyn Fn(u32) -> DVec3,
+    sew: f64,
+    body: &dyn Fn(u32) -> u32,
+    skipped: &[SkippedFace],
+) -> (usize, usize) {
     if free.is_empty() || !(sew > 0.0 && sew.is_finite()) {
-        return 0;
+        return (0, 0);
     }
     // Points of interest: free-edge vertices (tag = vertex id) and midpoints (tag = edge index).
     #[derive(Clone, Copy)]
@@ -170,7 +217,8 @@ fn count_cracks(free: &[(u32, u32, u32)], pos: &dyn Fn(u32) -> DVec3, sew: f64, 
         let m = (pos(a) + pos(b)) * 0.5;
         grid.insert(m, (m, Tag::Mid, f));
     }
-    let mut cracks = 0;
+    let holes = Holes::new(skipped, 2.0 * sew);
+    let (mut cracks, mut along) = (0, 0);
     for &(a, b, face) in free {
         let (pa, pb) = (pos(a), pos(b));
         // Relative to the edge too: an open border's own neighbours sit half an edge away.
@@ -189,9 +237,46 @@ fn count_cracks(free: &[(u32, u32, u32)], pos: &dyn Fn(u32) -> DVec3, sew: f64, 
         });
         if hit {
             cracks += 1;
+        } else if holes.along(pa, pb, body(face)) {
+            cracks += 1;
+            along += 1;
         }
     }
-    cracks
+    (cracks, along)
+}
+
+/// The border curves of skipped faces, each with its body and its box, for [`Holes::along`].
+struct Holes<'a> {
+    curves: Vec<(&'a NurbsCurve, u32, Aabb)>,
+    reach: f64,
+}
+
+impl<'a> Holes<'a> {
+    fn new(skipped: &'a [SkippedFace], reach: f64) -> Self {
+        let mut curves = Vec::new();
+        for s in skipped {
+            for c in &s.border {
+                let b = c.bbox();
+                if !b.is_empty() {
+                    curves.push((c, s.body, b));
+                }
+            }
+        }
+        Self { curves, reach }
+    }
+
+    /// Whether the edge `pa`–`pb` of body `body` runs along one skipped
+    /// face's border: its quarter, half and three-quarter points all lie
+    /// within the reach of one of that face's curves (an edge that only
+    /// meets the border at a corner has at least one of them farther).
+    fn along(&self, pa: DVec3, pb: DVec3, body: u32) -> bool {
+        let points = [0.25, 0.5, 0.75].map(|f| pa.lerp(pb, f));
+        self.curves.iter().any(|(c, b, bbox)| {
+            *b == body
+                && points.iter().all(|&q| bbox.contains(q, self.reach))
+                && points.iter().all(|&q| c.project(q).2 <= self.reach)
+        })
+    }
 }
 
 /// Triangle angle distribution.

@@ -8,8 +8,10 @@ use alloc::vec::Vec;
 use glam::DVec3;
 use serde::Serialize;
 
-pub(crate) use metrics::min_angle;
-pub use metrics::{angle_stats, edge_counts, edge_counts_in_bodies, AngleStats, EdgeCounts};
+pub use metrics::{
+    angle_stats, edge_counts, edge_counts_around_skipped, edge_counts_in_bodies, AngleStats, EdgeCounts,
+};
+pub(crate) use metrics::{holes_warning, min_angle};
 pub use weld::{weld_mesh, weld_positions};
 
 /// An indexed triangle mesh. Every face owns its vertices (so normals can break
@@ -51,12 +53,19 @@ impl Mesh {
 /// What a mesh run measured; serialized as the CLI's JSON report.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct Report {
+    /// Length unit of the mesh and of every length here (the file's own
+    /// unit, or the one asked for: see [`crate::mesh_model_in_units`]).
+    pub units: String,
     /// Absolute chordal tolerance used, model units.
     pub tolerance: f64,
     /// Angle limit used, radians.
     pub angle: f64,
     /// Faces in the model.
     pub faces: usize,
+    /// Faces of the file the reader could not build (skipped with a
+    /// warning), not in `faces`: the file has `faces + faces_unread`. The
+    /// edges their neighbours leave open along them count in `free_edges`.
+    pub faces_unread: usize,
     /// Faces that produced no triangles (skipped with a warning).
     pub faces_skipped: usize,
     /// Faces the file gives as triangles only (STEP tessellated faces): no
@@ -79,7 +88,8 @@ pub struct Report {
     pub min_angle_deg: f64,
     /// 1st-percentile triangle angle, degrees.
     pub p1_angle_deg: f64,
-    /// Cracks: free edges after welding that are not on the model's open boundary.
+    /// Cracks: free edges after welding that are not on the model's open
+    /// boundary, among them those along faces the reader skipped.
     pub free_edges: usize,
     /// All edges with one triangle after welding (cracks plus open boundary).
     pub boundary_edges: usize,

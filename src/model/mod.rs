@@ -29,6 +29,21 @@ pub struct Model {
     /// geometry), in file order. They follow the exact faces: tessellated
     /// face `k` is face `faces.len() + k` of the mesh, its bodies and its report.
     pub tessellated: Vec<TessellatedFace>,
+    /// Faces the file has that the reader could not build (each skipped
+    /// with a warning): not in [`Model::faces`], but counted, and their
+    /// borders make the edges their neighbours leave open there cracks.
+    pub skipped: Vec<SkippedFace>,
+}
+
+/// A face of the file the reader could not build: what is known of it.
+#[derive(Debug, Clone, Default)]
+pub struct SkippedFace {
+    /// The body it belongs to (as in [`Model::bodies`]).
+    pub body: u32,
+    /// The model-space curves of its border, as far as they could be read
+    /// (empty when none could): where a face beside it ends along them,
+    /// the mesh has a hole, not the model's own boundary.
+    pub border: Vec<NurbsCurve>,
 }
 
 impl Model {

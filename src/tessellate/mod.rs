@@ -24,7 +24,7 @@ use alloc::format;
 use alloc::vec::Vec;
 use glam::DVec2;
 
-use crate::mesh::{angle_stats, edge_counts_in_bodies, FaceRange};
+use crate::mesh::{angle_stats, edge_counts_around_skipped, holes_warning, FaceRange};
 use crate::nurbs::{Aabb, Surface};
 use crate::reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
 use crate::{Error, Mesh, Model, Report};
@@ -81,6 +81,8 @@ pub fn mesh_model_with_progress(
         // Tessellated faces are passed through unsewn.
         tessellated::append_unsewn(model, &mut r.mesh, &mut r.report);
         r.report.bodies = bodies;
+        r.report.units = model.units.clone();
+        r.report.faces_unread = model.skipped.len();
         return Ok(r);
     }
     // A share meshes its bodies only; the other faces stay empty (not skipped).
@@ -93,13 +95,27 @@ pub fn mesh_model_with_progress(
         // bounding box a tolerance needs (its report's tolerance stays 0).
         options.validate()?;
         let mesh = Mesh { face_ranges: alloc::vec![FaceRange::default(); model.face_count()], ..Mesh::default() };
-        let report = Report { angle: options.angle, faces: model.face_count(), bodies, ..Report::default() };
+        let report = Report {
+            units: model.units.clone(),
+            angle: options.angle,
+            faces: model.face_count(),
+            faces_unread: model.skipped.len(),
+            bodies,
+            ..Report::default()
+        };
         return Ok(MeshResult { mesh, report });
     }
     let Setup { tol, diag, lim, crit } = setup(model, options)?;
     let aim = crit.tol;
-    let mut report =
-        Report { tolerance: tol, angle: options.angle, faces: model.face_count(), bodies, ..Report::default() };
+    let mut report = Report {
+        units: model.units.clone(),
+        tolerance: tol,
+        angle: options.angle,
+        faces: model.face_count(),
+        faces_unread: model.skipped.len(),
+        bodies,
+        ..Report::default()
+    };
     report.warnings.extend(model.warnings.iter().cloned());
     let mut facets = tessellated::Facets::new(model, &mine);
     // Paper 001: faces whose parameters crowd are rebuilt on even ones first.
@@ -434,7 +450,8 @@ pub fn mesh_model_with_progress(
     report.mean_deviation = if dev_count > 0 { dev_sum / dev_count as f64 } else { 0.0 };
     report.triangles = mesh.triangle_count();
     report.vertices = mesh.positions.len();
-    let edges = edge_counts_in_bodies(&mesh, &model.bodies, (tol * 1e-3).min(tight * 0.5), tol);
+    let edges = edge_counts_around_skipped(&mesh, &model.bodies, &model.skipped, (tol * 1e-3).min(tight * 0.5), tol);
+    holes_warning(&model.skipped, edges.hole_edges, &mut report.warnings);
     report.free_edges = edges.free_edges;
     report.boundary_edges = edges.boundary_edges;
     report.nonmanifold_edges = edges.nonmanifold_edges;

@@ -194,6 +194,37 @@ fn huge_counts_and_reference_cycles_skip_the_face_with_a_reason() {
     assert!(m.warnings.iter().any(|w| w.contains("skipped") && w.contains("cycle")), "{:?}", m.warnings);
 }
 
+/// The corpus cube (a B-rep solid: 186, 514, six 510 faces) with its first
+/// face's surface pointer turned to the edge list (not a surface): the face
+/// is skipped with a warning, counted, and the edges the four faces beside
+/// it leave open along its border are cracks, not the solid's boundary.
+#[test]
+fn a_skipped_brep_face_leaves_free_edges_along_its_border() {
+    let text = String::from_utf8(crate::corpus_files::corpus_bytes("cube_10x10_inventor.igs")).unwrap();
+    let record = "510,53,1,1,17;";
+    assert_eq!(text.matches(record).count(), 1);
+    // Pointer 67 is the 504 edge list: same width, columns unchanged.
+    let broken = text.replace(record, "510,67,1,1,17;");
+    let model = read_iges(broken.as_bytes()).unwrap();
+    assert_eq!((model.faces.len(), model.skipped.len()), (5, 1));
+    assert!(model.warnings.iter().any(|w| w.starts_with("DE 5 (type 510): skipped")), "{:?}", model.warnings);
+    // Its border: the face's loop, four straight edges 10 mm long.
+    let border = &model.skipped[0].border;
+    assert_eq!(border.len(), 4);
+    for c in border {
+        let (a, b) = c.domain();
+        assert!((c.point(a).distance(c.point(b)) - 10.0).abs() < 1e-6);
+    }
+    let whole = mesh_model(&read_iges(text.as_bytes()).unwrap(), &MeshOptions::default()).unwrap();
+    assert_eq!((whole.report.boundary_edges, whole.report.free_edges), (0, 0));
+    let r = mesh_model(&model, &MeshOptions::default()).unwrap();
+    let rep = &r.report;
+    assert_eq!((rep.faces, rep.faces_unread), (5, 1));
+    assert!(rep.boundary_edges >= 4, "{} boundary edges", rep.boundary_edges);
+    assert_eq!(rep.free_edges, rep.boundary_edges, "every open edge runs round the hole");
+    assert!(rep.warnings.iter().any(|w| w.starts_with("1 face(s) of the file could not be read: the mesh has holes")));
+}
+
 /// An 80-column record: `data` in columns 1-72, the section letter, the sequence number.
 fn record(data: &str, letter: char, seq: usize) -> String {
     format!("{data:<72}{letter}{seq:>7}\n")
@@ -311,7 +342,7 @@ fn command_line_meshes_an_iges_file_by_its_extension() {
     let _ = std::fs::remove_dir_all(&out_dir);
 }
 
-/// The shared corpus, in a file of its own.
+/// The test corpus (`tests/corpus`), in a file of its own.
 #[path = "iges_corpus.rs"]
 mod corpus;
 

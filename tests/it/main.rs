@@ -1,6 +1,7 @@
 //! Native integration tests, one binary.
 
 mod cli;
+mod corpus_files;
 mod fit;
 mod iges;
 mod mesh;

@@ -1,22 +1,20 @@
 //! STEP: small files written for these tests (tests/data/step_*.stp) check
 //! units, assemblies, analytic surfaces, seams, poles and apexes, skipped
-//! faces and hostile input; the shared corpus (`../shared/corpus`, see its
+//! faces and hostile input; the test corpus (`tests/corpus`, see its
 //! SOURCES.md) checks real files: every face read, and the files listed in
 //! [`MESHED`] meshed within tolerance and watertight.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use surfmesh::{
-    edge_counts, mesh_model, read_model, read_step, read_step_parts, read_step_with_shells, Format, Mesh, MeshOptions,
-    MeshResult, Model, StepShell,
+    edge_counts, mesh_model, mesh_model_in_units, read_model, read_step, read_step_parts, read_step_with_shells,
+    Format, Mesh, MeshOptions, MeshResult, Model, StepShell, Units,
 };
+
+use crate::corpus_files::{corpus_bytes, corpus_names};
 
 fn data(name: &str) -> Vec<u8> {
     std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join("data").join(name)).unwrap()
-}
-
-fn corpus_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("shared").join("corpus")
 }
 
 /// The triangles of the given faces as one mesh.
@@ -219,6 +217,97 @@ fn a_bad_face_is_skipped_with_its_id_and_the_rest_is_read() {
     assert!(w[0].starts_with("#53 ADVANCED_FACE: skipped") && w[0].contains("expected an axis placement"), "{}", w[0]);
 }
 
+/// Meshing in another unit is the file's mesh scaled: an absolute
+/// tolerance given in millimetres for the inch box meshes as the same
+/// tolerance in inches does, every position and length 25.4 times larger.
+#[test]
+fn meshing_in_millimetres_scales_the_inch_box() {
+    let model = read_step(&data("step_box_inch.stp")).unwrap();
+    assert_eq!(model.units, "in");
+    let inch = mesh_model(&model, &MeshOptions::default().with_tolerance(0.01)).unwrap();
+    let options = MeshOptions::default().with_tolerance(0.254);
+    let mm = mesh_model_in_units(&model, &options, Units::Mm, &mut |_, _| true).unwrap();
+    assert_eq!((inch.report.units.as_str(), mm.report.units.as_str()), ("in", "mm"));
+    assert_eq!(mm.mesh.indices, inch.mesh.indices);
+    for (a, b) in mm.mesh.positions.iter().zip(&inch.mesh.positions) {
+        assert!(a.distance(*b * 25.4) < 1e-9, "{a} vs {b}");
+    }
+    let top = mm.mesh.positions.iter().map(|p| p.x).fold(f64::NEG_INFINITY, f64::max);
+    assert!((top - 50.8).abs() < 1e-9, "{top}");
+    assert!((mm.report.tolerance - 0.254).abs() < 1e-12);
+    assert!((mm.report.max_deviation - 25.4 * inch.report.max_deviation).abs() <= 1e-9);
+    // `File` changes nothing; a JSON model in metres comes out in millimetres.
+    let same = mesh_model_in_units(&model, &MeshOptions::default().with_tolerance(0.01), Units::File, &mut |_, _| true);
+    assert_eq!(same.unwrap().mesh.positions, inch.mesh.positions);
+    let json =
+        String::from_utf8(std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/plane.json")).unwrap())
+            .unwrap();
+    let mut metres = surfmesh::read_json(json.as_bytes()).unwrap();
+    metres.units = "m".into();
+    let a = mesh_model(&metres, &MeshOptions::default()).unwrap();
+    let b = mesh_model_in_units(&metres, &MeshOptions::default(), Units::Mm, &mut |_, _| true).unwrap();
+    assert_eq!(b.report.units, "mm");
+    assert!((b.report.tolerance - 1000.0 * a.report.tolerance).abs() <= 1e-9 * b.report.tolerance);
+    // A unit this does not know cannot be converted, and says so.
+    metres.units = "furlong".into();
+    let e = mesh_model_in_units(&metres, &MeshOptions::default(), Units::Mm, &mut |_, _| true).unwrap_err();
+    assert!(e.to_string().contains("'furlong'"), "{e}");
+}
+
+/// A closed box whose bottom face cannot be read: the mesh has a hole
+/// there, and the report says so. The edges the four side faces leave open
+/// along the missing face's border are cracks (free edges), not the model's
+/// own boundary, and the faces of the file are counted with the missing one.
+#[test]
+fn a_skipped_face_of_a_closed_box_leaves_free_edges_and_a_warning() {
+    let model = read_step(&data("step_bad_face.stp")).unwrap();
+    assert_eq!((model.faces.len(), model.skipped.len()), (5, 1));
+    // Its border: the four edges of the unit square at z = 0.
+    let border = &model.skipped[0].border;
+    assert_eq!(border.len(), 4);
+    for c in border {
+        let (a, b) = c.domain();
+        assert!(c.point(a).z.abs() < 1e-12 && c.point(b).z.abs() < 1e-12);
+    }
+    for rel in [1e-2, 1e-3] {
+        let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(rel)).unwrap();
+        let rep = &r.report;
+        assert_eq!((rep.faces, rep.faces_unread, rep.faces_skipped), (5, 1, 0));
+        // Every open edge runs round the hole: at least one per side.
+        assert!(rep.boundary_edges >= 4, "rel {rel}: {} boundary edges", rep.boundary_edges);
+        assert_eq!(rep.free_edges, rep.boundary_edges, "rel {rel}: every open edge is a crack");
+        let on_hole = hole_edges_at_z0(&r.mesh, rep.tolerance);
+        assert_eq!(on_hole, rep.boundary_edges, "rel {rel}: the open edges are the missing face's border");
+        assert!(
+            rep.warnings.iter().any(|w| w.starts_with("1 face(s) of the file could not be read: the mesh has holes")),
+            "{:?}",
+            rep.warnings
+        );
+        assert!(rep.max_deviation <= rep.tolerance && rep.inverted_triangles == 0);
+    }
+    // The same box whole: no hole, no crack, no warning about one.
+    let whole = read_step(&data("step_box_inch.stp")).unwrap();
+    let r = mesh_model(&whole, &MeshOptions::default().with_relative_tolerance(1e-2)).unwrap();
+    assert_eq!((r.report.faces_unread, r.report.free_edges, r.report.boundary_edges), (0, 0, 0));
+    assert!(!r.report.warnings.iter().any(|w| w.contains("could not be read")));
+}
+
+/// Edges of `mesh` with one triangle after welding whose two ends lie on the plane z = 0.
+fn hole_edges_at_z0(mesh: &Mesh, tol: f64) -> usize {
+    let (map, _) = surfmesh::weld_positions(&mesh.positions, tol * 1e-3);
+    // Per welded edge: how many triangles use it, and one of its two vertices' heights.
+    let mut uses: std::collections::HashMap<(u32, u32), (usize, f64, f64)> = std::collections::HashMap::new();
+    for t in mesh.indices.chunks_exact(3) {
+        for k in 0..3 {
+            let (p, q) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            let key = (map[p].min(map[q]), map[p].max(map[q]));
+            let e = uses.entry(key).or_insert((0, mesh.positions[p].z, mesh.positions[q].z));
+            e.0 += 1;
+        }
+    }
+    uses.values().filter(|(n, za, zb)| *n == 1 && za.abs() < tol && zb.abs() < tol).count()
+}
+
 #[test]
 fn hostile_and_malformed_files_are_errors_naming_the_instance() {
     let m = read_step(&data("step_hostile_knots.stp")).unwrap_err().to_string();
@@ -258,14 +347,9 @@ const MESHED_BUT_STRIPS: [&str; 1] = ["trj7_b1-ec-214.stp"];
 /// unoptimized); `cargo test --release` takes them all.
 const DEBUG_MAX_BYTES: usize = 200_000;
 
-fn corpus_files() -> Option<Vec<PathBuf>> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(corpus_dir())
-        .ok()?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().and_then(|e| e.to_str()).is_some_and(|e| e == "stp" || e == "step"))
-        .collect();
-    files.sort();
-    Some(files)
+/// STEP files of the test corpus, sorted by name.
+fn corpus_files() -> Vec<String> {
+    corpus_names(&["stp", "step"])
 }
 
 /// Faces the file lists (ADVANCED_FACE / FACE_SURFACE instances).
@@ -277,14 +361,10 @@ fn faces_in_file(text: &str) -> usize {
 
 #[test]
 fn corpus_reads_every_face() {
-    let Some(files) = corpus_files() else {
-        eprintln!("no corpus at {}: STEP corpus test not run", corpus_dir().display());
-        return;
-    };
+    let files = corpus_files();
     assert!(files.len() >= 16, "the corpus holds {} STEP files", files.len());
-    for path in files {
-        let name = path.file_name().unwrap().to_string_lossy().to_string();
-        let bytes = std::fs::read(&path).unwrap();
+    for name in files {
+        let bytes = corpus_bytes(&name);
         if cfg!(debug_assertions) && bytes.len() > DEBUG_MAX_BYTES {
             eprintln!("{name}: not read in an unoptimized build (run the tests with --release)");
             continue;
@@ -307,20 +387,19 @@ fn corpus_reads_every_face() {
 /// with no triangle that has two corners at one point.
 #[test]
 fn corpus_meshes_within_tolerance_watertight() {
-    let Some(files) = corpus_files() else {
-        eprintln!("no corpus at {}: STEP corpus test not run", corpus_dir().display());
-        return;
-    };
+    let files = corpus_files();
+    for m in MESHED.iter().chain(&MESHED_BUT_STRIPS) {
+        assert!(files.iter().any(|n| n == m), "{m} is not in the corpus");
+    }
     let mut failures = Vec::new();
     println!(
         "{:<30} {:>9} {:>8} {:>10} {:>10} {:>4} {:>5} {:>6} {:>5} {:>7}",
         "file", "faces", "tris", "max dev", "tolerance", "inv", "free", "shellB", "misor", "ms"
     );
-    for path in files {
-        let name = path.file_name().unwrap().to_string_lossy().to_string();
+    for name in files {
         let strips_allowed = MESHED_BUT_STRIPS.contains(&name.as_str());
         let must = MESHED.contains(&name.as_str()) || strips_allowed;
-        let bytes = std::fs::read(&path).unwrap();
+        let bytes = corpus_bytes(&name);
         if cfg!(debug_assertions) && bytes.len() > DEBUG_MAX_BYTES {
             continue;
         }
@@ -414,11 +493,7 @@ fn corpus_meshes_within_tolerance_watertight() {
 /// never split where a neighbour's nodes are, and the closed shell opens.
 #[test]
 fn corpus_fuselage_rebuilt_faces_keep_the_shell_closed() {
-    let path = corpus_dir().join("bug28366_fuselage.stp");
-    let Ok(bytes) = std::fs::read(&path) else {
-        eprintln!("no corpus at {}: test not run", corpus_dir().display());
-        return;
-    };
+    let bytes = corpus_bytes("bug28366_fuselage.stp");
     let (model, shells) = read_step_with_shells(&bytes).expect("reads");
     let options = MeshOptions::default().with_relative_tolerance(1e-3).with_reparam(surfmesh::Reparam::Auto);
     let r = mesh_model(&model, &options).expect("meshes");

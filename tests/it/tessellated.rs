@@ -6,9 +6,11 @@
 //! from tests/corpus or ../shared/corpus-wide) mesh through the CLI path.
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::DVec3;
+
+use crate::corpus_files::corpus_bytes;
 use surfmesh::{edge_counts, mesh_model, read_step_parts, Mesh, MeshOptions, MeshResult, StepModel};
 
 fn data(name: &str) -> Vec<u8> {
@@ -294,23 +296,13 @@ fn an_exact_and_a_tessellated_face_sharing_an_edge_are_sewn_without_a_crack() {
 /// its strips turned so that it faces out).
 #[test]
 fn corpus_tessellated_files_mesh() {
-    let find = |name: &str| -> Option<PathBuf> {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-        [root.join("tests").join("corpus").join(name), root.join("..").join("shared").join("corpus-wide").join(name)]
-            .into_iter()
-            .find(|p| p.exists())
-    };
-    let (Some(window), Some(cube)) = (find("bug33100_window.step"), find("bug33638.stp")) else {
-        eprintln!("bug33100_window.step / bug33638.stp not found: tessellated corpus test not run");
-        return;
-    };
-    let s = read_step_parts(&std::fs::read(window).unwrap()).unwrap();
+    let s = read_step_parts(&corpus_bytes("tessellated/bug33100_window.step")).unwrap();
     let r = mesh(&s, &MeshOptions::default());
     assert_eq!((r.report.faces, r.report.faces_tessellated), (4, 4));
     let counts: Vec<u32> = r.mesh.face_ranges.iter().map(|f| f.count).collect();
     assert_eq!(counts, [88, 68, 24, 176]);
     assert!(s.face_colours.iter().all(Option::is_some));
-    let s = read_step_parts(&std::fs::read(cube).unwrap()).unwrap();
+    let s = read_step_parts(&corpus_bytes("tessellated/bug33638.stp")).unwrap();
     let r = mesh(&s, &MeshOptions::default());
     assert_eq!((r.report.faces_tessellated, r.report.triangles), (6, 12));
     let c = edge_counts(&r.mesh, 1e-9, r.report.tolerance);

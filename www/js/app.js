@@ -106,6 +106,8 @@ function showStats(report, quality) {
   setStat('stat-triangles', count(report.triangles));
   setStat('stat-vertices', count(report.vertices));
   setStat('stat-tolerance', fmt(report.tolerance));
+  // Every length of the mesh and the report is in the file's unit.
+  $('stat-units').textContent = report.units ? ` (${report.units})` : '';
   const within = report.max_deviation <= report.tolerance;
   if (report.quality) {
     // Quality mode aims at a size, not a tolerance: the deviation is reported, not judged.

@@ -6,6 +6,8 @@
 //! A face that cannot be read is skipped with a warning naming its directory
 //! entry and type.
 
+mod skipped;
+
 use crate::collections::HashSet;
 use alloc::string::String;
 use alloc::vec::Vec;
@@ -19,14 +21,18 @@ use super::subfigures::{Count, Subfigures};
 use super::surfaces::{is_surface, surface_def};
 use super::xform::own_transform;
 use super::Ctx;
-use crate::model::Face;
+use crate::model::{Face, SkippedFace};
 use crate::Error;
 
 /// The faces of the file, in directory order, with warnings for what was
 /// skipped; the first skip's error is kept for files where nothing is left.
 /// Also each face's body: the B-rep shell (514, or 186's) it belongs to, 0
-/// for faces outside any.
-pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face>, Vec<u32>, Option<Error>) {
+/// for faces outside any; and the faces skipped, with their borders.
+pub(super) fn read_faces(
+    ctx: &Ctx<'_>,
+    warnings: &mut Vec<String>,
+    skipped: &mut Vec<SkippedFace>,
+) -> (Vec<Face>, Vec<u32>, Option<Error>) {
     let dir = ctx.dir;
     // Surfaces that faces (or offsets) use are not faces themselves.
     let mut used: HashSet<usize> = HashSet::default();
@@ -131,20 +137,23 @@ pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face
             for w in local {
                 warnings.push(alloc::format!("DE {} (type {}): {w}", fe.de, fe.kind));
             }
+            let body = match &job {
+                Job::Brep(parents) if !parents.is_empty() => {
+                    let next = shell_body.len() as u32 + 1;
+                    *shell_body.entry((at.instance, parents[0])).or_insert(next)
+                }
+                _ => 0,
+            };
             match result {
                 Ok(mut face) => {
                     face.name = name_of(ctx, fe, &job);
                     out.push(face);
-                    let body = match &job {
-                        Job::Brep(parents) if !parents.is_empty() => {
-                            let next = shell_body.len() as u32 + 1;
-                            *shell_body.entry((at.instance, parents[0])).or_insert(next)
-                        }
-                        _ => 0,
-                    };
                     bodies.push(body);
                 }
-                Err(err) => skip(warnings, &mut first_error, fe, err),
+                Err(err) => {
+                    skip(warnings, &mut first_error, fe, err);
+                    skipped.push(SkippedFace { body, border: skipped::border(ctx, fe, &job, at.m) });
+                }
             }
         }
     }
@@ -156,7 +165,7 @@ pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face
         let what = if kind == 402 { "perforated planes" } else { "array or network subfigure instances" };
         warnings.push(alloc::format!("{n} entities of type {kind} ({what}) skipped: not supported"));
     }
-    if bodies.iter().all(|&b| b == 0) {
+    if bodies.iter().all(|&b| b == 0) && skipped.iter().all(|s| s.body == 0) {
         bodies.clear();
     }
     (out, bodies, first_error)

@@ -227,12 +227,13 @@ pub fn read_iges(bytes: &[u8]) -> Result<Model, Error> {
         resolution: g.resolution.map(|r| r / g.scale),
         notes: core::cell::RefCell::default(),
     };
-    let (faces, bodies, first_error) = faces::read_faces(&ctx, &mut warnings);
+    let mut skipped = Vec::new();
+    let (faces, bodies, first_error) = faces::read_faces(&ctx, &mut warnings, &mut skipped);
     warnings.extend(ctx.notes.borrow().warnings());
     if faces.is_empty() {
         return Err(first_error.unwrap_or_else(|| iges_error(Section::Directory, 0, 0, no_faces(&dir))));
     }
-    Ok(Model { units: g.units, faces, warnings, tolerance: ctx.resolution, bodies, tessellated: Vec::new() })
+    Ok(Model { units: g.units, faces, warnings, tolerance: ctx.resolution, bodies, tessellated: Vec::new(), skipped })
 }
 
 /// The Global section: delimiters (fields 1–2), model space scale (13),

@@ -30,6 +30,7 @@ use alloc::string::String;
 use alloc::vec::Vec;
 use core::ops::Range;
 
+use crate::model::SkippedFace;
 use crate::{Error, Model};
 
 /// Deepest chain of references followed (composite curves, offsets,
@@ -177,6 +178,7 @@ pub fn read_step_parts(bytes: &[u8]) -> Result<StepModel, Error> {
     // tessellated faces of parts of several bodies or none, are bodies of their own.
     let offset = faces.len();
     let mut shells = shapes.shells;
+    let exact_shells = shells.len();
     let mut group: Vec<usize> = (0..placed.len()).map(|f| shells.len() + f).collect();
     let mut exact_of: crate::collections::HashMap<usize, Option<usize>> = crate::collections::HashMap::default();
     for (k, s) in shells.iter().enumerate() {
@@ -217,7 +219,17 @@ pub fn read_step_parts(bytes: &[u8]) -> Result<StepModel, Error> {
         .collect();
     let mut face_colours = shapes.colours;
     face_colours.extend(facets.colours);
-    let model = Model { units, faces, warnings, tolerance, bodies, tessellated };
+    // A skipped face is in its shell's body; it is counted, and its border kept.
+    let skipped = shapes
+        .skipped
+        .into_iter()
+        .map(|(k, border)| {
+            let next = numbers.len() as u32;
+            let body = if k < exact_shells { *numbers.entry(k).or_insert(next) } else { next };
+            SkippedFace { body, border }
+        })
+        .collect();
+    let model = Model { units, faces, warnings, tolerance, bodies, tessellated, skipped };
     Ok(StepModel { model, shells, parts, face_parts, face_colours })
 }
 
