@@ -613,6 +613,24 @@ fn trimmed_curves_against_their_basis_bound_a_quarter_cylinder() {
     }
 }
 
+/// A curve-bounded surface on an extrusion, whose extent along its
+/// direction only the boundary gives: the surface is built over the range
+/// the boundary's points need, and the quarter tube has its area.
+#[test]
+fn a_curve_bounded_extrusion_takes_its_range_from_the_boundary() {
+    let model = read_step(&data("step_extrusion_curve_bounded.stp")).unwrap();
+    assert_eq!(model.faces.len(), 1, "{:?}", model.warnings);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-3)).unwrap();
+    assert!(r.report.max_deviation <= r.report.tolerance);
+    let exact = 5.0 * std::f64::consts::FRAC_PI_2 * 10.0;
+    let a = area(&r.mesh, 0..1);
+    assert!((a - exact).abs() < 0.005 * exact, "area {a}, exact {exact}");
+    for p in &r.mesh.positions {
+        let radius = p.truncate().length();
+        assert!((radius - 5.0).abs() < 1e-2 && (-1e-6..=10.0 + 1e-6).contains(&p.z), "{p} off the quarter tube");
+    }
+}
+
 /// A face across the seam of a periodic B-spline surface whose knots are
 /// not clamped (as such surfaces come in files): the seam is moved into the
 /// face's gap after clamping, and the face has the area of its strip.

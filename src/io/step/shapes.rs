@@ -485,7 +485,19 @@ impl Reader<'_, '_> {
 
     /// A surface outside any face: whole or rectangular-trimmed.
     fn loose_surface(&mut self, geo: &Geo<'_>, s: Ent<'_>) -> Result<Face, Error> {
-        let surf = geo.surface(s, &[], 0)?;
+        // The boundary first: a surface of unbounded extent (an extrusion)
+        // takes its range from the points of the curves that bound it.
+        let mut bounds = Vec::new();
+        let mut domain_outer = false;
+        if s.has("CURVE_BOUNDED_SURFACE") {
+            let a = s.chain(&[("REPRESENTATION_ITEM", 1), ("CURVE_BOUNDED_SURFACE", 3)])?;
+            domain_outer = a.boolean(3, false)?;
+            for b in a.refs(2)? {
+                bounds.push(self.boundary_curve(geo, self.g.get(b, s.id())?)?);
+            }
+        }
+        let points: Vec<DVec3> = bounds.iter().flat_map(|l| l.model.iter()).flat_map(sample3).collect();
+        let surf = geo.surface(s, &points, 0)?;
         let mut loops = Vec::new();
         if s.has("RECTANGULAR_TRIMMED_SURFACE") {
             let a = s.chain(&[("REPRESENTATION_ITEM", 1), ("RECTANGULAR_TRIMMED_SURFACE", 7)])?;
@@ -504,14 +516,7 @@ impl Reader<'_, '_> {
             }
             loops.push(LoopSrc { model: Vec::new(), params: Some(params) });
         }
-        let mut domain_outer = false;
-        if s.has("CURVE_BOUNDED_SURFACE") {
-            let a = s.chain(&[("REPRESENTATION_ITEM", 1), ("CURVE_BOUNDED_SURFACE", 3)])?;
-            domain_outer = a.boolean(3, false)?;
-            for b in a.refs(2)? {
-                loops.push(self.boundary_curve(geo, self.g.get(b, s.id())?)?);
-            }
-        }
+        loops.extend(bounds);
         let mut surf = surf;
         if s.has("RECTANGULAR_TRIMMED_SURFACE") {
             surf.native = true;
