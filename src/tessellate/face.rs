@@ -368,7 +368,8 @@ fn domain_outline<'a>(
             }
         })
         .collect::<Option<Vec<_>>>()?;
-    let loops = Loops { polys: alloc::vec![Polyline { uv, at, seg }], curves: lp.curves.iter().collect() };
+    let loops =
+        Loops { polys: alloc::vec![Polyline { uv, at, seg }], curves: lp.curves.iter().collect(), mended: None };
     let gids = alloc::vec![alloc::vec![u32::MAX; n]];
     Some(Outline { loops, pu, pv, gids })
 }

@@ -9,6 +9,8 @@ mod face;
 #[cfg(feature = "std")]
 mod fill;
 pub(crate) mod measure;
+#[cfg(feature = "std")]
+mod mend_loops;
 mod options;
 mod params;
 mod refine;
@@ -242,7 +244,12 @@ pub fn mesh_model_with_progress(
         let loops = loops_of(f);
         let ready = made.into_iter().find(|(g, l, _)| core::ptr::eq(*g, f) && l.same_as(&face_lim)).map(|(_, _, o)| o);
         match Chosen::new(index, f, loops, face_lim, face_crit, fit_error, ready) {
-            Ok(c) => chosen.push(Some(c)),
+            Ok(c) => {
+                if let Some(m) = c.mended() {
+                    report.warnings.push(format!("face {index}: {m}"));
+                }
+                chosen.push(Some(c));
+            }
             // One face that cannot be meshed does not sink the others; a
             // model where none can is the first face's error.
             Err(Error::Mesh { face, message }) if model.faces.len() > 1 => {
@@ -620,6 +627,18 @@ impl<'a> Chosen<'a> {
             lim,
             crit,
         })
+    }
+
+    /// What mending its crossing trim loops changed, if they crossed.
+    #[cfg(feature = "std")]
+    fn mended(&self) -> Option<mend_loops::Mended> {
+        self.outline.loops.mended
+    }
+
+    /// Without the trimmed mesher there are no loops to mend.
+    #[cfg(not(feature = "std"))]
+    fn mended(&self) -> Option<&'static str> {
+        None
     }
 
     /// Whether a loop of the sewn outline passes one node twice.

@@ -5,6 +5,7 @@ use alloc::format;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
+use super::mend_loops::Mended;
 use super::params::{initial_breaks, subdivide, Limits, MAX_PARAMS};
 use crate::model::TrimLoop;
 use crate::nurbs::Surface;
@@ -49,6 +50,10 @@ pub(crate) struct Loops<'a> {
     pub polys: Vec<Polyline>,
     /// The trim curves, indexed by [`CurveRef::curve`].
     pub curves: Vec<&'a crate::NurbsCurve>,
+    /// Set when the file's loops crossed and were mended ([`super::mend_loops`]):
+    /// the polylines are then the border of the region they wind round,
+    /// possibly several counter-clockwise loops.
+    pub mended: Option<Mended>,
 }
 
 impl Loops<'_> {
@@ -142,6 +147,7 @@ pub(crate) fn prepare_loops<'a>(
 ) -> Result<Loops<'a>, Error> {
     let mut out = Loops::default();
     let mut areas = Vec::new();
+    let (mut kept, mut flat) = (Vec::new(), Vec::new());
     for (li, lp) in loops.iter().enumerate() {
         let mut poly = Polyline::default();
         for c in &lp.curves {
@@ -203,22 +209,26 @@ pub(crate) fn prepare_loops<'a>(
                 (a.curve, a.t, tb)
             })
             .collect();
-        if poly.uv.len() < 3 {
-            return Err(Error::Mesh { face, message: format!("loop {li} encloses no area") });
-        }
-        let area = signed_area(&poly.uv);
+        let area = if poly.uv.len() < 3 { 0.0 } else { signed_area(&poly.uv) };
         if area == 0.0 || !area.is_finite() {
-            return Err(Error::Mesh { face, message: format!("loop {li} encloses no area") });
+            // A loop of no area bounds nothing: dropped when others remain.
+            flat.push(li);
+            continue;
         }
         areas.push(area);
+        kept.push(li);
         out.polys.push(poly);
+    }
+    if let Some(&li) = flat.first().filter(|_| out.polys.is_empty()) {
+        return Err(Error::Mesh { face, message: format!("loop {li} encloses no area") });
     }
     // Outer = largest area; counter-clockwise. Holes clockwise.
     let outer = (0..areas.len()).max_by(|&i, &j| areas[i].abs().total_cmp(&areas[j].abs())).unwrap_or(0);
     out.polys.swap(0, outer);
     areas.swap(0, outer);
-    let mut order: Vec<usize> = (0..loops.len()).collect();
+    let mut order = kept;
     order.swap(0, outer);
+    let file_ccw: Vec<bool> = areas.iter().map(|&a| a > 0.0).collect();
     for (k, poly) in out.polys.iter_mut().enumerate() {
         let want_ccw = k == 0;
         if (areas[k] > 0.0) != want_ccw {
@@ -234,18 +244,41 @@ pub(crate) fn prepare_loops<'a>(
         }
     }
     if let Some(x) = split_crossings(&mut out) {
-        return Err(crossing_error(face, &x, &order));
-    }
-    for k in 1..out.polys.len() {
-        let probe = out.polys[k].uv[0];
-        let mut only_outer = Loops { polys: Vec::new(), curves: Vec::new() };
-        only_outer.polys.push(out.polys[0].clone());
-        if !only_outer.contains(probe) {
-            return Err(Error::Mesh {
-                face,
-                message: format!("loop {} lies outside the outer loop {}", order[k], order[0]),
-            });
+        let mm = super::mend_loops::mend(&mut out, &file_ccw);
+        match mm {
+            Some(m) if first_crossing(&out).is_none() => out.mended = Some(m),
+            _ => return Err(crossing_error(face, &x, &order)),
         }
+    }
+    if out.mended.is_none() {
+        for k in 1..out.polys.len() {
+            let probe = out.polys[k].uv[0];
+            let only_outer = Loops { polys: alloc::vec![out.polys[0].clone()], ..Loops::default() };
+            if !only_outer.contains(probe) {
+                // A loop beside the outer one: a region of its own, or a
+                // hole of nothing; mending keeps what the loops wind round.
+                match super::mend_loops::mend(&mut out, &file_ccw) {
+                    Some(m) if first_crossing(&out).is_none() => {
+                        out.mended = Some(m);
+                        break;
+                    }
+                    _ => {
+                        return Err(Error::Mesh {
+                            face,
+                            message: format!("loop {} lies outside the outer loop {}", order[k], order[0]),
+                        })
+                    }
+                }
+            }
+        }
+    }
+    if !flat.is_empty() {
+        let m = out.mended.get_or_insert(Mended {
+            loops_before: loops.len(),
+            loops_after: out.polys.len(),
+            ..Mended::default()
+        });
+        m.flat = flat.len();
     }
     Ok(out)
 }
@@ -492,7 +525,7 @@ mod tests {
             poly.at.push(CurveRef { curve: c, t });
         }
         poly.seg = alloc::vec![(0, 0.0, 0.5), (0, 0.5, 1.0), (1, 0.0, 0.25), (1, 0.25, 0.75), (1, 0.75, 1.0)];
-        let mut loops = Loops { polys: alloc::vec![poly], curves: curves.to_vec() };
+        let mut loops = Loops { polys: alloc::vec![poly], curves: curves.to_vec(), mended: None };
         assert!(first_crossing(&loops).is_some(), "the test's chords must cross");
         assert!(split_crossings(&mut loops).is_none());
         assert!(first_crossing(&loops).is_none());
@@ -567,7 +600,7 @@ mod tests {
                 poly.seg.push((k as u32, t, t + 0.5));
             }
         }
-        let mut loops = Loops { polys: alloc::vec![poly], curves: curves.to_vec() };
+        let mut loops = Loops { polys: alloc::vec![poly], curves: curves.to_vec(), mended: None };
         let left = split_crossings(&mut loops).expect("curves that cross stay crossing");
         assert!(first_crossing(&loops).is_some());
         let message = alloc::format!("{}", crossing_error(3, &left, &[0]));

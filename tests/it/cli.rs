@@ -461,9 +461,24 @@ fn cli_rejects_loop_point_with_three_coordinates() {
     assert_rejected("bad_loop_point.json", &["face 0", "loop 0", "curve 1", "points[0]"]);
 }
 
+/// Holes that cross are mended to their union: the file meshes, and the
+/// report's warning names the face.
 #[test]
-fn cli_rejects_crossing_loops() {
-    assert_rejected("bad_loops_cross.json", &["face 0", "loop 1 crosses loop 2"]);
+fn cli_mends_crossing_loops() {
+    let dir = scratch("mend");
+    let (out_path, report_path) = (dir.join("out.stl"), dir.join("report.json"));
+    let input = data("bad_loops_cross.json");
+    let args = ["mesh".as_ref(), input.as_os_str(), "-o".as_ref(), out_path.as_os_str()];
+    let out = run(&[&args[..], &["--report".as_ref(), report_path.as_os_str()]].concat());
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&report_path).unwrap()).unwrap();
+    let warnings = report["warnings"].as_array().expect("warnings");
+    assert!(
+        warnings.iter().any(|w| w.as_str().is_some_and(|w| w.starts_with("face 0: trim loops crossed"))),
+        "{warnings:?}"
+    );
+    assert_eq!(report["faces_skipped"], 0);
+    assert!(report["max_deviation"].as_f64().unwrap() <= report["tolerance"].as_f64().unwrap());
 }
 
 #[test]

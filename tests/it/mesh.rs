@@ -220,38 +220,96 @@ fn face_with_loops(loops: Vec<TrimLoop>) -> Model {
     }
 }
 
-#[test]
-fn mesh_rejects_crossing_loops() {
-    let outer = uv_polygon(&[(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9)]);
-    let a = uv_polygon(&[(0.3, 0.3), (0.6, 0.3), (0.6, 0.6), (0.3, 0.6)]);
-    let b = uv_polygon(&[(0.5, 0.5), (0.8, 0.5), (0.8, 0.8), (0.5, 0.8)]);
-    let err = mesh_model(&face_with_loops(vec![outer, a, b]), &MeshOptions::default()).expect_err("loops cross");
-    let msg = err.to_string();
-    assert!(matches!(err, Error::Mesh { face: 0, .. }), "{msg}");
-    assert!(msg.contains("face 0") && msg.contains("crosses"), "{msg}");
-
-    let bow = uv_polygon(&[(0.1, 0.1), (0.9, 0.9), (0.9, 0.1), (0.1, 0.9)]);
-    let msg = mesh_model(&face_with_loops(vec![bow]), &MeshOptions::default()).expect_err("self-crossing").to_string();
-    assert!(msg.contains("crosses itself"), "{msg}");
+/// A flat 10 × 10 square patch (x = 10u, y = 10v) with `loops`, so areas in
+/// (u,v) scale by 100 into the mesh.
+fn flat_face_with_loops(loops: Vec<TrimLoop>) -> Model {
+    let points = vec![
+        vec![DVec3::new(0.0, 0.0, 0.0), DVec3::new(0.0, 10.0, 0.0)],
+        vec![DVec3::new(10.0, 0.0, 0.0), DVec3::new(10.0, 10.0, 0.0)],
+    ];
+    let surface = NurbsSurface::try_new([1, 1], vec![0.0, 0.0, 1.0, 1.0], vec![0.0, 0.0, 1.0, 1.0], &points, None)
+        .expect("bilinear patch");
+    Model {
+        units: "mm".into(),
+        faces: vec![Face { name: None, surface: FaceSurface::Nurbs(surface), loops }],
+        ..Model::default()
+    }
 }
 
-/// One face whose loops cross does not sink a model of several: it is
+fn mesh_area(mesh: &Mesh) -> f64 {
+    mesh.indices
+        .chunks_exact(3)
+        .map(|t| {
+            let [a, b, c] = [0, 1, 2].map(|k| mesh.positions[t[k] as usize]);
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .sum()
+}
+
+/// Loops that cross are mended, as industrial readers mend wires: split at
+/// the crossings and keep the region the loops wind round, with a warning
+/// naming the face (paper 000 §3.1 needs loops that neither cross nor touch).
+#[test]
+fn mesh_mends_crossing_loops_to_the_region_they_wind_round() {
+    let outer = uv_polygon(&[(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9)]);
+    let a = uv_polygon(&[(0.3, 0.3), (0.3, 0.6), (0.6, 0.6), (0.6, 0.3)]);
+    let b = uv_polygon(&[(0.5, 0.5), (0.5, 0.8), (0.8, 0.8), (0.8, 0.5)]);
+    let r = mesh_model(&flat_face_with_loops(vec![outer.clone(), a, b]), &MeshOptions::default()).expect("mended");
+    let w = &r.report.warnings;
+    assert!(w.iter().any(|w| w.starts_with("face 0: trim loops crossed") && w.contains("mended")), "{w:?}");
+    // The square less the union of the two holes (0.09 + 0.09 - 0.01).
+    let area = mesh_area(&r.mesh);
+    assert!((area - 100.0 * (0.64 - 0.17)).abs() < 1e-6, "area {area}");
+    for t in r.mesh.indices.chunks_exact(3) {
+        let c = t.iter().map(|&i| r.mesh.positions[i as usize]).sum::<DVec3>() / 30.0;
+        let in_hole = |lo: f64, hi: f64| c.x > lo && c.x < hi && c.y > lo && c.y < hi;
+        assert!(!in_hole(0.3, 0.6) && !in_hole(0.5, 0.8), "triangle in a hole at {c}");
+    }
+    assert_eq!(r.report.inverted_triangles, 0);
+
+    // A bow tie: the lobe that runs counter-clockwise is the region.
+    let bow = uv_polygon(&[(0.1, 0.1), (0.9, 0.9), (0.9, 0.1), (0.1, 0.9)]);
+    let r = mesh_model(&flat_face_with_loops(vec![bow]), &MeshOptions::default()).expect("one lobe");
+    assert!(r.report.warnings.iter().any(|w| w.contains("mended")), "{:?}", r.report.warnings);
+    let area = mesh_area(&r.mesh);
+    assert!((area - 16.0).abs() < 1e-6, "one lobe of 0.16 in (u,v): area {area}");
+
+    // A hole of no area (a line gone out and back) bounds nothing.
+    let flat = uv_polygon(&[(0.3, 0.3), (0.6, 0.6), (0.45, 0.45)]);
+    let r = mesh_model(&flat_face_with_loops(vec![outer.clone(), flat]), &MeshOptions::default()).expect("meshes");
+    let w = &r.report.warnings;
+    assert!(w.iter().any(|w| w == "face 0: 1 trim loop enclosing no area dropped"), "{w:?}");
+    assert!((mesh_area(&r.mesh) - 64.0).abs() < 1e-6);
+
+    // A clockwise loop beside the outer loop is a hole of nothing; a
+    // counter-clockwise one is a second region of the face.
+    let cw = [(0.92, 0.3), (0.92, 0.6), (0.98, 0.6), (0.98, 0.3)];
+    let ccw: Vec<(f64, f64)> = cw.iter().rev().copied().collect();
+    for (beside, want) in [(cw.to_vec(), 64.0), (ccw, 64.0 + 1.8)] {
+        let loops = vec![outer.clone(), uv_polygon(&beside)];
+        let r = mesh_model(&flat_face_with_loops(loops), &MeshOptions::default()).expect("meshes");
+        assert!(r.report.warnings.iter().any(|w| w.contains("mended")), "{:?}", r.report.warnings);
+        let area = mesh_area(&r.mesh);
+        assert!((area - want).abs() < 1e-6, "area {area}, want {want}");
+    }
+}
+
+/// One face whose loop encloses nothing does not sink a model of several: it is
 /// skipped with a warning naming it, its face range stays (empty) so ranges
 /// still match faces, and the others mesh. When no face meshes, the first
 /// face's error is the model's.
 #[test]
 fn mesh_skips_a_bad_face_among_good_ones() {
     let outer = uv_polygon(&[(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9)]);
-    let a = uv_polygon(&[(0.3, 0.3), (0.6, 0.3), (0.6, 0.6), (0.3, 0.6)]);
-    let b = uv_polygon(&[(0.5, 0.5), (0.8, 0.5), (0.8, 0.8), (0.5, 0.8)]);
-    let bad = face_with_loops(vec![outer.clone(), a, b]).faces.remove(0);
+    let flat = uv_polygon(&[(0.1, 0.1), (0.5, 0.5), (0.9, 0.9)]);
+    let bad = face_with_loops(vec![flat]).faces.remove(0);
     let good = face_with_loops(vec![outer]).faces.remove(0);
     let mut model = face_with_loops(vec![]);
     model.faces = vec![good.clone(), bad.clone(), good];
     let r = mesh_model(&model, &MeshOptions::default()).expect("the good faces mesh");
     assert_eq!(r.report.faces_skipped, 1);
     assert!(
-        r.report.warnings.iter().any(|w| w.starts_with("face 1: skipped") && w.contains("crosses")),
+        r.report.warnings.iter().any(|w| w.starts_with("face 1: skipped") && w.contains("area")),
         "{:?}",
         r.report.warnings
     );

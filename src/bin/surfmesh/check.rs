@@ -149,13 +149,14 @@ pub struct Row {
     pub ok: bool,
     /// The one-line error of a file that did not mesh.
     pub error: Option<String>,
-    /// Faces in the file: the model's and those the reader could not build.
+    /// Faces in the file: the model's (exact and tessellated) and those the
+    /// reader could not build.
     pub faces_in_file: usize,
     /// Faces with at least one triangle.
     pub faces_meshed: usize,
     /// Faces the reader could not build (each with a warning).
     pub faces_unread: usize,
-    /// Faces of the model that produced no triangles.
+    /// Faces of the model (exact or tessellated) that produced no triangles.
     pub faces_empty: usize,
     /// Triangles.
     pub triangles: usize,
@@ -341,12 +342,13 @@ fn check_file(a: &CheckArgs, path: &Path, name: &str, format: Format) -> Row {
         drop(bytes);
         row.parse_ms = start.elapsed().as_secs_f64() * 1e3;
         row.faces_unread = model.skipped.len();
-        row.faces_in_file = model.faces.len() + model.skipped.len();
+        let built = model.faces.len() + model.tessellated.len();
+        row.faces_in_file = built + model.skipped.len();
         let mut within = |_: usize, _: usize| start.elapsed().as_secs_f64() < a.timeout;
         let r = mesh_model_in_units(&model, &a.options, a.units, &mut within)?;
         let rep = &r.report;
         row.faces_meshed = r.mesh.face_ranges.iter().filter(|f| f.count > 0).count();
-        row.faces_empty = model.faces.len() - row.faces_meshed;
+        row.faces_empty = built.saturating_sub(row.faces_meshed);
         row.triangles = rep.triangles;
         row.cracks = rep.free_edges;
         row.nonmanifold_edges = rep.nonmanifold_edges;
