@@ -12,6 +12,7 @@ use crate::Error;
 /// What the CDT of a trimmed face works on: loop nodes first (with their
 /// segments as constraints), then the grid nodes inside the region and not too
 /// close to a loop, and the scale of the plane the triangulation runs in.
+#[derive(Clone)]
 pub(super) struct Band {
     pub nodes: Vec<DVec2>,
     pub constraints: Vec<[usize; 2]>,
@@ -51,10 +52,14 @@ impl Band {
         Self { nodes, constraints, segs, scale }
     }
 
-    /// The kept triangles (indices into `nodes`), counter-clockwise.
-    pub fn triangulate(&self, index: usize) -> Result<Vec<[u32; 3]>, Error> {
+    /// The kept triangles (indices into `nodes`), counter-clockwise. Where
+    /// the triangulation split crossing segments, the crossing points are
+    /// added to `nodes` (a strip narrower than the sewing distance).
+    pub fn triangulate(&mut self, index: usize) -> Result<Vec<[u32; 3]>, Error> {
         let scaled: Vec<DVec2> = self.nodes.iter().map(|&q| q * self.scale).collect();
-        super::cdt::triangulate_region(index, &scaled, &self.constraints)
+        let r = super::cdt::triangulate_region(index, &scaled, &self.constraints)?;
+        self.nodes.extend(r.added.iter().map(|&q| q / self.scale));
+        Ok(r.tris)
     }
 
     /// Puts the nodes on the surface and the triangles `tris` into `wm`, loop

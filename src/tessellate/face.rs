@@ -498,7 +498,7 @@ pub(crate) fn initial_from_outline(
     // a grid up to four times the budget is triangulated, and judged by the
     // triangles the loops keep.
     check_band_cells(index, o, budget)?;
-    let band = super::band::Band::new(surface, &o.loops, &o.pu, &o.pv);
+    let mut band = super::band::Band::new(surface, &o.loops, &o.pu, &o.pv);
     let tris = band.triangulate(index)?;
     if tris.len() > budget {
         check_grid(index, &o.pu, &o.pv, budget)?;

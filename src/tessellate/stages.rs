@@ -120,7 +120,7 @@ impl<'a> FaceStages<'a> {
     /// # Errors
     /// As `mesh_model` for crossing loops.
     pub fn cdt(&self, input: &CdtInput) -> Result<usize, Error> {
-        Ok(input.0.triangulate(self.index)?.len())
+        Ok(input.0.clone().triangulate(self.index)?.len())
     }
 
     /// Stages 1 to 3 together: the mesh refinement starts from.
@@ -138,7 +138,7 @@ impl<'a> FaceStages<'a> {
                 Ok(Initial { mesh, curves: Vec::new() })
             }
             Some(loops) => {
-                let band = Band::new(self.surface(), &loops, &g.pu, &g.pv);
+                let mut band = Band::new(self.surface(), &loops, &g.pu, &g.pv);
                 let tris = band.triangulate(self.index)?;
                 band.build(self.surface(), &tris, &mut mesh, None);
                 Ok(Initial { mesh, curves: loops.curves })
