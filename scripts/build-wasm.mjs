@@ -1,18 +1,23 @@
 #!/usr/bin/env node
-// Builds the npm package in pkg/ from wasm-pack.toml: one cargo build of the
-// cdylib for wasm32-unknown-unknown, then per target `wasm-bindgen` (the CLI
-// version pinned in Cargo.lock) and `wasm-opt` from the npm package
-// `binaryen` (Debian's binaryen writes modules that do not load). Prints the
-// size of every .wasm, raw and gzipped. The plain-JS helpers in js/ (the
-// three.js adapter) are copied beside the targets and exported as subpaths.
+// Builds the npm package in pkg/ from wasm-pack.toml: per build ([builds.*]:
+// the viewer build, the package's default entry, and the full build under
+// full/) one cargo build of the cdylib for wasm32-unknown-unknown with that
+// build's Cargo features, then per target `wasm-bindgen` (the CLI version
+// pinned in Cargo.lock) and `wasm-opt` from the npm package `binaryen`
+// (Debian's binaryen writes modules that do not load). Ends with a size
+// report: every .wasm raw, gzip -9 and brotli, and per build the 20 largest
+// functions and sections (`twiggy top`, on a copy optimized with its names
+// kept; scripts/setup.sh installs twiggy), also written to pkg/SIZES.md.
+// The plain-JS helpers in js/ (the three.js adapter and loader, and its
+// worker) are copied beside the targets and exported as subpaths.
 //
-// Usage: node scripts/build-wasm.mjs [--target web|bundler|nodejs ...] [--no-opt]
+// Usage: node scripts/build-wasm.mjs [--build viewer|full ...] [--target web|bundler|nodejs ...] [--no-opt]
 
 import { spawnSync } from 'node:child_process';
 import { copyFileSync, existsSync, mkdirSync, readFileSync, rmSync, statSync, writeFileSync } from 'node:fs';
 import { dirname, join, relative } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { gzipSync } from 'node:zlib';
+import { brotliCompressSync, constants as zlib, gzipSync } from 'node:zlib';
 import { parse as parseToml } from 'smol-toml';
 
 const root = join(dirname(fileURLToPath(import.meta.url)), '..');
@@ -21,7 +26,9 @@ const root = join(dirname(fileURLToPath(import.meta.url)), '..');
  * Plain-JS helpers copied from js/ into the package root: the export subpath,
  * the module and its types, and the optional peer dependency it imports.
  */
-const HELPERS = [{ export: './three', file: 'three.mjs', types: 'three.d.mts', peer: ['three', '>=0.150.0'] }];
+const HELPERS = [
+  { export: './three', file: 'three.mjs', types: 'three.d.mts', peer: ['three', '>=0.150.0'], extra: ['three-worker.mjs'] },
+];
 
 function fail(message) {
   console.error(`build-wasm: ${message}`);
@@ -44,13 +51,15 @@ function capture(cmd, args) {
 
 function parseArgs(argv) {
   const picked = [];
+  const builds = [];
   let opt = true;
   for (let i = 0; i < argv.length; i++) {
     if (argv[i] === '--target' && i + 1 < argv.length) picked.push(argv[++i]);
+    else if (argv[i] === '--build' && i + 1 < argv.length) builds.push(argv[++i]);
     else if (argv[i] === '--no-opt') opt = false;
-    else fail(`unknown argument ${argv[i]} (expected --target NAME or --no-opt)`);
+    else fail(`unknown argument ${argv[i]} (expected --build NAME, --target NAME or --no-opt)`);
   }
-  return { picked, opt };
+  return { picked, builds, opt };
 }
 
 function readConfig() {
@@ -63,7 +72,15 @@ function readConfig() {
       if (typeof t[key] !== 'string') fail(`wasm-pack.toml [targets.${name}] needs a string ${key}`);
     }
   }
+  const builds = config.builds ?? {};
+  if (Object.keys(builds).length === 0) fail('wasm-pack.toml has no [builds.*]');
+  for (const [name, b] of Object.entries(builds)) {
+    if (!Array.isArray(b.features) || typeof b.dir !== 'string' || typeof b.export !== 'string') {
+      fail(`wasm-pack.toml [builds.${name}] needs features (a list), dir and export (strings)`);
+    }
+  }
   return {
+    builds,
     profile: build.cargo_profile ?? 'release',
     optLevel: build.opt_level,
     stackSize: build.stack_size,
@@ -114,16 +131,19 @@ function targetManifest(name, cargo, outName) {
   return { ...base, type: 'module', main: `${outName}.js`, module: `${outName}.js`, sideEffects: [`./${outName}.js`, './snippets/*'] };
 }
 
+/** The package.json subpath of `target` in `build`: the build's prefix, then the target's own. */
+function exportPath(build, target) {
+  return target.export === '.' ? build.export : `${build.export}${target.export.slice(1)}`;
+}
+
 /** Top-level package.json: export conditions pick the target ("node" before "default"). */
 function packageManifest(cargo, config, built) {
   const exports = {};
   const order = (c) => (c === 'default' ? 1 : 0);
-  const entries = built
-    .map((name) => ({ name, t: config.targets[name] }))
-    .sort((a, b) => order(a.t.condition) - order(b.t.condition));
-  for (const { t } of entries) {
-    const slot = (exports[t.export] ??= {});
-    slot[t.condition] = { types: `./${t.out_dir}/${config.outName}.d.ts`, default: `./${t.out_dir}/${config.outName}.js` };
+  const entries = built.sort((a, b) => order(a.target.condition) - order(b.target.condition));
+  for (const { build, target, dir } of entries) {
+    const slot = (exports[exportPath(build, target)] ??= {});
+    slot[target.condition] = { types: `./${dir}/${config.outName}.d.ts`, default: `./${dir}/${config.outName}.js` };
   }
   for (const h of HELPERS) exports[h.export] = { types: `./${h.types}`, default: `./${h.file}` };
   exports['./package.json'] = './package.json';
@@ -132,11 +152,19 @@ function packageManifest(cargo, config, built) {
     version: cargo.version,
     description: cargo.description,
     license: cargo.license,
-    files: [...built.map((name) => `${config.targets[name].out_dir}/`), ...HELPERS.flatMap((h) => [h.file, h.types])],
+    files: [...new Set(built.map(({ dir }) => `${dir}/`)), ...HELPERS.flatMap((h) => [h.file, h.types, ...(h.extra ?? [])])],
     exports,
     peerDependencies: Object.fromEntries(HELPERS.map((h) => h.peer)),
     peerDependenciesMeta: Object.fromEntries(HELPERS.map((h) => [h.peer[0], { optional: true }])),
   };
+}
+
+/** The 20 largest items of `wasm` by twiggy, or a line saying why there are none. */
+function twiggyTop(wasm) {
+  const r = spawnSync('twiggy', ['top', '-n', '20', wasm], { cwd: root, encoding: 'utf8' });
+  if (r.error) return `(twiggy not found: scripts/setup.sh installs it)`;
+  if (r.status !== 0) return `(twiggy failed: ${r.stderr.trim()})`;
+  return r.stdout.trimEnd();
 }
 
 function main() {
@@ -144,43 +172,70 @@ function main() {
   const config = readConfig();
   const names = args.picked.length ? args.picked : Object.keys(config.targets);
   for (const n of names) if (!config.targets[n]) fail(`no [targets.${n}] in wasm-pack.toml`);
+  const buildNames = args.builds.length ? args.builds : Object.keys(config.builds);
+  for (const n of buildNames) if (!config.builds[n]) fail(`no [builds.${n}] in wasm-pack.toml`);
   const optimize = args.opt && config.opt.enabled !== false;
   const wasmOpt = checkTools(optimize);
 
   const cargo = parseToml(readFileSync(join(root, 'Cargo.toml'), 'utf8')).package;
   const env = { ...process.env };
-  if (config.optLevel !== undefined) {
-    env[`CARGO_PROFILE_${config.profile.toUpperCase().replace(/-/g, '_')}_OPT_LEVEL`] = String(config.optLevel);
-  }
+  const optLevelVar = `CARGO_PROFILE_${config.profile.toUpperCase().replace(/-/g, '_')}_OPT_LEVEL`;
   if (config.stackSize !== undefined) {
     if (!Number.isInteger(config.stackSize) || config.stackSize % 65536 !== 0) fail('wasm-pack.toml stack_size: a whole number of 64 KiB pages');
     env.CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUSTFLAGS = `-C link-arg=-zstack-size=${config.stackSize}`;
   }
-  run('cargo', ['build', '--lib', '--target', 'wasm32-unknown-unknown', '--profile', config.profile], { env });
   const meta = JSON.parse(capture('cargo', ['metadata', '--format-version', '1', '--no-deps']));
   const input = join(meta.target_directory, 'wasm32-unknown-unknown', config.profile, `${cargo.name.replace(/-/g, '_')}.wasm`);
-  if (!existsSync(input)) fail(`cargo did not write ${input}`);
 
   mkdirSync(config.packageDir, { recursive: true });
   const sizes = [];
-  for (const name of names) {
-    const t = config.targets[name];
-    const out = join(config.packageDir, t.out_dir);
-    rmSync(out, { recursive: true, force: true });
-    run('wasm-bindgen', ['--target', name, '--out-dir', out, '--out-name', config.outName, input]);
-    const wasm = join(out, `${config.outName}_bg.wasm`);
-    if (optimize) run(wasmOpt, [...(config.opt.args ?? ['-Oz']), wasm, '-o', wasm]);
-    writeFileSync(join(out, 'package.json'), `${JSON.stringify(targetManifest(name, cargo, config.outName), null, 2)}\n`);
-    sizes.push({ name, path: relative(root, wasm), raw: statSync(wasm).size, gzip: gzipSize(wasm) });
+  const built = [];
+  const tops = [];
+  for (const buildName of buildNames) {
+    const build = config.builds[buildName];
+    const features = build.features.join(',');
+    // A build's own opt_level, else [build]'s, else the profile's.
+    const optLevel = build.opt_level ?? config.optLevel;
+    if (optLevel !== undefined) env[optLevelVar] = String(optLevel);
+    run('cargo', ['build', '--lib', '--target', 'wasm32-unknown-unknown', '--profile', config.profile, '--no-default-features', '--features', features], { env });
+    if (!existsSync(input)) fail(`cargo did not write ${input}`);
+    for (const name of names) {
+      const t = config.targets[name];
+      const dir = build.dir ? `${build.dir}/${t.out_dir}` : t.out_dir;
+      const out = join(config.packageDir, dir);
+      rmSync(out, { recursive: true, force: true });
+      run('wasm-bindgen', ['--target', name, '--out-dir', out, '--out-name', config.outName, input]);
+      const wasm = join(out, `${config.outName}_bg.wasm`);
+      const optArgs = config.opt.args ?? ['-Oz'];
+      if (optimize && tops.every((x) => x.build !== buildName)) {
+        // The names survive into a copy for twiggy; the shipped module drops them.
+        const named = join(config.packageDir, `${buildName}.names.wasm`);
+        run(wasmOpt, [...optArgs, '--debuginfo', wasm, '-o', named]);
+        tops.push({ build: buildName, top: twiggyTop(named) });
+        rmSync(named, { force: true });
+      }
+      if (optimize) run(wasmOpt, [...optArgs, wasm, '-o', wasm]);
+      writeFileSync(join(out, 'package.json'), `${JSON.stringify(targetManifest(name, cargo, config.outName), null, 2)}\n`);
+      const bytes = readFileSync(wasm);
+      const brotli = brotliCompressSync(bytes, { params: { [zlib.BROTLI_PARAM_QUALITY]: 11, [zlib.BROTLI_PARAM_SIZE_HINT]: bytes.length } }).length;
+      sizes.push({ build: buildName, name, path: relative(root, wasm), raw: bytes.length, gzip: gzipSize(wasm), brotli });
+      built.push({ build, target: t, dir });
+    }
   }
   for (const h of HELPERS) {
-    for (const file of [h.file, h.types]) copyFileSync(join(root, 'js', file), join(config.packageDir, file));
+    for (const file of [h.file, h.types, ...(h.extra ?? [])]) copyFileSync(join(root, 'js', file), join(config.packageDir, file));
   }
-  const manifest = packageManifest(cargo, config, names);
+  const manifest = packageManifest(cargo, config, built);
   writeFileSync(join(config.packageDir, 'package.json'), `${JSON.stringify(manifest, null, 2)}\n`);
 
-  console.log(`\npackage written to ${relative(root, config.packageDir)}/ (wasm-opt ${optimize ? 'on' : 'off'})`);
-  for (const s of sizes) console.log(`  ${s.name.padEnd(8)} ${s.path}: ${s.raw} bytes (${kb(s.raw)}), gzip ${s.gzip} bytes (${kb(s.gzip)})`);
+  const lines = [`# Sizes of the npm package's wasm modules (wasm-opt ${optimize ? 'on' : 'off'})`, ''];
+  lines.push('| build | target | file | bytes | gzip -9 | brotli |', '|---|---|---|---:|---:|---:|');
+  for (const s of sizes) lines.push(`| ${s.build} | ${s.name} | ${s.path} | ${s.raw} (${kb(s.raw)}) | ${s.gzip} (${kb(s.gzip)}) | ${s.brotli} (${kb(s.brotli)}) |`);
+  for (const { build, top } of tops) lines.push('', `## ${build}: the 20 largest items (twiggy top, after wasm-opt)`, '', '```', top, '```');
+  const report = `${lines.join('\n')}\n`;
+  writeFileSync(join(config.packageDir, 'SIZES.md'), report);
+  console.log(`\npackage written to ${relative(root, config.packageDir)}/\n`);
+  console.log(report);
 }
 
 main();

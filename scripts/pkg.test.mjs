@@ -1,6 +1,7 @@
 // Tests of the built npm package (pkg/, from `npm run build`) through the
-// real wasm-bindgen glue: every target loads and meshes, the package's export
-// map resolves, and a thrown Error carries exactly the command line's message.
+// real wasm-bindgen glue: every target of both builds loads and meshes, the
+// package's export map resolves, a thrown Error carries exactly the command
+// line's message, and the declarations are typed.
 //
 // Run: node --test scripts/pkg.test.mjs   (after `npm run build`)
 
@@ -64,7 +65,7 @@ function cliError(name, text) {
 }
 
 test('the Node build meshes the bundled freeform surface within its tolerance', () => {
-  const out = surfmesh.mesh(freeform, 'auto', { toleranceRel: 1e-3 });
+  const out = surfmesh.mesh(freeform, 'auto', { toleranceRel: 1e-3, flatten: true });
   assert.ok(out.positions instanceof Float32Array);
   assert.ok(out.normals instanceof Float32Array);
   assert.ok(out.indices instanceof Uint32Array);
@@ -81,7 +82,7 @@ test('the Node build meshes the bundled freeform surface within its tolerance', 
 test('a part of 1006 faces, two of them with 1000 holes each, meshes closed and within tolerance', (t) => {
   const bytes = new TextEncoder().encode(plateStep(25, 40));
   const before = surfmesh.memoryBytes();
-  const out = surfmesh.mesh(bytes, 'step', { toleranceRel: 1e-3 });
+  const out = surfmesh.mesh(bytes, 'step', { toleranceRel: 1e-3, flatten: true });
   const { report } = out;
   assert.equal(report.faces, 1006);
   assert.equal(out.faceRanges.length, 2 * 1006);
@@ -155,17 +156,18 @@ test('the bundler build loads as an ES module that imports its .wasm', () => {
   assert.equal(Number(r.stdout.trim()), surfmesh.mesh(freeform, 'json').report.triangles);
 });
 
-test('an assembly meshed in shares of its bodies merges into the whole mesh', async () => {
+test('an assembly meshed in shares of its parts merges into the whole mesh', async () => {
   const { mergeShares } = await import(join(root, 'www', 'js', 'pool.js'));
   const bytes = readFileSync(join(root, 'tests', 'data', 'step_assembly.stp'));
-  const options = { toleranceRel: 1e-3 };
+  const options = { toleranceRel: 1e-3, flatten: true };
   const whole = surfmesh.mesh(bytes, 'step', options);
   assert.equal(whole.report.bodies, 2);
   const none = { wire: new Uint32Array(), borders: new Float32Array(), open: new Float32Array() };
   const shares = [0, 1].map((i) => ({ result: surfmesh.mesh(bytes, 'step', { ...options, share: [i, 2] }), lines: none }));
-  for (const { result } of shares) {
-    assert.ok(result.report.triangles > 0 && result.report.triangles < whole.report.triangles, 'each share holds one block');
-  }
+  // The two blocks are one part placed twice: it is meshed in one share, which
+  // places both copies; the other share has no part of its own.
+  const counts = shares.map(({ result }) => result.report.triangles).sort((a, b) => a - b);
+  assert.deepEqual(counts, [0, whole.report.triangles]);
   const { result } = mergeShares(shares);
   // Bodies share no border: each face meshes as in the whole model, and the merge keeps face order.
   assert.deepEqual(result.faceRanges, whole.faceRanges);
@@ -179,4 +181,57 @@ test('an assembly meshed in shares of its bodies merges into the whole mesh', as
   assert.ok(Math.abs(result.report.mean_deviation - whole.report.mean_deviation) <= 1e-9 * whole.report.tolerance);
   assert.throws(() => surfmesh.mesh(bytes, 'step', { share: [2, 2] }), /option share: expected \[index, count\]/);
   assert.throws(() => surfmesh.mesh(bytes, 'step', { share: [0, 2], mode: 'quality' }), /option share: meshes fast mode only/);
+});
+
+test('the viewer build meshes; repair, fit and quality mode are the full build\'s, at surfmesh/full', () => {
+  assert.equal(surfmesh.repair, undefined);
+  assert.equal(surfmesh.fit, undefined);
+  assert.throws(() => surfmesh.mesh(freeform, 'json', { mode: 'quality' }), /quality/);
+  const full = require(join(pkg, 'full', 'node'));
+  const q = full.mesh(freeform, 'json', { mode: 'quality', flatten: true });
+  assert.ok(q.report.quality.good_angle_fraction > 0.9);
+  const stl = `solid t
+facet normal 0 0 1
+outer loop
+vertex 0 0 0
+vertex 1 0 0
+vertex 0 1 0
+endloop
+endfacet
+endsolid t
+`;
+  assert.throws(() => full.repair(new TextEncoder().encode(stl), 'stl', { bucketing: 'grid' }), /^Error: option bucketing: expected "kd" or "bvh"$/);
+  // The same mesh from both builds.
+  assert.equal(full.mesh(freeform, 'json').report.triangles, surfmesh.mesh(freeform, 'json').report.triangles);
+  const manifest = JSON.parse(readFileSync(join(pkg, 'package.json'), 'utf8'));
+  for (const sub of ['.', './web', './full', './full/web', './three']) assert.ok(manifest.exports[sub], `exports ${sub}`);
+});
+
+test('the default result: each distinct part once, its copies as instances, the tree, edges beside the meshes', () => {
+  const bytes = readFileSync(join(root, 'tests', 'data', 'step_assembly.stp'));
+  const out = surfmesh.mesh(bytes, 'step', { toleranceRel: 1e-3 });
+  assert.equal(out.meshes.length, 1);
+  assert.deepEqual(out.instances.map((i) => i.part), [0, 0]);
+  assert.equal(out.tree.name, 'Assembly');
+  assert.deepEqual(out.tree.children.map((c) => c.occurrence), ['Block instance 1', 'Block instance 2']);
+  const [part] = out.meshes;
+  assert.ok(part.edges instanceof Float32Array && part.edgeRanges instanceof Uint32Array);
+  // Every edge point is a vertex of the part's mesh.
+  const vertices = new Set();
+  for (let v = 0; v < part.positions.length; v += 3) vertices.add(`${part.positions[v]},${part.positions[v + 1]},${part.positions[v + 2]}`);
+  for (let p = 0; p < part.edges.length; p += 3) assert.ok(vertices.has(`${part.edges[p]},${part.edges[p + 1]},${part.edges[p + 2]}`));
+  // The report counts both copies, as the flattened mesh does.
+  assert.equal(out.report.triangles, 2 * part.indices.length / 3);
+});
+
+test('the declarations are typed: options and results are interfaces, not any', () => {
+  for (const dir of ['web', 'node', 'bundler', join('full', 'web')]) {
+    const dts = readFileSync(join(pkg, dir, 'surfmesh.d.ts'), 'utf8');
+    for (const name of ['MeshOptions', 'Report', 'MeshOutput', 'FlatMeshOutput', 'AssemblyNode', 'PartInstance']) {
+      assert.match(dts, new RegExp(`export interface ${name} `), `${dir}: interface ${name}`);
+    }
+    assert.match(dts, /export function mesh\(bytes: Uint8Array, format: string, options\?: MeshOptions\): MeshOutput;/);
+    assert.doesNotMatch(dts, /export function (mesh|meshWithProgress|repair|fit)\([^)]*\bany\b/, `${dir}: an export takes any`);
+    assert.equal(/export function repair\(/.test(dts), dir.startsWith('full'), `${dir}: repair only in the full build`);
+  }
 });

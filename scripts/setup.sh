@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what the build and the tests need, each step skipped when already
 # there, so it is cheap to run again: rustup targets and components, the
-# wasm-bindgen CLI at the exact version Cargo.lock pins, the npm dev
+# wasm-bindgen CLI at the exact version Cargo.lock pins, twiggy (the build's
+# size report) at a pinned version, the npm dev
 # dependencies (binaryen's wasm-opt, verb-nurbs, playwright-core) and Debian's
 # chromium + chromium-driver for the browser tests. Only crates.io, npm,
 # Debian and rustup are contacted.
@@ -37,6 +38,14 @@ if [[ "$(wasm-bindgen --version 2>/dev/null || true)" != "wasm-bindgen $bindgen_
   say "cargo install wasm-bindgen-cli $bindgen_version (a few minutes)"
   cargo install wasm-bindgen-cli --version "$bindgen_version" --locked \
     || cargo install wasm-bindgen-cli --version "$bindgen_version" --force
+fi
+
+# twiggy: the 20 largest items of each build in the build script's size report.
+twiggy_version=0.8.0
+if [[ "$(twiggy --version 2>/dev/null || true)" != "twiggy-opt $twiggy_version" ]]; then
+  say "cargo install twiggy $twiggy_version (a few minutes)"
+  cargo install twiggy --version "$twiggy_version" --locked \
+    || cargo install twiggy --version "$twiggy_version" --force
 fi
 
 # npm dev dependencies: reinstall only when package-lock.json changed since the last install.

@@ -14,8 +14,11 @@ extern crate alloc;
 extern crate std;
 
 mod collections;
+mod edges;
 mod error;
+#[cfg(feature = "fit")]
 mod fit;
+mod instances;
 mod io;
 mod math;
 mod measure;
@@ -23,6 +26,7 @@ mod mesh;
 mod model;
 mod nurbs;
 mod quality;
+#[cfg(feature = "repair")]
 mod repair;
 mod reparam;
 mod tessellate;
@@ -32,27 +36,37 @@ mod units;
 #[cfg(all(target_arch = "wasm32", target_os = "unknown"))]
 mod wasm;
 
+pub use edges::{edge_lines, EdgeLines};
 pub use error::Error;
+#[cfg(feature = "fit")]
 pub use fit::{
     fit_points, read_points, Cubic, FitOptions, FitPolygon, FitReport, FitResult, FitSurface, PatchPoint, PointFormat,
     TriPatch, MAX_FILE_POINTS,
 };
+pub use instances::{flatten, mesh_instanced, InstancedResult, PartMesh};
 pub use io::{
-    read_iges, read_json, read_mesh, read_model, read_msh, read_step, read_step_parts, read_step_with_shells,
-    write_glb, write_glb_scaled, write_iges, write_msh, write_obj, write_stl, write_unv, Format, MeshFormat, StepModel,
-    StepShell, UNV_SHELL_TRIANGLE,
+    read_iges, read_json, read_model, read_step, read_step_parts, read_step_with_shells, Format, StepModel, StepShell,
+};
+#[cfg(feature = "repair")]
+pub use io::{read_mesh, MeshFormat};
+#[cfg(feature = "writers")]
+pub use io::{
+    read_msh, write_glb, write_glb_scaled, write_iges, write_msh, write_obj, write_stl, write_unv, UNV_SHELL_TRIANGLE,
 };
 pub use measure::{measure_mesh, MeasureOptions, MeshMeasure};
 pub use mesh::{
     angle_stats, edge_counts, edge_counts_around_skipped, edge_counts_in_bodies, weld_mesh, weld_positions, AngleStats,
     EdgeCounts, FaceRange, Mesh, Report,
 };
-pub use model::{Face, FaceSurface, Model, SkippedFace, TessellatedFace, TrimLoop};
+pub use model::{
+    Assembly, AssemblyNode, Face, FaceSurface, Model, PartInstance, SkippedFace, TessellatedFace, TrimLoop,
+};
 pub use nurbs::{
     project_to_surface, Aabb, BasisDers, CurveDerivs, KnotVector, NurbsCurve, NurbsError, NurbsSurface, Projection,
     ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
 };
 pub use quality::{ElementSize, QualityMethod, QualityOptions, QualityReport, EDGE_BAND, GOOD_ANGLE_DEG};
+#[cfg(feature = "repair")]
 pub use repair::{
     find_self_intersections, mesh_edge_census, mesh_volume, offset_mesh, repair_mesh, repair_mesh_timed, Bucketing,
     EdgeCensus, RepairOptions, RepairReport, RepairResult, StageTimes,

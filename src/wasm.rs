@@ -1,5 +1,10 @@
 //! The JavaScript door (wasm-bindgen): JS values in, core types through
-//! [`crate::mesh_model`], typed arrays out. No algorithm lives here.
+//! [`crate::mesh_instanced`], typed arrays out. No algorithm lives here.
+//!
+//! Options arrive as `#[derive(Deserialize)]` structs through
+//! serde-wasm-bindgen (every key must be known, every value of its type);
+//! reports leave as JS objects serialized straight from the core's structs,
+//! the typed arrays beside them passed through as they are.
 //!
 //! Errors are thrown as JS `Error` objects whose message is the
 //! [`crate::Error`] `Display` text, the same line the command line prints.
@@ -12,13 +17,17 @@ use alloc::format;
 use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 
-use js_sys::{Array, Float32Array, Function, Object, Reflect, Uint32Array, JSON};
+use js_sys::{Array, Float32Array, Function, Uint32Array};
+use serde::de::{self, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
+use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;
 
-use crate::{fit_points, read_points, FitOptions, FitResult, PointFormat};
-use crate::{mesh_model_in_units, Units};
-use crate::{offset_mesh, read_mesh, repair_mesh_timed, Bucketing, MeshFormat, RepairOptions};
-use crate::{read_model, read_step_parts, Error, Format, MeshMode, MeshOptions, MeshResult, QualityMethod};
+use crate::{edge_lines, flatten, mesh_instanced, mm_per_unit, read_model, read_step_parts, Assembly, EdgeLines};
+#[cfg(feature = "fit")]
+use crate::{fit_points, read_points, FitOptions, FitReport, FitResult, PointFormat};
+#[cfg(feature = "repair")]
+use crate::{offset_mesh, read_mesh, repair_mesh_timed, Bucketing, MeshFormat, RepairOptions, RepairReport};
+use crate::{Error, Format, InstancedResult, Mesh, MeshMode, MeshOptions, QualityMethod, Report, Units};
 // `tests/wasm_node.rs` compiles this file into a crate where `crate::` is the
 // test itself, which does not import this name; take it from the library there.
 #[cfg(not(test))]
@@ -28,7 +37,7 @@ use surfmesh::Reparam;
 
 #[cfg_attr(not(test), wasm_bindgen(typescript_custom_section))]
 #[cfg_attr(test, allow(dead_code))]
-const TS_TYPES: &str = r#"
+const TS_MESH: &str = r#"
 /** Options of `mesh`; every field is optional. Lengths are in model units, angles in radians. */
 export interface MeshOptions {
   /** Absolute chordal tolerance (exclusive with toleranceRel). */
@@ -45,7 +54,10 @@ export interface MeshOptions {
   maxTriangles?: number;
   /** Rebuild poorly parameterized faces first: "auto" (default: flagged faces, a rebuild kept where it wins), "off", "force". */
   reparam?: "auto" | "off" | "force";
-  /** "fast" (default): fewest triangles within the tolerance; "quality": near-equilateral triangles of size H (paper 003). */
+  /**
+   * "fast" (default): fewest triangles within the tolerance; "quality": near-equilateral triangles of
+   * size H (paper 003; in the full build, surfmesh/full, only).
+   */
   mode?: "fast" | "quality";
   /** Quality mode: element size H in model units (exclusive with sizeRel). */
   size?: number;
@@ -54,9 +66,10 @@ export interface MeshOptions {
   /** Quality mode: "looping" (default, paper 003), "delaunay" (spade's refinement) or "best" (both, better per face). */
   method?: "looping" | "delaunay" | "best";
   /**
-   * Fast mode: [index, count] meshes only share `index` of `count` of the model's bodies, so
-   * that `count` workers can mesh one model side by side; the other faces come back empty
-   * (count 0 in faceRanges). Bodies share no border, so the shares together are the whole mesh.
+   * Fast mode: [index, count] meshes only share `index` of `count` of the work, so that `count`
+   * workers can mesh one model side by side: the distinct parts of an assembly when it has at
+   * least `count` of them, else the bodies of each part. What a share does not mesh comes back
+   * empty (count 0 in faceRanges); the shares together are the whole mesh.
    */
   share?: [number, number];
   /**
@@ -65,10 +78,163 @@ export interface MeshOptions {
    * absolute options (tolerance, maxEdge, minEdge, size) are taken in it too.
    */
   units?: "file" | "mm" | "cm" | "m" | "in" | "ft";
+  /**
+   * false (default): each distinct part is meshed once and returned in `meshes`, placed by
+   * `instances`; true: one merged mesh of every face in the file's order (FlatMeshOutput).
+   */
+  flatten?: boolean;
+  /** Also print every warning of the report with console.warn (default false). */
+  consoleWarnings?: boolean;
 }
 
-/** What `mesh` returns. */
+/** One face the re-parameterization test flagged (paper 001). */
+export interface ReparamFace {
+  /** The model's face. */
+  face: number;
+  /** Its step ratio: how unevenly its parameters cover it. */
+  ratio: number;
+  /** Whether it was rebuilt (else meshed as it is, a warning says why). */
+  rebuilt: boolean;
+  /** Samples of the rebuild along u and v. */
+  samples: [number, number];
+  /** Largest distance from the rebuild to the original surface. */
+  fit_error: number;
+}
+
+/** Quality mode's own measures (paper 003). */
+export interface QualityReport {
+  /** Element size H used, model units. */
+  size: number;
+  /** Faces filled by the looping method. */
+  faces_looping: number;
+  /** Faces filled by Delaunay refinement. */
+  faces_delaunay: number;
+  /** Fraction of triangles whose smallest angle is at least 25 degrees. */
+  good_angle_fraction: number;
+  /** Fraction of edges between 0.7 H and 1.4 H long. */
+  edge_band_fraction: number;
+  /** Shortest edge over H. */
+  edge_ratio_min: number;
+  /** Mean edge length over H. */
+  edge_ratio_mean: number;
+  /** Longest edge over H. */
+  edge_ratio_max: number;
+}
+
+/** What a mesh run measured (the command line's JSON report). Lengths are in `units`. */
+export interface Report {
+  /** Length unit of the mesh and of every length here ("mm", "in", ...). */
+  units: string;
+  /** Absolute chordal tolerance used. */
+  tolerance: number;
+  /** Angle limit used, radians. */
+  angle: number;
+  /** Faces in the model. */
+  faces: number;
+  /** Faces of the file the reader could not build (each with a warning), not in `faces`. */
+  faces_unread: number;
+  /** Faces that produced no triangles (each with a warning). */
+  faces_skipped: number;
+  /** Faces the file gives as triangles only (STEP tessellated faces); the deviations do not cover them. */
+  faces_tessellated: number;
+  /** Sets of faces that share no border (solids, sheets, assembly parts). */
+  bodies: number;
+  /** Triangles of the whole model (every instance counted). */
+  triangles: number;
+  /** Vertices of the whole model (every instance counted, per-face copies counted). */
+  vertices: number;
+  /** Largest measured distance from the mesh to the exact surfaces. */
+  max_deviation: number;
+  /** Mean of the measured distances. */
+  mean_deviation: number;
+  /** Smallest triangle angle, degrees. */
+  min_angle_deg: number;
+  /** 1st-percentile triangle angle, degrees. */
+  p1_angle_deg: number;
+  /** Cracks: one-triangle edges after welding that are not on the model's open boundary. */
+  free_edges: number;
+  /** All one-triangle edges after welding. */
+  boundary_edges: number;
+  /** Edges with more than two triangles. */
+  nonmanifold_edges: number;
+  /** Triangles whose facet normal opposes the surface normal. */
+  inverted_triangles: number;
+  /** Largest normal turn across one triangle, radians. */
+  max_normal_turn: number;
+  /** Meshing time, milliseconds (the host's clock). */
+  time_ms: number;
+  /** Parse time, milliseconds. */
+  parse_ms: number;
+  /** Skipped entities, repaired surfaces, incomplete refinement, ... */
+  warnings: string[];
+  /** Faces the re-parameterization test flagged, rebuilt or not. */
+  reparameterized: ReparamFace[];
+  /** Quality mode only. */
+  quality?: QualityReport;
+}
+
+/** The mesh of one distinct part (the whole model when it has no assembly structure). */
+export interface PartMesh {
+  /** The part's product name ("" when the file gives none). */
+  name: string;
+  /** x, y, z per vertex, in the coordinates of the part's node (apply an instance's matrix). */
+  positions: Float32Array;
+  /** Unit surface normal per vertex. */
+  normals: Float32Array;
+  /** Three vertex indices per triangle, counter-clockwise seen from the normal side. */
+  indices: Uint32Array;
+  /** Pairs (first triangle, triangle count), one pair per face of the part. */
+  faceRanges: Uint32Array;
+  /** For each face of the part, the model's face it is (in the part's first instance). */
+  faces: Uint32Array;
+  /** Red, green, blue (0 to 1) per face as the file colours it (STEP styles); NaN where it does not. */
+  faceColors: Float32Array;
+  /** The B-rep edges as polylines: x, y, z per point, every point a vertex of the mesh. */
+  edges: Float32Array;
+  /** Pairs (first point, point count), one pair per polyline of `edges`. */
+  edgeRanges: Uint32Array;
+}
+
+/** One placed copy of a part mesh. */
+export interface PartInstance {
+  /** Index into `meshes`. */
+  part: number;
+  /** 4 x 4 matrix, column-major (three.js Matrix4.fromArray order), from the mesh's coordinates to the model's. */
+  matrix: number[];
+  /** This instance's node index in a walk of `tree` (depth first, parents before children). */
+  node: number;
+}
+
+/** A node of the assembly tree (the STEP product structure; one root node for other files). */
+export interface AssemblyNode {
+  /** The product's name ("" when the file gives none). */
+  name: string;
+  /** The occurrence's own name where the file gives one (e.g. "nut_1"). */
+  occurrence?: string;
+  /** 4 x 4 matrix, column-major, from this node's coordinates to its parent's. */
+  matrix: number[];
+  /** Sub-assemblies and parts placed here. */
+  children: AssemblyNode[];
+  /** The part instances at this node: indices into `instances` (with flatten, the values of `faceParts`). */
+  instances: number[];
+}
+
+/** What `mesh` returns: each distinct part meshed once, and where its copies go. */
 export interface MeshOutput {
+  /** One mesh per distinct part. */
+  meshes: PartMesh[];
+  /** One per part instance: draw meshes[part] under matrix (three.js InstancedMesh). */
+  instances: PartInstance[];
+  /** The assembly tree: names, placements, children. */
+  tree: AssemblyNode;
+  /** Length unit of the positions and of the report's lengths (also `report.units`). */
+  units: string;
+  /** The measured report, counting every instance. */
+  report: Report;
+}
+
+/** What `mesh` returns with `flatten: true`: every face of the model in one mesh, in the file's order. */
+export interface FlatMeshOutput {
   /** x, y, z per vertex. */
   positions: Float32Array;
   /** Unit surface normal per vertex. */
@@ -77,25 +243,55 @@ export interface MeshOutput {
   indices: Uint32Array;
   /** Pairs (first triangle, triangle count), one pair per model face. */
   faceRanges: Uint32Array;
-  /** The part of each face (the pair of the same index in `faceRanges`): an index into `parts`. */
+  /** The part instance of each face: an index into `parts`. */
   faceParts: Uint32Array;
   /** Red, green, blue (0 to 1) per face as the file colours it (STEP styles); NaN where it does not. */
   faceColors: Float32Array;
   /** Part names: one per part instance of a STEP assembly ("" when unnamed); one "" for other formats. */
   parts: string[];
-  /** Length unit of `positions` and of the report's lengths ("mm", "in", "m", ...; also `report.units`). */
+  /** The B-rep edges as polylines: x, y, z per point, every point a vertex of the mesh. */
+  edges: Float32Array;
+  /** Pairs (first point, point count), one pair per polyline of `edges`. */
+  edgeRanges: Uint32Array;
+  /** The assembly tree; its nodes' `instances` are part indices (the values of `faceParts`). */
+  tree: AssemblyNode;
+  /** Length unit of `positions` and of the report's lengths. */
   units: string;
-  /** The measured report (tolerance, triangles, max_deviation, warnings, ...); `faces_tessellated`
-   * counts the faces given as triangles (STEP tessellated faces), which max_deviation does not cover. */
-  report: Record<string, any>;
+  /** The measured report. */
+  report: Report;
 }
 
 /**
  * Reads `bytes` in `format` ("json", "iges" or "igs", "step" or "stp", or "" / "auto" to detect it) and meshes the model.
  * Throws an `Error` whose message names the problem (the CLI's one-line error).
  */
+export function mesh(bytes: Uint8Array, format: string, options: MeshOptions & { flatten: true }): FlatMeshOutput;
 export function mesh(bytes: Uint8Array, format: string, options?: MeshOptions): MeshOutput;
 
+/**
+ * As `mesh`, calling `progress(facesDone, facesTotal)` after each face is meshed (the faces of the
+ * distinct parts, each once; sewing and measuring follow the last call). Returning `false` stops
+ * meshing, which then throws an Error whose message is "cancelled"; an exception thrown by
+ * `progress` stops it and is rethrown.
+ */
+export function meshWithProgress(
+  bytes: Uint8Array,
+  format: string,
+  options: MeshOptions & { flatten: true },
+  progress: (facesDone: number, facesTotal: number) => boolean | void,
+): FlatMeshOutput;
+export function meshWithProgress(
+  bytes: Uint8Array,
+  format: string,
+  options: MeshOptions | undefined,
+  progress: (facesDone: number, facesTotal: number) => boolean | void,
+): MeshOutput;
+"#;
+
+#[cfg(feature = "repair")]
+#[cfg_attr(not(test), wasm_bindgen(typescript_custom_section))]
+#[cfg_attr(test, allow(dead_code))]
+const TS_REPAIR: &str = r#"
 /** Options of `repair`; every field is optional. Lengths are fractions of the mesh's bounding-box diagonal. */
 export interface RepairOptions {
   /** Candidate-pair search: "kd" (default, the paper's k-d tree) or "bvh". */
@@ -110,14 +306,65 @@ export interface RepairOptions {
   verify?: boolean;
 }
 
+/** Free, non-manifold and misoriented edges of a mesh. */
+export interface EdgeCensus {
+  free_edges: number;
+  nonmanifold_edges: number;
+  misoriented_edges: number;
+}
+
+/** Milliseconds per stage of a repair. */
+export interface StageTimes {
+  prepare: number;
+  degenerate: number;
+  intersect: number;
+  regions: number;
+  verify: number;
+  total: number;
+}
+
+/** What `repair` did and measured (the command line's report). */
+export interface RepairReport {
+  triangles_in: number;
+  vertices_in: number;
+  vertices_welded: number;
+  triangles_dropped: number;
+  triangles_reoriented: number;
+  components: number;
+  free_edges_in: number;
+  degenerate_collapsed: number;
+  degenerate_swapped: number;
+  degenerate_left: number;
+  perturbation: number;
+  bucketing: "kd-tree" | "bvh" | null;
+  kd_leaves: number;
+  candidate_pairs: number;
+  segments: number;
+  degenerate_contacts: number;
+  regions: number;
+  triangles_subdivided: number;
+  subdivision_fallbacks: number;
+  stitch_misses: number;
+  triangles_out: number;
+  vertices_out: number;
+  census_out: EdgeCensus;
+  volume_in: number;
+  volume_out: number;
+  /** With `verify`: self-intersecting triangle pairs left (0); else null. */
+  self_intersections_out: number | null;
+  time_ms: StageTimes;
+  warnings: string[];
+  /** Reading the input, milliseconds. */
+  parse_ms: number;
+}
+
 /** What `repair` returns. */
 export interface RepairOutput {
   /** x, y, z per vertex. */
   positions: Float32Array;
   /** Three vertex indices per triangle, counter-clockwise seen from outside. */
   indices: Uint32Array;
-  /** The report (triangles_in, triangles_out, segments, regions, census_out, time_ms, warnings, ...). */
-  report: Record<string, any>;
+  report: RepairReport;
 }
 
 /**
@@ -132,7 +379,12 @@ export function repair(bytes: Uint8Array, format: string, options?: RepairOption
  * inward): the kind of input `repair` is for. Returns `{ positions, indices }`.
  */
 export function offset(bytes: Uint8Array, format: string, distance: number): { positions: Float32Array; indices: Uint32Array };
+"#;
 
+#[cfg(feature = "fit")]
+#[cfg_attr(not(test), wasm_bindgen(typescript_custom_section))]
+#[cfg_attr(test, allow(dead_code))]
+const TS_FIT: &str = r#"
 /** Options of `fit`; every field is optional. */
 export interface FitOptions {
   /** Absolute chordal tolerance of the mesh (exclusive with toleranceRel). */
@@ -141,6 +393,31 @@ export interface FitOptions {
   toleranceRel?: number;
   /** Largest polygon of the net, 3 to 32 (default 8; 3 keeps the triangles). */
   maxSides?: number;
+}
+
+/** What `fit` measured (the command line's report). */
+export interface FitReport {
+  points_in: number;
+  points: number;
+  duplicates_merged: number;
+  net_triangles: number;
+  holes_filled: number;
+  holes_open: number;
+  borders: number;
+  swaps: number;
+  polygons: number;
+  /** Polygons per number of sides. */
+  polygon_sides: number[];
+  sub_patches: number;
+  sub_patches_triangular: number;
+  max_g1_angle: number;
+  tolerance: number;
+  triangles: number;
+  vertices: number;
+  boundary_edges: number;
+  nonmanifold_edges: number;
+  time_ms: number;
+  warnings: string[];
 }
 
 /** What `fit` returns: the mesh of the fitted surface, its net and its patches. */
@@ -159,8 +436,7 @@ export interface FitOutput {
   netEdges: Uint32Array;
   /** The polygon net and its quartic sub-patches as JSON text (the CLI's --patches file). */
   patches: string;
-  /** The report (points, polygons, sub_patches, sub_patches_triangular, max_g1_angle, warnings, ...). */
-  report: Record<string, any>;
+  report: FitReport;
 }
 
 /**
@@ -169,22 +445,239 @@ export interface FitOutput {
  * Throws an `Error` whose message names the problem (the CLI's one-line error).
  */
 export function fit(bytes: Uint8Array, format: string, options?: FitOptions): FitOutput;
-
-/**
- * As `mesh`, calling `progress(facesDone, facesTotal)` after each face is meshed (sewing and
- * measuring follow the last call). Returning `false` stops meshing, which then throws an Error
- * whose message is "cancelled"; an exception thrown by `progress` stops it and is rethrown.
- */
-export function meshWithProgress(
-  bytes: Uint8Array,
-  format: string,
-  options: MeshOptions | undefined,
-  progress: (facesDone: number, facesTotal: number) => boolean | void,
-): MeshOutput;
 "#;
 
-/// Option names `mesh` accepts, in the order they are read.
-const OPTION_NAMES: [&str; 13] = [
+// ---------------------------------------------------------------------------
+// Option values: each type's Deserialize says what it expected and what it
+// found, in the words of the one-line errors; `options()` puts the option's
+// name in front.
+
+/// A finite number.
+#[derive(Debug, Clone, Copy)]
+struct Number(f64);
+
+/// A string.
+#[derive(Debug, Clone)]
+struct Text(String);
+
+/// A boolean.
+#[derive(Debug, Clone, Copy)]
+struct Flag(bool);
+
+/// Any value, told apart only as much as the errors need: numbers, the rest by kind.
+#[derive(Debug, Clone, Copy)]
+enum Loose {
+    Number(f64),
+    Other,
+}
+
+/// `Err(found X)` for every kind of value but the ones a visitor accepts.
+macro_rules! wrong_kinds {
+    ($expected:expr) => {
+        fn visit_bool<E: de::Error>(self, _: bool) -> Result<Self::Value, E> {
+            Err(E::custom(format!("expected {}, found boolean", $expected)))
+        }
+        fn visit_str<E: de::Error>(self, _: &str) -> Result<Self::Value, E> {
+            Err(E::custom(format!("expected {}, found string", $expected)))
+        }
+        fn visit_unit<E: de::Error>(self) -> Result<Self::Value, E> {
+            Err(E::custom(format!("expected {}, found null", $expected)))
+        }
+        fn visit_seq<A: SeqAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
+            Err(de::Error::custom(format!("expected {}, found an array", $expected)))
+        }
+        fn visit_map<A: MapAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
+            Err(de::Error::custom(format!("expected {}, found object", $expected)))
+        }
+        fn visit_bytes<E: de::Error>(self, _: &[u8]) -> Result<Self::Value, E> {
+            Err(E::custom(format!("expected {}, found object", $expected)))
+        }
+    };
+}
+
+/// Numbers as f64, anything else an error.
+macro_rules! numbers {
+    ($map:expr) => {
+        fn visit_f64<E: de::Error>(self, x: f64) -> Result<Self::Value, E> {
+            $map(x)
+        }
+        fn visit_i64<E: de::Error>(self, x: i64) -> Result<Self::Value, E> {
+            $map(x as f64)
+        }
+        fn visit_u64<E: de::Error>(self, x: u64) -> Result<Self::Value, E> {
+            $map(x as f64)
+        }
+    };
+}
+
+impl<'de> Deserialize<'de> for Number {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Number;
+            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.write_str("a number")
+            }
+            numbers!(|x: f64| if x.is_finite() {
+                Ok(Number(x))
+            } else {
+                Err(E::custom(format!("expected a finite number, found {x}")))
+            });
+            wrong_kinds!("a number");
+        }
+        d.deserialize_any(V)
+    }
+}
+
+impl<'de> Deserialize<'de> for Text {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Text;
+            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.write_str("a string")
+            }
+            fn visit_str<E: de::Error>(self, s: &str) -> Result<Self::Value, E> {
+                Ok(Text(s.into()))
+            }
+            fn visit_string<E: de::Error>(self, s: String) -> Result<Self::Value, E> {
+                Ok(Text(s))
+            }
+            numbers!(|_: f64| Err(E::custom("expected a string, found number")));
+            fn visit_bool<E: de::Error>(self, _: bool) -> Result<Self::Value, E> {
+                Err(E::custom("expected a string, found boolean"))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
+                Err(de::Error::custom("expected a string, found an array"))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
+                Err(de::Error::custom("expected a string, found object"))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+impl<'de> Deserialize<'de> for Flag {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Flag;
+            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.write_str("a boolean")
+            }
+            fn visit_bool<E: de::Error>(self, b: bool) -> Result<Self::Value, E> {
+                Ok(Flag(b))
+            }
+            numbers!(|_: f64| Err(E::custom("expected a boolean, found number")));
+            fn visit_str<E: de::Error>(self, _: &str) -> Result<Self::Value, E> {
+                Err(E::custom("expected a boolean, found string"))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
+                Err(de::Error::custom("expected a boolean, found an array"))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
+                Err(de::Error::custom("expected a boolean, found object"))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// What `share` holds: an array of any values, checked once read.
+#[derive(Debug, Clone)]
+struct List(Vec<Loose>);
+
+/// The message of a `share` that is not `[index, count]`.
+const SHARE_EXPECTED: &str = "expected [index, count] with whole numbers, index < count";
+
+impl<'de> Deserialize<'de> for List {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = List;
+            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.write_str("an array")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut s: A) -> Result<Self::Value, A::Error> {
+                let mut items = Vec::new();
+                // Only the first few matter; the rest are counted, not kept.
+                while let Some(x) = s.next_element::<Loose>()? {
+                    if items.len() < 3 {
+                        items.push(x);
+                    }
+                }
+                Ok(List(items))
+            }
+            numbers!(|_: f64| Err(E::custom(SHARE_EXPECTED)));
+            fn visit_bool<E: de::Error>(self, _: bool) -> Result<Self::Value, E> {
+                Err(E::custom(SHARE_EXPECTED))
+            }
+            fn visit_str<E: de::Error>(self, _: &str) -> Result<Self::Value, E> {
+                Err(E::custom(SHARE_EXPECTED))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
+                Err(de::Error::custom(SHARE_EXPECTED))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+impl<'de> Deserialize<'de> for Loose {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Loose;
+            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.write_str("any value")
+            }
+            numbers!(|x: f64| Ok(Loose::Number(x)));
+            fn visit_bool<E: de::Error>(self, _: bool) -> Result<Self::Value, E> {
+                Ok(Loose::Other)
+            }
+            fn visit_str<E: de::Error>(self, _: &str) -> Result<Self::Value, E> {
+                Ok(Loose::Other)
+            }
+            fn visit_unit<E: de::Error>(self) -> Result<Self::Value, E> {
+                Ok(Loose::Other)
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut s: A) -> Result<Self::Value, A::Error> {
+                while s.next_element::<IgnoredAny>()?.is_some() {}
+                Ok(Loose::Other)
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut m: A) -> Result<Self::Value, A::Error> {
+                while m.next_entry::<IgnoredAny, IgnoredAny>()?.is_some() {}
+                Ok(Loose::Other)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// The options of `mesh` as JS gives them.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "camelCase")]
+struct JsMeshOptions {
+    tolerance: Option<Number>,
+    tolerance_rel: Option<Number>,
+    angle: Option<Number>,
+    max_edge: Option<Number>,
+    min_edge: Option<Number>,
+    max_triangles: Option<Number>,
+    reparam: Option<Text>,
+    mode: Option<Text>,
+    size: Option<Number>,
+    size_rel: Option<Number>,
+    method: Option<Text>,
+    share: Option<List>,
+    units: Option<Text>,
+    flatten: Option<Flag>,
+    console_warnings: Option<Flag>,
+}
+
+/// Option names `mesh` accepts: every key of an options object must be one.
+const OPTION_NAMES: &[&str] = &[
     "tolerance",
     "toleranceRel",
     "angle",
@@ -198,7 +691,126 @@ const OPTION_NAMES: [&str; 13] = [
     "method",
     "share",
     "units",
+    "flatten",
+    "consoleWarnings",
 ];
+
+/// Reads an options object into `T`: undefined and null are the defaults
+/// (as is an option that is undefined or null); anything but an object, a
+/// key not in `known` or a value of the wrong kind is a one-line error
+/// naming the option.
+fn options<T: for<'de> Deserialize<'de> + Default>(value: JsValue, example: &str, known: &[&str]) -> Result<T, String> {
+    if value.is_undefined() || value.is_null() {
+        return Ok(T::default());
+    }
+    if !value.is_object() || Array::is_array(&value) || value.is_function() {
+        let found =
+            if Array::is_array(&value) { "an array".into() } else { value.js_typeof().as_string().unwrap_or_default() };
+        return Err(format!("options: expected an object like {{ {example} }}, found {found}"));
+    }
+    // serde-wasm-bindgen reads a struct's own fields by name and never sees
+    // other keys, so `deny_unknown_fields` alone would let a typo pass.
+    for key in js_sys::Object::keys(value.unchecked_ref::<js_sys::Object>()).iter() {
+        let key = key.as_string().unwrap_or_default();
+        if !known.contains(&key.as_str()) {
+            return Err(format!("option {key}: unknown option (known: {})", known.join(", ")));
+        }
+    }
+    let d = serde_wasm_bindgen::Deserializer::from(value);
+    serde_path_to_error::deserialize(d).map_err(|e| {
+        // serde-wasm-bindgen's error is a JS Error, printed "Error: message".
+        let message = e.inner().to_string();
+        let message = message.strip_prefix("Error: ").unwrap_or(&message);
+        let path = e.path().to_string();
+        let name = path.split(['[', '.']).next().filter(|n| !n.is_empty() && *n != "?").unwrap_or("options");
+        format!("option {name}: {message}")
+    })
+}
+
+/// One of `allowed`, by index; the message lists them as `expected`.
+fn word(value: &Option<Text>, name: &str, allowed: &[&str], expected: &str) -> Result<Option<usize>, String> {
+    let Some(Text(text)) = value else { return Ok(None) };
+    match allowed.iter().position(|a| a == text) {
+        Some(i) => Ok(Some(i)),
+        None => Err(format!("option {name}: expected {expected}")),
+    }
+}
+
+/// Whether `x` is a whole number from 0 to `u32::MAX`.
+fn whole(x: f64) -> bool {
+    x.fract() == 0.0 && (0.0..=u32::MAX as f64).contains(&x)
+}
+
+/// What `mesh` does besides the meshing options.
+#[derive(Debug, Clone, Copy)]
+struct Output {
+    units: Units,
+    flatten: bool,
+    console_warnings: bool,
+}
+
+/// The meshing options, the unit of the result and the output's shape.
+fn mesh_options(value: JsValue) -> Result<(MeshOptions, Output), String> {
+    let js: JsMeshOptions = options(value, "toleranceRel: 0.001", OPTION_NAMES)?;
+    let mut o = MeshOptions::default();
+    match (js.tolerance, js.tolerance_rel) {
+        (Some(_), Some(_)) => return Err("option tolerance: give tolerance or toleranceRel, not both".into()),
+        (Some(Number(t)), None) => o = o.with_tolerance(t),
+        (None, Some(Number(r))) => o = o.with_relative_tolerance(r),
+        (None, None) => {}
+    }
+    if let Some(Number(a)) = js.angle {
+        o = o.with_angle(a);
+    }
+    if let Some(Number(m)) = js.max_edge {
+        o = o.with_max_edge(Some(m));
+    }
+    if let Some(Number(m)) = js.min_edge {
+        o = o.with_min_edge(Some(m));
+    }
+    if let Some(Number(n)) = js.max_triangles {
+        if !whole(n) {
+            return Err(format!("option maxTriangles: expected a whole number, found {n}"));
+        }
+        o = o.with_max_triangles(n as usize);
+    }
+    if let Some(r) = word(&js.reparam, "reparam", &["auto", "off", "force"], "\"auto\", \"off\" or \"force\"")? {
+        o = o.with_reparam([Reparam::Auto, Reparam::Off, Reparam::Force][r]);
+    }
+    let mut quality = o.quality.clone();
+    match (js.size, js.size_rel) {
+        (Some(_), Some(_)) => return Err("option size: give size or sizeRel, not both".into()),
+        (Some(Number(h)), None) => quality = quality.with_size(h),
+        (None, Some(Number(r))) => quality = quality.with_relative_size(r),
+        (None, None) => {}
+    }
+    let methods = ["looping", "delaunay", "best"];
+    if let Some(m) = word(&js.method, "method", &methods, "one of \"looping\", \"delaunay\", \"best\"")? {
+        quality = quality.with_method([QualityMethod::Looping, QualityMethod::Delaunay, QualityMethod::Best][m]);
+    }
+    o = o.with_quality(quality);
+    if let Some(m) = word(&js.mode, "mode", &["fast", "quality"], "one of \"fast\", \"quality\"")? {
+        o = o.with_mode([MeshMode::Fast, MeshMode::Quality][m]);
+    }
+    if let Some(List(pair)) = js.share {
+        match pair.as_slice() {
+            [Loose::Number(i), Loose::Number(n)] if whole(*i) && whole(*n) && i < n => {
+                o = o.with_share(*i as u32, *n as u32);
+            }
+            _ => return Err(format!("option share: {SHARE_EXPECTED}")),
+        }
+    }
+    let units = match js.units {
+        Some(Text(name)) => Units::from_name(&name).map_err(|e| e.to_string())?,
+        None => Units::File,
+    };
+    let flatten = js.flatten.is_some_and(|Flag(b)| b);
+    let console_warnings = js.console_warnings.is_some_and(|Flag(b)| b);
+    Ok((o, Output { units, flatten, console_warnings }))
+}
+
+// ---------------------------------------------------------------------------
+// Entry points.
 
 /// The crate version, so a page can show which mesher produced a mesh.
 #[cfg_attr(not(test), wasm_bindgen)]
@@ -224,8 +836,8 @@ pub fn memory_bytes() -> f64 {
 /// that is invalid.
 #[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
 pub fn mesh(bytes: Vec<u8>, format: &str, options: JsValue) -> Result<JsValue, JsError> {
-    let (options, units) = read_options(&options).map_err(|e| JsError::new(&e))?;
-    run(bytes, format, &options, units, &mut |_, _| true).map_err(|e| JsError::new(&one_line(&e.to_string())))
+    let (options, output) = mesh_options(options).map_err(|e| JsError::new(&e))?;
+    run(bytes, format, &options, output, &mut |_, _| true).map_err(|e| JsError::new(&one_line(&e.to_string())))
 }
 
 /// As [`mesh`], calling the JS function `progress(faces_done, faces_total)`
@@ -243,7 +855,7 @@ pub fn mesh_with_progress(
     options: JsValue,
     progress: &Function,
 ) -> Result<JsValue, JsValue> {
-    let (options, units) = read_options(&options).map_err(|e| JsValue::from(JsError::new(&e)))?;
+    let (options, output) = mesh_options(options).map_err(|e| JsValue::from(JsError::new(&e)))?;
     let mut thrown: Option<JsValue> = None;
     let mut call = |done: usize, total: usize| -> bool {
         match progress.call2(&JsValue::NULL, &JsValue::from(done as f64), &JsValue::from(total as f64)) {
@@ -254,7 +866,7 @@ pub fn mesh_with_progress(
             }
         }
     };
-    let result = run(bytes, format, &options, units, &mut call);
+    let result = run(bytes, format, &options, output, &mut call);
     match (result, thrown) {
         (_, Some(e)) => Err(e),
         (Ok(out), None) => Ok(out),
@@ -265,46 +877,6 @@ pub fn mesh_with_progress(
 /// The message on one line, as the command line prints it.
 fn one_line(message: &str) -> String {
     message.split_whitespace().collect::<Vec<_>>().join(" ")
-}
-
-/// Parses, meshes (reporting each face to `progress`) and converts, timing
-/// the two stages with the host clock. The input is freed once read: wasm
-/// memory never shrinks, so the file need not sit beside the mesh at its peak.
-fn run(
-    bytes: Vec<u8>,
-    format: &str,
-    options: &MeshOptions,
-    units: Units,
-    progress: &mut dyn FnMut(usize, usize) -> bool,
-) -> Result<JsValue, Error> {
-    options.validate()?;
-    let format = pick_format(&bytes, format)?;
-    let t0 = now_ms();
-    let (model, parts) = if format == Format::Step {
-        let s = read_step_parts(&bytes)?;
-        (s.model, Parts { names: s.parts, faces: s.face_parts, colours: s.face_colours })
-    } else {
-        let model = read_model(&bytes, format)?;
-        let n = model.faces.len();
-        (model, Parts { names: alloc::vec![String::new()], faces: alloc::vec![0; n], colours: alloc::vec![None; n] })
-    };
-    drop(bytes);
-    let t1 = now_ms();
-    let mut result = mesh_model_in_units(&model, options, units, progress)?;
-    drop(model);
-    let t2 = now_ms();
-    if let (Some(t0), Some(t1), Some(t2)) = (t0, t1, t2) {
-        result.report.parse_ms = t1 - t0;
-        result.report.time_ms = t2 - t1;
-    }
-    to_js(&result, &parts)
-}
-
-/// Part names, each face's part and each face's colour, for the JS result.
-struct Parts {
-    names: Vec<String>,
-    faces: Vec<u32>,
-    colours: Vec<Option<[f32; 3]>>,
 }
 
 /// `""` and `"auto"` detect the format from the bytes; anything else is a name.
@@ -318,220 +890,386 @@ fn pick_format(bytes: &[u8], name: &str) -> Result<Format, Error> {
     }
 }
 
-/// `performance.now()` when the host has it (browser, worker, Node), else `Date.now()`.
-fn now_ms() -> Option<f64> {
-    let perf = Reflect::get(&js_sys::global(), &JsValue::from_str("performance")).ok()?;
-    if perf.is_object() {
-        let now = Reflect::get(&perf, &JsValue::from_str("now")).ok()?;
-        if let Some(f) = now.dyn_ref::<Function>() {
-            if let Some(t) = f.call0(&perf).ok().and_then(|v| v.as_f64()) {
-                return Some(t);
-            }
-        }
-    }
-    Some(js_sys::Date::now())
+// Not in the test's copy of this file: the import's glue symbols would be
+// defined twice at link time (the test's clock is `Date.now` under Node).
+#[cfg(not(test))]
+#[wasm_bindgen]
+extern "C" {
+    /// The global object of any host (a window, a worker, Node).
+    type Host;
+    /// Its `performance`, when it has one (`undefined` otherwise).
+    #[wasm_bindgen(method, getter, structural)]
+    fn performance(this: &Host) -> JsValue;
 }
 
-/// Reads the JS options object (every key must be known and every value of
-/// its type) into the meshing options and the unit of the result.
-fn read_options(value: &JsValue) -> Result<(MeshOptions, Units), String> {
-    let mut options = MeshOptions::default();
-    if value.is_undefined() || value.is_null() {
-        return Ok((options, Units::File));
-    }
-    if !value.is_object() || Array::is_array(value) {
-        return Err(format!("options: expected an object like {{ toleranceRel: 0.001 }}, found {}", type_name(value)));
-    }
-    let object: &Object = value.unchecked_ref();
-    for key in Object::keys(object).iter() {
-        let key = key.as_string().unwrap_or_default();
-        if !OPTION_NAMES.contains(&key.as_str()) {
-            return Err(format!("option {key}: unknown option (known: {})", OPTION_NAMES.join(", ")));
-        }
-    }
-    let absolute = number(object, "tolerance")?;
-    let relative = number(object, "toleranceRel")?;
-    match (absolute, relative) {
-        (Some(_), Some(_)) => return Err("option tolerance: give tolerance or toleranceRel, not both".into()),
-        (Some(t), None) => options = options.with_tolerance(t),
-        (None, Some(r)) => options = options.with_relative_tolerance(r),
-        (None, None) => {}
-    }
-    if let Some(a) = number(object, "angle")? {
-        options = options.with_angle(a);
-    }
-    if let Some(m) = number(object, "maxEdge")? {
-        options = options.with_max_edge(Some(m));
-    }
-    if let Some(m) = number(object, "minEdge")? {
-        options = options.with_min_edge(Some(m));
-    }
-    if let Some(n) = number(object, "maxTriangles")? {
-        if !(n.is_finite() && n >= 0.0 && n.fract() == 0.0 && n <= u32::MAX as f64) {
-            return Err(format!("option maxTriangles: expected a whole number, found {n}"));
-        }
-        options = options.with_max_triangles(n as usize);
-    }
-    let reparam = Reflect::get(object, &JsValue::from_str("reparam")).map_err(|_| "option reparam: cannot be read")?;
-    if !(reparam.is_undefined() || reparam.is_null()) {
-        let mode = match reparam.as_string().as_deref() {
-            Some("auto") => Reparam::Auto,
-            Some("off") => Reparam::Off,
-            Some("force") => Reparam::Force,
-            _ => return Err("option reparam: expected \"auto\", \"off\" or \"force\"".into()),
-        };
-        options = options.with_reparam(mode);
-    }
-    let mut quality = options.quality.clone();
-    match (number(object, "size")?, number(object, "sizeRel")?) {
-        (Some(_), Some(_)) => return Err("option size: give size or sizeRel, not both".into()),
-        (Some(h), None) => quality = quality.with_size(h),
-        (None, Some(r)) => quality = quality.with_relative_size(r),
-        (None, None) => {}
-    }
-    if let Some(m) = word(object, "method", &["looping", "delaunay", "best"])? {
-        let method = [QualityMethod::Looping, QualityMethod::Delaunay, QualityMethod::Best][m];
-        quality = quality.with_method(method);
-    }
-    options = options.with_quality(quality);
-    if let Some(m) = word(object, "mode", &["fast", "quality"])? {
-        options = options.with_mode([MeshMode::Fast, MeshMode::Quality][m]);
-    }
-    let share = Reflect::get(object, &JsValue::from_str("share")).map_err(|_| "option share: cannot be read")?;
-    if !(share.is_undefined() || share.is_null()) {
-        let pair: Option<[u32; 2]> = Array::is_array(&share)
-            .then(|| share.unchecked_ref::<Array>().to_vec())
-            .filter(|v| v.len() == 2)
-            .and_then(|v| {
-                let whole = |x: &JsValue| x.as_f64().filter(|n| n.fract() == 0.0 && *n >= 0.0 && *n <= u32::MAX as f64);
-                Some([whole(&v[0])? as u32, whole(&v[1])? as u32])
-            });
-        match pair {
-            Some([i, n]) if i < n => options = options.with_share(i, n),
-            _ => return Err("option share: expected [index, count] with whole numbers, index < count".into()),
-        }
-    }
-    let units = Reflect::get(object, &JsValue::from_str("units")).map_err(|_| "option units: cannot be read")?;
-    let units = match units.as_string() {
-        Some(name) => Units::from_name(&name).map_err(|e| e.to_string())?,
-        None if units.is_undefined() || units.is_null() => Units::File,
-        None => return Err(format!("option units: expected a string, found {}", type_name(&units))),
-    };
-    Ok((options, units))
-}
-
-/// A string-valued option: the index of its value in `allowed`, `None` when absent.
-fn word(object: &Object, name: &str, allowed: &[&str]) -> Result<Option<usize>, String> {
-    let value = Reflect::get(object, &JsValue::from_str(name)).map_err(|_| format!("option {name}: cannot be read"))?;
-    if value.is_undefined() || value.is_null() {
-        return Ok(None);
-    }
-    let text = value.as_string().unwrap_or_default();
-    match allowed.iter().position(|a| *a == text) {
-        Some(i) => Ok(Some(i)),
-        None => Err(format!("option {name}: expected one of \"{}\"", allowed.join("\", \""))),
-    }
-}
-
-/// A number-valued option: `None` when absent (undefined or null).
-fn number(object: &Object, name: &str) -> Result<Option<f64>, String> {
-    let value = Reflect::get(object, &JsValue::from_str(name)).map_err(|_| format!("option {name}: cannot be read"))?;
-    if value.is_undefined() || value.is_null() {
-        return Ok(None);
-    }
-    match value.as_f64() {
-        Some(x) if x.is_finite() => Ok(Some(x)),
-        Some(x) => Err(format!("option {name}: expected a finite number, found {x}")),
-        None => Err(format!("option {name}: expected a number, found {}", type_name(&value))),
-    }
-}
-
-/// JS `typeof`-style name of a value, for error messages.
-fn type_name(value: &JsValue) -> String {
-    if value.is_null() {
-        "null".into()
-    } else if Array::is_array(value) {
-        "an array".into()
+/// `performance.now()` of the host (browser, worker, Node), else `Date.now()`.
+fn now_ms() -> f64 {
+    let global = js_sys::global();
+    let perf = if let Some(w) = global.dyn_ref::<web_sys::Window>() {
+        w.performance()
+    } else if let Some(w) = global.dyn_ref::<web_sys::WorkerGlobalScope>() {
+        w.performance()
     } else {
-        value.js_typeof().as_string().unwrap_or_default()
+        node_performance(global)
+    };
+    perf.map_or_else(js_sys::Date::now, |p| p.now())
+}
+
+/// Node's `performance`: the same object, not under a browser's class.
+#[cfg(not(test))]
+fn node_performance(global: js_sys::Object) -> Option<web_sys::Performance> {
+    let p = global.unchecked_into::<Host>().performance();
+    p.is_object().then(|| p.unchecked_into::<web_sys::Performance>())
+}
+
+#[cfg(test)]
+fn node_performance(_: js_sys::Object) -> Option<web_sys::Performance> {
+    None
+}
+
+/// What the result needs of the file besides the mesh.
+struct Read {
+    /// A name per part instance.
+    parts: Vec<String>,
+    /// A colour per face.
+    colours: Vec<Option<[f32; 3]>>,
+    assembly: Assembly,
+    /// Result units per file unit (the tree's matrices are in the file's).
+    scale: f64,
+}
+
+/// Parses, meshes (reporting each face to `progress`) and converts, timing
+/// the two stages with the host clock. The input is freed once read: wasm
+/// memory never shrinks, so the file need not sit beside the mesh at its peak.
+fn run(
+    bytes: Vec<u8>,
+    format: &str,
+    options: &MeshOptions,
+    output: Output,
+    progress: &mut dyn FnMut(usize, usize) -> bool,
+) -> Result<JsValue, Error> {
+    options.validate()?;
+    let format = pick_format(&bytes, format)?;
+    let t0 = now_ms();
+    let (model, mut read) = if format == Format::Step {
+        let s = read_step_parts(&bytes)?;
+        (s.model, Read { parts: s.parts, colours: s.face_colours, assembly: s.assembly, scale: 1.0 })
+    } else {
+        let model = read_model(&bytes, format)?;
+        let n = model.face_count();
+        let parts = alloc::vec![String::new()];
+        (model, Read { parts, colours: alloc::vec![None; n], assembly: Assembly::single("", n), scale: 1.0 })
+    };
+    drop(bytes);
+    if let (Some(name), Some(from)) = (output.units.name(), mm_per_unit(&model.units)) {
+        read.scale = from / mm_per_unit(name).unwrap_or(from);
+    }
+    let t1 = now_ms();
+    let mut result = mesh_instanced(&model, &read.assembly, options, output.units, progress)?;
+    let faces = model.face_count();
+    drop(model);
+    result.report.parse_ms = t1 - t0;
+    result.report.time_ms = now_ms() - t1;
+    if output.console_warnings {
+        for w in &result.report.warnings {
+            web_sys::console::warn_1(&JsValue::from_str(w));
+        }
+    }
+    if output.flatten {
+        flat_to_js(&result, &read, faces)
+    } else {
+        instanced_to_js(&result, &read)
     }
 }
 
-/// Builds `{ positions, normals, indices, faceRanges, faceParts, faceColors, parts, units, report }`.
-fn to_js(result: &MeshResult, parts: &Parts) -> Result<JsValue, Error> {
-    let mesh = &result.mesh;
-    let flat =
-        |v: &[glam::DVec3]| -> Vec<f32> { v.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect() };
-    let ranges: Vec<u32> = mesh.face_ranges.iter().flat_map(|r| [r.first, r.count]).collect();
-    let report_json =
-        serde_json::to_string(&result.report).map_err(|e| Error::Internal(format!("report to JSON: {e}")))?;
-    let report = JSON::parse(&report_json).map_err(|_| Error::Internal("report JSON rejected by JSON.parse".into()))?;
+// ---------------------------------------------------------------------------
+// Results: serialized straight to JS objects, the typed arrays as they are.
 
-    let colours: Vec<f32> = parts.colours.iter().flat_map(|c| c.unwrap_or([f32::NAN; 3])).collect();
-    let names = Array::new();
-    for n in &parts.names {
-        names.push(&JsValue::from_str(n));
-    }
-    let out = Object::new();
-    // One f32 copy at a time, each freed once JS has its own.
-    let positions: JsValue = Float32Array::from(flat(&mesh.positions).as_slice()).into();
-    let normals: JsValue = Float32Array::from(flat(&mesh.normals).as_slice()).into();
-    let fields: [(&str, JsValue); 9] = [
-        ("positions", positions),
-        ("normals", normals),
-        ("indices", Uint32Array::from(mesh.indices.as_slice()).into()),
-        ("faceRanges", Uint32Array::from(ranges.as_slice()).into()),
-        ("faceParts", Uint32Array::from(parts.faces.as_slice()).into()),
-        ("faceColors", Float32Array::from(colours.as_slice()).into()),
-        ("parts", names.into()),
-        ("units", JsValue::from_str(&result.report.units)),
-        ("report", report),
-    ];
-    for (name, value) in fields {
-        Reflect::set(&out, &JsValue::from_str(name), &value)
-            .map_err(|_| Error::Internal(format!("cannot set result field {name}")))?;
-    }
-    Ok(out.into())
+/// The serializer of every result: maps as plain objects, `None` as `null`
+/// (as the command line's JSON has it).
+fn serializer() -> serde_wasm_bindgen::Serializer {
+    serde_wasm_bindgen::Serializer::new().serialize_maps_as_objects(true).serialize_missing_as_null(true)
 }
 
-/// Option names `repair` accepts.
-const REPAIR_OPTION_NAMES: [&str; 5] = ["bucketing", "bucketCapacity", "weldTolerance", "perturbation", "verify"];
+fn to_value<T: Serialize>(value: &T) -> Result<JsValue, Error> {
+    value.serialize(&serializer()).map_err(|e| Error::Internal(format!("result to JS: {e}")))
+}
+
+/// x, y, z of each point as f32.
+fn floats(points: &[glam::DVec3]) -> Float32Array {
+    let flat: Vec<f32> = points.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect();
+    Float32Array::from(flat.as_slice())
+}
+
+fn ranges(mesh: &Mesh) -> Uint32Array {
+    let r: Vec<u32> = mesh.face_ranges.iter().flat_map(|r| [r.first, r.count]).collect();
+    Uint32Array::from(r.as_slice())
+}
+
+/// The edge polylines as points and (first, count) pairs.
+fn edge_arrays(lines: &EdgeLines) -> (Float32Array, Uint32Array) {
+    let r: Vec<u32> = lines.ranges.iter().flat_map(|&(a, n)| [a, n]).collect();
+    (floats(&lines.points), Uint32Array::from(r.as_slice()))
+}
+
+fn colours(list: impl Iterator<Item = Option<[f32; 3]>>) -> Float32Array {
+    let c: Vec<f32> = list.flat_map(|c| c.unwrap_or([f32::NAN; 3])).collect();
+    Float32Array::from(c.as_slice())
+}
+
+/// A column-major 4 × 4 matrix (three.js `Matrix4.fromArray` order).
+fn matrix4(m: &glam::DAffine3) -> Vec<f64> {
+    glam::DMat4::from(*m).to_cols_array().to_vec()
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct PartOut {
+    name: String,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    positions: Float32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    normals: Float32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    indices: Uint32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    face_ranges: Uint32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    faces: Uint32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    face_colors: Float32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    edges: Float32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    edge_ranges: Uint32Array,
+}
+
+#[derive(Serialize)]
+struct InstanceOut {
+    part: usize,
+    matrix: Vec<f64>,
+    node: usize,
+}
+
+#[derive(Serialize)]
+struct NodeOut {
+    name: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    occurrence: Option<String>,
+    matrix: Vec<f64>,
+    children: Vec<NodeOut>,
+    instances: Vec<usize>,
+}
+
+/// The tree from node `n` down (translations times `scale`), and each
+/// node's place in a depth-first walk (`order`, counted by `next`).
+fn tree(a: &Assembly, n: usize, scale: f64, order: &mut [usize], next: &mut usize, depth: usize) -> NodeOut {
+    if let Some(o) = order.get_mut(n) {
+        *o = *next;
+    }
+    *next += 1;
+    let node = &a.nodes[n];
+    let m = glam::DAffine3 { matrix3: node.matrix.matrix3, translation: node.matrix.translation * scale };
+    // The reader caps the depth; this only guards a malformed tree.
+    let children = if depth > 256 {
+        Vec::new()
+    } else {
+        node.children
+            .iter()
+            .filter(|&&c| c < a.nodes.len())
+            .map(|&c| tree(a, c, scale, order, next, depth + 1))
+            .collect()
+    };
+    NodeOut {
+        name: node.name.clone(),
+        occurrence: node.occurrence.clone(),
+        matrix: matrix4(&m),
+        children,
+        instances: node.instances.clone(),
+    }
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct InstancedOut<'a> {
+    meshes: Vec<PartOut>,
+    instances: Vec<InstanceOut>,
+    tree: NodeOut,
+    units: &'a str,
+    report: &'a Report,
+}
+
+/// `{ meshes, instances, tree, units, report }`.
+fn instanced_to_js(result: &InstancedResult, read: &Read) -> Result<JsValue, Error> {
+    let a = &read.assembly;
+    let mut order = alloc::vec![0; a.nodes.len()];
+    let root = tree(a, 0, read.scale, &mut order, &mut 0, 0);
+    let mut meshes = Vec::with_capacity(result.parts.len());
+    for (p, part) in result.parts.iter().enumerate() {
+        let first = result.instances.iter().position(|(q, _)| *q == p);
+        let name = first.and_then(|k| a.instances.get(k)).and_then(|i| a.nodes.get(i.node));
+        let lines = edge_lines(&part.mesh);
+        let (edges, edge_ranges) = edge_arrays(&lines);
+        let faces: Vec<u32> = part.faces.iter().map(|&f| f as u32).collect();
+        meshes.push(PartOut {
+            name: name.map(|n| n.name.clone()).unwrap_or_default(),
+            positions: floats(&part.mesh.positions),
+            normals: floats(&part.mesh.normals),
+            indices: Uint32Array::from(part.mesh.indices.as_slice()),
+            face_ranges: ranges(&part.mesh),
+            faces: Uint32Array::from(faces.as_slice()),
+            face_colors: colours(part.faces.iter().map(|&f| read.colours.get(f).copied().flatten())),
+            edges,
+            edge_ranges,
+        });
+    }
+    let instances = result
+        .instances
+        .iter()
+        .enumerate()
+        .map(|(k, (part, m))| {
+            let node = a.instances.get(k).map_or(0, |i| order.get(i.node).copied().unwrap_or(0));
+            InstanceOut { part: *part, matrix: matrix4(m), node }
+        })
+        .collect();
+    let out = InstancedOut { meshes, instances, tree: root, units: &result.report.units, report: &result.report };
+    to_value(&out)
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct FlatOut<'a> {
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    positions: Float32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    normals: Float32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    indices: Uint32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    face_ranges: Uint32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    face_parts: Uint32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    face_colors: Float32Array,
+    parts: &'a [String],
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    edges: Float32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    edge_ranges: Uint32Array,
+    tree: NodeOut,
+    units: &'a str,
+    report: &'a Report,
+}
+
+/// `{ positions, normals, indices, faceRanges, faceParts, faceColors, parts, edges, edgeRanges, tree, units, report }`.
+fn flat_to_js(result: &InstancedResult, read: &Read, faces: usize) -> Result<JsValue, Error> {
+    let mesh = flatten(result, &read.assembly);
+    let lines = edge_lines(&mesh);
+    let (edges, edge_ranges) = edge_arrays(&lines);
+    drop(lines);
+    let mut order = alloc::vec![0; read.assembly.nodes.len()];
+    let root = tree(&read.assembly, 0, read.scale, &mut order, &mut 0, 0);
+    let face_parts: Vec<u32> = match read.assembly.face_instances.len() {
+        n if n == faces => read.assembly.face_instances.clone(),
+        _ => alloc::vec![0; faces],
+    };
+    let out = FlatOut {
+        // One f32 copy at a time, each freed once JS has its own.
+        positions: floats(&mesh.positions),
+        normals: floats(&mesh.normals),
+        indices: Uint32Array::from(mesh.indices.as_slice()),
+        face_ranges: ranges(&mesh),
+        face_parts: Uint32Array::from(face_parts.as_slice()),
+        face_colors: colours(read.colours.iter().copied()),
+        parts: &read.parts,
+        edges,
+        edge_ranges,
+        tree: root,
+        units: &result.report.units,
+        report: &result.report,
+    };
+    to_value(&out)
+}
+
+// ---------------------------------------------------------------------------
+// The full build's functions: repair, offset, fit.
+
+/// The options of `repair` as JS gives them.
+#[cfg(feature = "repair")]
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "camelCase")]
+struct JsRepairOptions {
+    bucketing: Option<Text>,
+    bucket_capacity: Option<Number>,
+    weld_tolerance: Option<Number>,
+    perturbation: Option<Number>,
+    verify: Option<Flag>,
+}
+
+#[cfg(feature = "repair")]
+const REPAIR_OPTION_NAMES: &[&str] = &["bucketing", "bucketCapacity", "weldTolerance", "perturbation", "verify"];
 
 /// Reads a mesh (`"stl"`, `"obj"`, or `""`/`"auto"` to detect it) and repairs it (paper 002).
 ///
 /// # Errors
 /// Throws a JS `Error` with the one-line message of a bad option, a reader
 /// error with its line, or a mesh that cannot be repaired.
+#[cfg(feature = "repair")]
 #[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
 pub fn repair(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsError> {
-    let options = read_repair_options(&options).map_err(|e| JsError::new(&e))?;
+    let options = repair_options(options).map_err(|e| JsError::new(&e))?;
     run_repair(bytes, format, &options).map_err(|e| JsError::new(&one_line(&e.to_string())))
+}
+
+#[cfg(feature = "repair")]
+fn repair_options(value: JsValue) -> Result<RepairOptions, String> {
+    let js: JsRepairOptions = options(value, "bucketing: \"kd\"", REPAIR_OPTION_NAMES)?;
+    let mut o = RepairOptions::default();
+    if let Some(b) = word(&js.bucketing, "bucketing", &["kd", "bvh"], "\"kd\" or \"bvh\"")? {
+        o = o.with_bucketing([Bucketing::KdTree, Bucketing::Bvh][b]);
+    }
+    if let Some(Number(n)) = js.bucket_capacity {
+        if !whole(n) {
+            return Err(format!("option bucketCapacity: expected a whole number, found {n}"));
+        }
+        o = o.with_bucket_capacity(n as usize);
+    }
+    if let Some(Number(w)) = js.weld_tolerance {
+        o = o.with_weld_tolerance(w);
+    }
+    if let Some(Number(p)) = js.perturbation {
+        o.perturbation = p;
+    }
+    if let Some(Flag(v)) = js.verify {
+        o = o.with_verify(v);
+    }
+    Ok(o)
 }
 
 /// Reads a mesh (`format` as for [`repair`]) and offsets it by `distance` along its vertex normals.
 ///
 /// # Errors
 /// Throws a JS `Error` with the reader's or the offset's one-line message.
+#[cfg(feature = "repair")]
 #[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
 pub fn offset(bytes: &[u8], format: &str, distance: f64) -> Result<JsValue, JsError> {
+    #[derive(Serialize)]
+    struct Out {
+        #[serde(with = "serde_wasm_bindgen::preserve")]
+        positions: Float32Array,
+        #[serde(with = "serde_wasm_bindgen::preserve")]
+        indices: Uint32Array,
+    }
     let run = || -> Result<JsValue, Error> {
         let mesh = read_mesh(bytes, mesh_format(bytes, format)?)?;
         let out = offset_mesh(&mesh, distance)?;
-        let positions: Vec<f32> = out.positions.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect();
-        let obj = Object::new();
-        for (name, value) in [
-            ("positions", JsValue::from(Float32Array::from(positions.as_slice()))),
-            ("indices", Uint32Array::from(out.indices.as_slice()).into()),
-        ] {
-            Reflect::set(&obj, &JsValue::from_str(name), &value)
-                .map_err(|_| Error::Internal(format!("cannot set result field {name}")))?;
-        }
-        Ok(obj.into())
+        to_value(&Out { positions: floats(&out.positions), indices: Uint32Array::from(out.indices.as_slice()) })
     };
     run().map_err(|e| JsError::new(&one_line(&e.to_string())))
 }
 
 /// `""` and `"auto"` detect the mesh format from the bytes; anything else is a name.
+#[cfg(feature = "repair")]
 fn mesh_format(bytes: &[u8], name: &str) -> Result<MeshFormat, Error> {
     if name.is_empty() || name.eq_ignore_ascii_case("auto") {
         MeshFormat::detect(bytes).ok_or_else(|| {
@@ -542,84 +1280,48 @@ fn mesh_format(bytes: &[u8], name: &str) -> Result<MeshFormat, Error> {
     }
 }
 
+#[cfg(feature = "repair")]
 fn run_repair(bytes: &[u8], format: &str, options: &RepairOptions) -> Result<JsValue, Error> {
+    /// The repair's report with the parse time the binding measured.
+    #[derive(Serialize)]
+    struct Timed<'a> {
+        #[serde(flatten)]
+        report: &'a RepairReport,
+        parse_ms: f64,
+    }
+    #[derive(Serialize)]
+    struct Out<'a> {
+        #[serde(with = "serde_wasm_bindgen::preserve")]
+        positions: Float32Array,
+        #[serde(with = "serde_wasm_bindgen::preserve")]
+        indices: Uint32Array,
+        report: Timed<'a>,
+    }
     options.validate()?;
     let format = mesh_format(bytes, format)?;
-    let t0 = now_ms().unwrap_or(0.0);
+    let t0 = now_ms();
     let mesh = read_mesh(bytes, format)?;
-    let t1 = now_ms().unwrap_or(0.0);
-    let result = repair_mesh_timed(&mesh, options, &mut || now_ms().unwrap_or(0.0) - t1)?;
-    let mut report =
-        serde_json::to_value(&result.report).map_err(|e| Error::Internal(format!("report to JSON: {e}")))?;
-    if let Some(o) = report.as_object_mut() {
-        o.insert("parse_ms".into(), (t1 - t0).into());
-    }
-    let report_json = serde_json::to_string(&report).map_err(|e| Error::Internal(format!("report to JSON: {e}")))?;
-    let report = JSON::parse(&report_json).map_err(|_| Error::Internal("report JSON rejected by JSON.parse".into()))?;
-    let positions: Vec<f32> = result.mesh.positions.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect();
-    let out = Object::new();
-    let fields: [(&str, JsValue); 3] = [
-        ("positions", Float32Array::from(positions.as_slice()).into()),
-        ("indices", Uint32Array::from(result.mesh.indices.as_slice()).into()),
-        ("report", report),
-    ];
-    for (name, value) in fields {
-        Reflect::set(&out, &JsValue::from_str(name), &value)
-            .map_err(|_| Error::Internal(format!("cannot set result field {name}")))?;
-    }
-    Ok(out.into())
+    let t1 = now_ms();
+    let result = repair_mesh_timed(&mesh, options, &mut || now_ms() - t1)?;
+    to_value(&Out {
+        positions: floats(&result.mesh.positions),
+        indices: Uint32Array::from(result.mesh.indices.as_slice()),
+        report: Timed { report: &result.report, parse_ms: t1 - t0 },
+    })
 }
 
-/// Reads the JS options object of `repair`; every key must be known.
-fn read_repair_options(value: &JsValue) -> Result<RepairOptions, String> {
-    let mut options = RepairOptions::default();
-    if value.is_undefined() || value.is_null() {
-        return Ok(options);
-    }
-    if !value.is_object() || Array::is_array(value) {
-        return Err(format!("options: expected an object like {{ bucketing: \"kd\" }}, found {}", type_name(value)));
-    }
-    let object: &Object = value.unchecked_ref();
-    for key in Object::keys(object).iter() {
-        let key = key.as_string().unwrap_or_default();
-        if !REPAIR_OPTION_NAMES.contains(&key.as_str()) {
-            return Err(format!("option {key}: unknown option (known: {})", REPAIR_OPTION_NAMES.join(", ")));
-        }
-    }
-    let get = |name: &str| {
-        Reflect::get(object, &JsValue::from_str(name)).map_err(|_| format!("option {name}: cannot be read"))
-    };
-    let b = get("bucketing")?;
-    if !b.is_undefined() && !b.is_null() {
-        options = options.with_bucketing(match b.as_string().as_deref() {
-            Some("kd") => Bucketing::KdTree,
-            Some("bvh") => Bucketing::Bvh,
-            _ => return Err("option bucketing: expected \"kd\" or \"bvh\"".into()),
-        });
-    }
-    if let Some(n) = number(object, "bucketCapacity")? {
-        if !(n.fract() == 0.0 && n >= 0.0 && n <= u32::MAX as f64) {
-            return Err(format!("option bucketCapacity: expected a whole number, found {n}"));
-        }
-        options = options.with_bucket_capacity(n as usize);
-    }
-    if let Some(w) = number(object, "weldTolerance")? {
-        options = options.with_weld_tolerance(w);
-    }
-    if let Some(p) = number(object, "perturbation")? {
-        options.perturbation = p;
-    }
-    let v = get("verify")?;
-    if !v.is_undefined() && !v.is_null() {
-        options = options.with_verify(
-            v.as_bool().ok_or_else(|| format!("option verify: expected a boolean, found {}", type_name(&v)))?,
-        );
-    }
-    Ok(options)
+/// The options of `fit` as JS gives them.
+#[cfg(feature = "fit")]
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "camelCase")]
+struct JsFitOptions {
+    tolerance: Option<Number>,
+    tolerance_rel: Option<Number>,
+    max_sides: Option<Number>,
 }
 
-/// Option names `fit` accepts.
-const FIT_OPTION_NAMES: [&str; 3] = ["tolerance", "toleranceRel", "maxSides"];
+#[cfg(feature = "fit")]
+const FIT_OPTION_NAMES: &[&str] = &["tolerance", "toleranceRel", "maxSides"];
 
 /// Reads points (`"xyz"`, `"csv"`, `"ply"`, or `""`/`"auto"` to detect them)
 /// and fits a surface through them (paper 004).
@@ -627,9 +1329,10 @@ const FIT_OPTION_NAMES: [&str; 3] = ["tolerance", "toleranceRel", "maxSides"];
 /// # Errors
 /// Throws a JS `Error` with the one-line message of a bad option, a reader
 /// error naming its line, or points no surface passes through.
+#[cfg(feature = "fit")]
 #[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
 pub fn fit(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsError> {
-    let options = read_fit_options(&options).map_err(|e| JsError::new(&e))?;
+    let options = fit_options(options).map_err(|e| JsError::new(&e))?;
     let run = || -> Result<JsValue, Error> {
         let format = if format.is_empty() || format.eq_ignore_ascii_case("auto") {
             PointFormat::detect(bytes)
@@ -639,70 +1342,63 @@ pub fn fit(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsEr
         let points = read_points(bytes, format)?;
         let t0 = now_ms();
         let mut result = fit_points(&points, &options)?;
-        if let (Some(t0), Some(t1)) = (t0, now_ms()) {
-            result.report.time_ms = t1 - t0;
-        }
+        result.report.time_ms = now_ms() - t0;
         fit_to_js(&result)
     };
     run().map_err(|e| JsError::new(&one_line(&e.to_string())))
 }
 
-/// Reads the JS options object of `fit`; every key must be known and every value a number.
-fn read_fit_options(value: &JsValue) -> Result<FitOptions, String> {
-    let mut options = FitOptions::default();
-    if value.is_undefined() || value.is_null() {
-        return Ok(options);
-    }
-    if !value.is_object() || Array::is_array(value) {
-        return Err(format!("options: expected an object like {{ toleranceRel: 0.001 }}, found {}", type_name(value)));
-    }
-    let object: &Object = value.unchecked_ref();
-    for key in Object::keys(object).iter() {
-        let key = key.as_string().unwrap_or_default();
-        if !FIT_OPTION_NAMES.contains(&key.as_str()) {
-            return Err(format!("option {key}: unknown option (known: {})", FIT_OPTION_NAMES.join(", ")));
-        }
-    }
-    match (number(object, "tolerance")?, number(object, "toleranceRel")?) {
+#[cfg(feature = "fit")]
+fn fit_options(value: JsValue) -> Result<FitOptions, String> {
+    let js: JsFitOptions = options(value, "toleranceRel: 0.001", FIT_OPTION_NAMES)?;
+    let mut o = FitOptions::default();
+    match (js.tolerance, js.tolerance_rel) {
         (Some(_), Some(_)) => return Err("option tolerance: give tolerance or toleranceRel, not both".into()),
-        (Some(t), None) => options = options.with_tolerance(t),
-        (None, Some(r)) => options = options.with_relative_tolerance(r),
+        (Some(Number(t)), None) => o = o.with_tolerance(t),
+        (None, Some(Number(r))) => o = o.with_relative_tolerance(r),
         (None, None) => {}
     }
-    if let Some(n) = number(object, "maxSides")? {
+    if let Some(Number(n)) = js.max_sides {
         if !(n.fract() == 0.0 && (3.0..=32.0).contains(&n)) {
             return Err(format!("option maxSides: expected a whole number from 3 to 32, found {n}"));
         }
-        options = options.with_max_polygon_sides(n as usize);
+        o = o.with_max_polygon_sides(n as usize);
     }
-    options.validate().map_err(|e| e.to_string())?;
-    Ok(options)
+    o.validate().map_err(|e| e.to_string())?;
+    Ok(o)
 }
 
 /// Builds `{ positions, normals, indices, faceRanges, points, netEdges, patches, report }`.
+#[cfg(feature = "fit")]
 fn fit_to_js(result: &FitResult) -> Result<JsValue, Error> {
-    let flat =
-        |v: &[glam::DVec3]| -> Vec<f32> { v.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect() };
-    let mesh = &result.mesh;
-    let ranges: Vec<u32> = mesh.face_ranges.iter().flat_map(|r| [r.first, r.count]).collect();
-    let edges: Vec<u32> = result.surface.edges().iter().flat_map(|(a, b, _)| [*a, *b]).collect();
-    let report_json =
-        serde_json::to_string(&result.report).map_err(|e| Error::Internal(format!("report to JSON: {e}")))?;
-    let report = JSON::parse(&report_json).map_err(|_| Error::Internal("report JSON rejected by JSON.parse".into()))?;
-    let out = Object::new();
-    let fields: [(&str, JsValue); 8] = [
-        ("positions", Float32Array::from(flat(&mesh.positions).as_slice()).into()),
-        ("normals", Float32Array::from(flat(&mesh.normals).as_slice()).into()),
-        ("indices", Uint32Array::from(mesh.indices.as_slice()).into()),
-        ("faceRanges", Uint32Array::from(ranges.as_slice()).into()),
-        ("points", Float32Array::from(flat(&result.surface.points).as_slice()).into()),
-        ("netEdges", Uint32Array::from(edges.as_slice()).into()),
-        ("patches", JsValue::from_str(&result.surface.to_json())),
-        ("report", report),
-    ];
-    for (name, value) in fields {
-        Reflect::set(&out, &JsValue::from_str(name), &value)
-            .map_err(|_| Error::Internal(format!("cannot set result field {name}")))?;
+    #[derive(Serialize)]
+    #[serde(rename_all = "camelCase")]
+    struct Out<'a> {
+        #[serde(with = "serde_wasm_bindgen::preserve")]
+        positions: Float32Array,
+        #[serde(with = "serde_wasm_bindgen::preserve")]
+        normals: Float32Array,
+        #[serde(with = "serde_wasm_bindgen::preserve")]
+        indices: Uint32Array,
+        #[serde(with = "serde_wasm_bindgen::preserve")]
+        face_ranges: Uint32Array,
+        #[serde(with = "serde_wasm_bindgen::preserve")]
+        points: Float32Array,
+        #[serde(with = "serde_wasm_bindgen::preserve")]
+        net_edges: Uint32Array,
+        patches: String,
+        report: &'a FitReport,
     }
-    Ok(out.into())
+    let mesh = &result.mesh;
+    let edges: Vec<u32> = result.surface.edges().iter().flat_map(|(a, b, _)| [*a, *b]).collect();
+    to_value(&Out {
+        positions: floats(&mesh.positions),
+        normals: floats(&mesh.normals),
+        indices: Uint32Array::from(mesh.indices.as_slice()),
+        face_ranges: ranges(mesh),
+        points: floats(&result.surface.points),
+        net_edges: Uint32Array::from(edges.as_slice()),
+        patches: result.surface.to_json(),
+        report: &result.report,
+    })
 }

@@ -12,9 +12,10 @@ extern crate alloc;
 // Names `src/wasm.rs` reaches through `crate::`.
 #[allow(unused_imports)]
 use surfmesh::{
-    fit_points, mesh_model, mesh_model_in_units, offset_mesh, read_mesh, read_model, read_points, read_step_parts,
-    repair_mesh_timed, Bucketing, Error, FitOptions, FitResult, Format, MeshFormat, MeshMode, MeshOptions, MeshResult,
-    PointFormat, QualityMethod, RepairOptions, Units,
+    edge_lines, fit_points, flatten, mesh_instanced, mesh_model, mm_per_unit, offset_mesh, read_mesh, read_model,
+    read_points, read_step_parts, repair_mesh_timed, Assembly, Bucketing, EdgeLines, Error, FitOptions, FitReport,
+    FitResult, Format, InstancedResult, Mesh, MeshFormat, MeshMode, MeshOptions, PointFormat, QualityMethod,
+    RepairOptions, RepairReport, Report, Units,
 };
 
 #[path = "../src/wasm.rs"]
@@ -89,9 +90,22 @@ fn num(x: f64) -> JsValue {
     JsValue::from_f64(x)
 }
 
-/// Calls the binding; on failure checks that what it throws is a JS `Error` and returns its message.
+/// `opts` with `flatten: true` added (the one merged mesh these tests read)
+/// unless it says otherwise; anything but an object or undefined as it is.
+fn flat(opts: JsValue) -> JsValue {
+    if opts.is_undefined() {
+        return options(&[("flatten", true.into())]);
+    }
+    let has = Reflect::has(&opts, &"flatten".into()).unwrap_or(true);
+    if opts.is_object() && !Array::is_array(&opts) && !has {
+        Reflect::set(&opts, &"flatten".into(), &true.into()).expect("set flatten");
+    }
+    opts
+}
+
+/// Calls the binding (flattened); on failure checks that what it throws is a JS `Error` and returns its message.
 fn call(bytes: &[u8], format: &str, opts: JsValue) -> Result<Output, String> {
-    match binding::mesh(bytes.to_vec(), format, opts) {
+    match binding::mesh(bytes.to_vec(), format, flat(opts)) {
         Ok(v) => {
             let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
             Ok(Output {
@@ -420,7 +434,7 @@ fn mesh_with_progress_js(bytes: &[u8], body: &str) -> (Result<JsValue, JsValue>,
     Reflect::set(&js_sys::global(), &"__surfmeshCalls".into(), &calls).expect("set global");
     let source = format!("globalThis.__surfmeshCalls.push([done, total]); {body}");
     let progress = js_sys::Function::new_with_args("done, total", &source);
-    let result = binding::mesh_with_progress(bytes.to_vec(), "json", JsValue::UNDEFINED, &progress);
+    let result = binding::mesh_with_progress(bytes.to_vec(), "json", flat(JsValue::UNDEFINED), &progress);
     let seen = calls
         .iter()
         .map(|c| {
@@ -616,7 +630,7 @@ fn fit_errors_are_js_errors_with_the_cli_message() {
 #[wasm_bindgen_test]
 fn step_assembly_parts_and_colours_reach_js() {
     let bytes = include_bytes!("data/step_assembly.stp");
-    let v = binding::mesh(bytes.to_vec(), "step", options(&[("toleranceRel", num(1e-3))]))
+    let v = binding::mesh(bytes.to_vec(), "step", flat(options(&[("toleranceRel", num(1e-3))])))
         .unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
     let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
     let parts: Vec<String> =
@@ -631,7 +645,7 @@ fn step_assembly_parts_and_colours_reach_js() {
     assert_eq!(&colours[3..6], &[0.0, 0.0, 1.0]);
     assert_eq!(&colours[21..24], &[0.0, 0.0, 1.0]);
 
-    let v = binding::mesh(FREEFORM.to_vec(), "json", JsValue::UNDEFINED)
+    let v = binding::mesh(FREEFORM.to_vec(), "json", flat(JsValue::UNDEFINED))
         .unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
     let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
     assert_eq!(get("parts").dyn_into::<Array>().expect("parts").length(), 1);
@@ -647,8 +661,8 @@ fn step_assembly_parts_and_colours_reach_js() {
 #[wasm_bindgen_test]
 fn step_tessellated_faces_reach_js_counted() {
     let bytes = include_bytes!("data/step_tess_solid.stp");
-    let v =
-        binding::mesh(bytes.to_vec(), "step", JsValue::UNDEFINED).unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+    let v = binding::mesh(bytes.to_vec(), "step", flat(JsValue::UNDEFINED))
+        .unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
     let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
     assert_eq!(get("faceRanges").dyn_into::<Uint32Array>().expect("faceRanges").to_vec(), [0, 1, 1, 1, 2, 1, 3, 1]);
     let parts: Vec<String> =
@@ -669,7 +683,7 @@ fn step_tessellated_faces_reach_js_counted() {
 fn units_option_scales_the_result_and_names_its_unit() {
     let bytes = include_bytes!("data/step_box_inch.stp");
     let run = |opts: JsValue| {
-        let v = binding::mesh(bytes.to_vec(), "step", opts).unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+        let v = binding::mesh(bytes.to_vec(), "step", flat(opts)).unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
         let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
         let positions = get("positions").dyn_into::<Float32Array>().expect("positions").to_vec();
         let max_x = positions.chunks(3).map(|p| p[0]).fold(f32::NEG_INFINITY, f32::max);
@@ -706,4 +720,162 @@ fn reparam_auto_is_the_default() {
     assert_eq!(rebuilt.as_bool(), Some(true));
     assert!(plain.triangles() < off.triangles(), "{} vs {}", plain.triangles(), off.triangles());
     assert!(plain.number("max_deviation") <= plain.number("tolerance"));
+}
+
+/// The message a call threw (a JS `Error`), or a panic when it returned.
+fn thrown<T>(result: Result<T, wasm_bindgen::JsError>) -> String {
+    match result {
+        Ok(_) => panic!("expected an error"),
+        Err(e) => String::from(JsValue::from(e).unchecked_into::<js_sys::Error>().message()),
+    }
+}
+
+/// Every option of `mesh` with a value of the wrong kind, and each object
+/// that is not an options object: a one-line error that names the option
+/// (or `options`) and says what it expected and found.
+#[wasm_bindgen_test]
+fn each_bad_mesh_option_throws_one_line_naming_it() {
+    let array = |xs: &[JsValue]| JsValue::from(xs.iter().collect::<Array>());
+    let cases: Vec<(JsValue, &str)> = vec![
+        (options(&[("tolerance", "fine".into())]), "option tolerance: expected a number, found string"),
+        (options(&[("toleranceRel", true.into())]), "option toleranceRel: expected a number, found boolean"),
+        (options(&[("angle", "wide".into())]), "option angle: expected a number, found string"),
+        (options(&[("maxEdge", "long".into())]), "option maxEdge: expected a number, found string"),
+        (options(&[("minEdge", array(&[num(1.0)]))]), "option minEdge: expected a number, found an array"),
+        (options(&[("maxTriangles", Object::new().into())]), "option maxTriangles: expected a number, found object"),
+        (options(&[("maxTriangles", num(-3.0))]), "option maxTriangles: expected a whole number, found -3"),
+        (options(&[("reparam", num(1.0))]), "option reparam: expected a string, found number"),
+        (options(&[("reparam", "sometimes".into())]), "option reparam: expected \"auto\", \"off\" or \"force\""),
+        (options(&[("mode", "slow".into())]), "option mode: expected one of \"fast\", \"quality\""),
+        (options(&[("size", "big".into())]), "option size: expected a number, found string"),
+        (options(&[("sizeRel", num(f64::INFINITY))]), "option sizeRel: expected a finite number, found inf"),
+        (options(&[("method", true.into())]), "option method: expected a string, found boolean"),
+        (options(&[("share", num(2.0))]), "option share: expected [index, count]"),
+        (options(&[("share", array(&[num(0.0), "2".into()]))]), "option share: expected [index, count]"),
+        (options(&[("share", array(&[num(1.0)]))]), "option share: expected [index, count]"),
+        (options(&[("units", num(25.4))]), "option units: expected a string, found number"),
+        (options(&[("units", "yd".into())]), "option units: expected"),
+        (options(&[("flatten", "yes".into())]), "option flatten: expected a boolean, found string"),
+        (options(&[("consoleWarnings", num(1.0))]), "option consoleWarnings: expected a boolean, found number"),
+        (options(&[("tol", num(0.1))]), "option tol: unknown option (known: tolerance, toleranceRel"),
+        (num(5.0), "options: expected an object like { toleranceRel: 0.001 }, found number"),
+        ("fine".into(), "options: expected an object like { toleranceRel: 0.001 }, found string"),
+        (array(&[]), "options: expected an object like { toleranceRel: 0.001 }, found an array"),
+    ];
+    for (opts, expected) in cases {
+        let m = thrown(binding::mesh(dome(), "json", opts.clone()));
+        assert!(m.starts_with(expected), "{opts:?}: expected {expected:?}, got {m:?}");
+        assert!(!m.contains('\n'), "{m:?}");
+    }
+    // Undefined and null are the defaults, for the whole object and for one option.
+    assert!(binding::mesh(dome(), "json", JsValue::NULL).is_ok());
+    assert!(binding::mesh(dome(), "json", options(&[("angle", JsValue::NULL)])).is_ok());
+}
+
+/// The options of `repair` and `fit` are read the same way.
+#[wasm_bindgen_test]
+fn each_bad_repair_and_fit_option_throws_one_line_naming_it() {
+    let stl = folded_ellipsoid_stl();
+    for (opts, expected) in [
+        (options(&[("bucketing", "grid".into())]), "option bucketing: expected \"kd\" or \"bvh\""),
+        (options(&[("bucketCapacity", num(0.5))]), "option bucketCapacity: expected a whole number, found 0.5"),
+        (options(&[("weldTolerance", "1e-9".into())]), "option weldTolerance: expected a number, found string"),
+        (options(&[("perturbation", true.into())]), "option perturbation: expected a number, found boolean"),
+        (options(&[("verify", num(1.0))]), "option verify: expected a boolean, found number"),
+        (options(&[("weld", num(1.0))]), "option weld: unknown option (known: bucketing"),
+        (num(1.0), "options: expected an object like { bucketing: \"kd\" }, found number"),
+    ] {
+        let m = thrown(binding::repair(&stl, "stl", opts));
+        assert!(m.starts_with(expected), "expected {expected:?}, got {m:?}");
+    }
+    let xyz = sphere_xyz();
+    for (opts, expected) in [
+        (options(&[("tolerance", "fine".into())]), "option tolerance: expected a number, found string"),
+        (options(&[("toleranceRel", true.into())]), "option toleranceRel: expected a number, found boolean"),
+        (options(&[("maxSides", num(40.0))]), "option maxSides: expected a whole number from 3 to 32, found 40"),
+        (options(&[("smooth", num(1.0))]), "option smooth: unknown option (known: tolerance, toleranceRel, maxSides)"),
+    ] {
+        let m = thrown(binding::fit(xyz.as_bytes(), "xyz", opts));
+        assert!(m.starts_with(expected), "expected {expected:?}, got {m:?}");
+    }
+}
+
+/// Field `name` of `v`.
+fn field(v: &JsValue, name: &str) -> JsValue {
+    Reflect::get(v, &name.into()).unwrap_or_else(|_| panic!("no field {name}"))
+}
+
+/// A column-major 4 × 4 matrix applied to the point `p`.
+fn apply(m: &[f64], p: &[f32]) -> [f64; 3] {
+    let (x, y, z) = (p[0] as f64, p[1] as f64, p[2] as f64);
+    [0, 1, 2].map(|r| m[r] * x + m[4 + r] * y + m[8 + r] * z + m[12 + r])
+}
+
+/// The two placed blocks of a STEP assembly: meshed once (one part mesh, six
+/// faces reported to progress, not twelve), placed twice; the tree has the
+/// file's names and placements; each instance's mesh under its matrix is the
+/// flattened mesh's faces of that instance vertex for vertex; every edge
+/// polyline point is a vertex of its part mesh.
+#[wasm_bindgen_test]
+fn step_assembly_instances_match_the_flattened_mesh() {
+    let bytes = include_bytes!("data/step_assembly.stp");
+    let counted = js_sys::Function::new_with_args("done, total", "globalThis.__surfmeshTotal = total;");
+    let v = binding::mesh_with_progress(bytes.to_vec(), "step", JsValue::UNDEFINED, &counted).expect("mesh");
+    assert_eq!(field(&js_sys::global(), "__surfmeshTotal").as_f64(), Some(6.0));
+    let meshes: Array = field(&v, "meshes").unchecked_into();
+    let instances: Array = field(&v, "instances").unchecked_into();
+    assert_eq!((meshes.length(), instances.length()), (1, 2));
+    let tree = field(&v, "tree");
+    assert_eq!(field(&tree, "name").as_string().as_deref(), Some("Assembly"));
+    let children: Array = field(&tree, "children").unchecked_into();
+    assert_eq!(children.length(), 2);
+    // The second placement turns the block a quarter about z (its x axis along y).
+    let placements = [("Block instance 1", 0.0, 1.0, 0.0), ("Block instance 2", 20.0, 0.0, 1.0)];
+    for (k, (occurrence, x, c, s)) in placements.into_iter().enumerate() {
+        let child = children.get(k as u32);
+        assert_eq!(field(&child, "name").as_string().as_deref(), Some("Block"));
+        assert_eq!(field(&child, "occurrence").as_string().as_deref(), Some(occurrence));
+        let m: Vec<f64> = Array::from(&field(&child, "matrix")).iter().map(|x| x.as_f64().unwrap()).collect();
+        assert_eq!(m, [c, s, 0.0, 0.0, -s, c, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, x, 0.0, 0.0, 1.0]);
+    }
+    let report = field(&v, "report");
+    assert_eq!(field(&report, "faces").as_f64(), Some(12.0));
+
+    let flat = binding::mesh(bytes.to_vec(), "step", options(&[("flatten", true.into())])).expect("flat");
+    let f32s = |v: &JsValue, n: &str| field(v, n).unchecked_into::<Float32Array>().to_vec();
+    let u32s = |v: &JsValue, n: &str| field(v, n).unchecked_into::<Uint32Array>().to_vec();
+    let (flat_pos, flat_idx, flat_ranges) =
+        (f32s(&flat, "positions"), u32s(&flat, "indices"), u32s(&flat, "faceRanges"));
+    let face_parts = u32s(&flat, "faceParts");
+    assert_eq!(field(&field(&flat, "report"), "triangles").as_f64(), field(&report, "triangles").as_f64());
+    let mut compared = 0;
+    for k in 0..instances.length() {
+        let inst = instances.get(k);
+        let part = meshes.get(field(&inst, "part").as_f64().unwrap() as u32);
+        let m: Vec<f64> = Array::from(&field(&inst, "matrix")).iter().map(|x| x.as_f64().unwrap()).collect();
+        let (pos, idx, ranges) = (f32s(&part, "positions"), u32s(&part, "indices"), u32s(&part, "faceRanges"));
+        let flat_faces: Vec<usize> = (0..face_parts.len()).filter(|&f| face_parts[f] == k).collect();
+        assert_eq!(2 * flat_faces.len(), ranges.len());
+        for (j, &f) in flat_faces.iter().enumerate() {
+            let (a, n) = (ranges[2 * j] as usize, ranges[2 * j + 1] as usize);
+            let (fa, fnn) = (flat_ranges[2 * f] as usize, flat_ranges[2 * f + 1] as usize);
+            assert_eq!(n, fnn, "instance {k} face {j}");
+            for t in 0..3 * n {
+                let p = apply(&m, &pos[3 * idx[3 * a + t] as usize..]);
+                let q = &flat_pos[3 * flat_idx[3 * fa + t] as usize..];
+                for c in 0..3 {
+                    assert!((p[c] - q[c] as f64).abs() < 1e-4, "instance {k} face {j}: {p:?} vs {q:?}");
+                }
+                compared += 1;
+            }
+        }
+        // The outlines run through the mesh's vertices.
+        let edges = f32s(&part, "edges");
+        let edge_ranges = u32s(&part, "edgeRanges");
+        assert!(edge_ranges.len() >= 2 * 12, "a block has 12 edges: {edge_ranges:?}");
+        for e in edges.chunks(3) {
+            assert!(pos.chunks(3).any(|p| p == e), "edge point {e:?} is not a vertex");
+        }
+    }
+    assert_eq!(compared, flat_idx.len());
 }

@@ -1,28 +1,43 @@
 //! Readers (bytes in, [`Model`] or [`crate::Mesh`] out) and mesh writers (bytes out).
 
+#[cfg(feature = "writers")]
 mod glb;
 mod iges;
+#[cfg(feature = "writers")]
 mod iges_write;
 mod json;
+#[cfg(feature = "repair")]
 mod meshfile;
+#[cfg(feature = "writers")]
 mod msh;
+#[cfg(feature = "writers")]
 mod obj;
 mod step;
+#[cfg(feature = "writers")]
 mod stl;
+#[cfg(feature = "writers")]
 mod unv;
 
 use alloc::format;
 
+#[cfg(feature = "writers")]
 pub use glb::{write_glb, write_glb_scaled};
 pub use iges::read_iges;
+#[cfg(feature = "writers")]
 pub use iges_write::write_iges;
 pub use json::read_json;
+#[cfg(feature = "repair")]
 pub(crate) use meshfile::MAX_COORDINATE;
+#[cfg(feature = "repair")]
 pub use meshfile::{read_mesh, MeshFormat};
+#[cfg(feature = "writers")]
 pub use msh::{read_msh, write_msh};
+#[cfg(feature = "writers")]
 pub use obj::write_obj;
 pub use step::{read_step, read_step_parts, read_step_with_shells, StepModel, StepShell};
+#[cfg(feature = "writers")]
 pub use stl::write_stl;
+#[cfg(feature = "writers")]
 pub use unv::{write_unv, UNV_SHELL_TRIANGLE};
 
 use crate::{Error, Model};

@@ -7,6 +7,9 @@ use glam::{DVec2, DVec3};
 
 use crate::nurbs::{Aabb, NurbsCurve, NurbsSurface, Surface, SurfaceDerivs};
 
+mod assembly;
+pub use assembly::{Assembly, AssemblyNode, PartInstance};
+
 /// Everything read from one input file.
 #[derive(Debug, Clone, Default)]
 pub struct Model {

@@ -52,7 +52,12 @@ test('a Node script imports the package by name and meshes the sample', () => {
   assert.deepEqual(s.rethrown, { name: 'TypeError', message: 'stop here' }, "the callback's exception comes back as it was");
 });
 
-test('a Vite-built page meshes the same sample on its thread and in a worker', async () => {
+/** The hex three.js gives an sRGB colour of 0..1 components. */
+function rgbHex(r, g, b) {
+  return [r, g, b].map((c) => Math.round(c * 255).toString(16).padStart(2, '0')).join('');
+}
+
+test('a Vite-built page meshes the same sample on its thread and in a worker, and SurfmeshLoader loads a STEP assembly', async () => {
   const page = await open(env.browser, `${env.url}consumer/`, { width: 800, height: 500 });
   await page.waitForSelector('#result[data-state="done"], #result[data-state="error"]', { timeout: 30000 });
   const text = await page.textContent('#result');
@@ -65,6 +70,24 @@ test('a Vite-built page meshes the same sample on its thread and in a worker', a
   assert.equal(s.workerProgressCalls, 50);
   assert.equal(s.groups, 50, 'surfmesh/three makes one group per face');
   assert.ok(s.sharesArrays, 'surfmesh/three wraps the arrays without copying them');
+  // SurfmeshLoader, worker-backed: the STEP assembly's two placed blocks are one part drawn twice.
+  const l = s.loader;
+  assert.equal(l.name, 'Assembly');
+  assert.deepEqual(l.children, [
+    ['Block', 'Block instance 1'],
+    ['Block', 'Block instance 2'],
+  ]);
+  assert.equal(l.instancedMeshes, 1);
+  assert.deepEqual(l.copies, [2]);
+  assert.deepEqual(l.groupsPerPart, [6], 'one draw group per face');
+  // The file colours the solid (0.8, 0.25, 0.1) and one face blue.
+  assert.deepEqual(new Set(l.materials[0]), new Set([rgbHex(0.8, 0.25, 0.1), '0000ff']));
+  assert.equal(l.lines, 2, 'edge lines for each copy');
+  assert.equal(l.meshProgress, 6, 'the loader reports each face of the one part meshed');
+  assert.equal(l.triangles, l.flatTriangles);
+  // The InstancedMesh copies, under their matrices, are the flattened mesh vertex for vertex.
+  assert.equal(l.compared, l.flatCorners);
+  assert.ok(l.worst < 1e-4, `largest distance ${l.worst}`);
   assert.deepEqual(page.errors, []);
   await page.context().close();
 });

@@ -5,7 +5,7 @@ import { readFileSync } from 'node:fs';
 import { mesh, meshWithProgress, version } from 'surfmesh';
 
 const bytes = readFileSync(new URL('../../www/samples/grid50.json', import.meta.url));
-const result = mesh(bytes, 'json', { toleranceRel: 1e-3 });
+const result = mesh(bytes, 'json', { toleranceRel: 1e-3, flatten: true });
 const seen = [];
 const again = meshWithProgress(bytes, 'json', { toleranceRel: 1e-3 }, (done, total) => {
   seen.push([done, total]);

@@ -1,5 +1,6 @@
 //! Native integration tests, one binary.
 
+mod assembly;
 mod cli;
 mod corpus_files;
 mod fit;

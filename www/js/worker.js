@@ -13,6 +13,8 @@
 // meshes the default sample from its own fetch, so the first mesh never waits
 // for the page's thread (busy parsing three.js while this runs).
 //
+// The full build is imported on the first quality-mode request.
+//
 // Messages in:  { type: 'init', module } | { type: 'boot', wasm, sample?, id, options }
 //               then { type: 'mesh', id, bytes, format, options }
 // Messages out: { type: 'module', module } | { type: 'module', error } (after boot) | { type: 'ready' } | { type: 'fatal', message }
@@ -21,6 +23,17 @@
 //               { type: 'error', id, message }
 
 import init, { meshWithProgress, version } from '../pkg/web/surfmesh.js';
+
+// The package's full build (surfmesh/full), loaded the first time a request
+// needs what only it has (quality mode); the viewer build does the rest.
+let full = null;
+function fullBuild() {
+  full ??= import('../pkg/full/web/surfmesh.js').then(async (m) => {
+    await m.default();
+    return m;
+  });
+  return full;
+}
 
 // Settles when the module is loaded: to null, or to the reason it could not load.
 // A request that arrives first waits for it.
@@ -84,7 +97,9 @@ async function run(id, bytes, format, options) {
   }
   let result;
   try {
-    result = meshWithProgress(new Uint8Array(bytes), format, options, (done, total) => {
+    // The page draws one merged mesh (flatten); quality mode is the full build's.
+    const build = options?.mode === 'quality' ? await fullBuild() : { meshWithProgress };
+    result = build.meshWithProgress(new Uint8Array(bytes), format, { ...options, flatten: true }, (done, total) => {
       self.postMessage({ type: 'progress', id, done, total });
     });
   } catch (e) {

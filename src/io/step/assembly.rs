@@ -20,6 +20,7 @@ use glam::{DAffine3, DVec3};
 use super::curves::Geo;
 use super::graph::{Ent, Graph, Value};
 use super::{MAX_DEPTH, MAX_FACES};
+use crate::model::{Assembly, AssemblyNode, PartInstance};
 use crate::Error;
 
 /// One shape item to read, placed.
@@ -36,14 +37,32 @@ pub(super) struct Placed {
     /// Product name of the part.
     pub name: Option<String>,
     /// Which part instance the item belongs to: items placed together by
-    /// one assembly path share it.
+    /// one assembly path share it. It is the index of that path's node in
+    /// [`Plan::nodes`].
     pub instance: usize,
+}
+
+/// One visit of the walk down the placements: a node of the product tree.
+#[derive(Debug, Clone)]
+pub(super) struct PlanNode {
+    /// The node it was placed in (`None`: a root).
+    pub parent: Option<usize>,
+    /// Product name, as [`Placed::name`].
+    pub name: Option<String>,
+    /// The occurrence's own name (`NEXT_ASSEMBLY_USAGE_OCCURRENCE.name`).
+    pub occurrence: Option<String>,
+    /// From the node's coordinates to its parent's, output unit.
+    pub local: DAffine3,
+    /// From the node's coordinates to the output's, output unit.
+    pub world: DAffine3,
 }
 
 /// What to read.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Plan {
     pub placed: Vec<Placed>,
+    /// The product tree as the walk found it; `Placed::instance` indexes it.
+    pub nodes: Vec<PlanNode>,
     pub units: String,
     pub tolerance: Option<f64>,
 }
@@ -133,7 +152,9 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
     // Groups: representations related without a transformation.
     let n = reps.len();
     let mut parent: Vec<usize> = (0..n).collect();
-    let mut edges: Vec<(u64, u64, DAffine3, Option<String>)> = Vec::new(); // parent rep, child rep, child→parent (mm)
+    // Parent rep, child rep, child→parent (mm), product name, occurrence name.
+    type Edge = (u64, u64, DAffine3, Option<String>, Option<String>);
+    let mut edges: Vec<Edge> = Vec::new();
     let cdsr = cdsr_products(g);
     let product_of_rep = rep_products(g);
     for e in g.all() {
@@ -163,13 +184,14 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
         };
         // rep_1 is the child unless the product structure says otherwise.
         let (child, par, m) = match cdsr.get(&e.id()) {
-            Some((_, child_pd)) if product_of_rep.get(&r2).is_some_and(|(pd, _)| pd == child_pd) => {
+            Some((_, child_pd, _)) if product_of_rep.get(&r2).is_some_and(|(pd, _)| pd == child_pd) => {
                 (r2, r1, m1 * m2.inverse())
             }
             _ => (r1, r2, m2 * m1.inverse()),
         };
-        let name = cdsr.get(&e.id()).and_then(|(n, _)| n.clone());
-        edges.push((par, child, m, name));
+        let name = cdsr.get(&e.id()).and_then(|(n, _, _)| n.clone());
+        let occurrence = cdsr.get(&e.id()).and_then(|(_, _, o)| o.clone());
+        edges.push((par, child, m, name, occurrence));
     }
     // Mapped items.
     for (ri, (rid, items, _)) in reps.iter().enumerate() {
@@ -188,19 +210,20 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
             let gt = Geo { g, angle: units[ri].rad, uncertainty: 0.0 };
             let m =
                 in_mm(gt.transform(a.ent(2)?)?, units[ri].mm) * in_mm(go.transform(origin)?, units[ci].mm).inverse();
-            edges.push((*rid, child, m, None));
+            edges.push((*rid, child, m, None, None));
         }
     }
     // Groups and their children.
     let group = |parent: &mut Vec<usize>, rep: u64| rep_index.get(&rep).map(|&i| root(parent, i));
-    let mut children: HashMap<usize, Vec<(usize, DAffine3, Option<String>)>> = HashMap::default();
+    type Child = (usize, DAffine3, Option<String>, Option<String>);
+    let mut children: HashMap<usize, Vec<Child>> = HashMap::default();
     let mut is_child: HashSet<usize> = HashSet::default();
-    for (p, c, m, name) in &edges {
+    for (p, c, m, name, occurrence) in &edges {
         let (Some(gp), Some(gc)) = (group(&mut parent, *p), group(&mut parent, *c)) else { continue };
         if gp == gc {
             continue;
         }
-        children.entry(gp).or_default().push((gc, *m, name.clone()));
+        children.entry(gp).or_default().push((gc, *m, name.clone(), occurrence.clone()));
         is_child.insert(gc);
     }
     let mut members: HashMap<usize, Vec<usize>> = HashMap::default();
@@ -238,10 +261,15 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
             || members.get(&gi).is_some_and(|ms| ms.iter().any(|&i| product_of_rep.contains_key(&reps[i].0)))
     };
     roots.sort_by_key(|&r| !in_products(r));
-    let mut stack: Vec<(usize, DAffine3, Option<String>, usize)> =
-        roots.iter().rev().map(|&r| (r, DAffine3::IDENTITY, None, 0)).collect();
+    // The output unit's view of a map between millimetre coordinates.
+    let out_map = |m: DAffine3| scale_out * m * scale_out.inverse();
+    /// A node to visit: its group, its map to the output (mm), its name, its
+    /// depth, its parent node, its map to the parent (mm) and its occurrence name.
+    type Visit = (usize, DAffine3, Option<String>, usize, Option<usize>, DAffine3, Option<String>);
+    let mut stack: Vec<Visit> =
+        roots.iter().rev().map(|&r| (r, DAffine3::IDENTITY, None, 0, None, DAffine3::IDENTITY, None)).collect();
     let mut visits = 0usize;
-    while let Some((gi, m, name, depth)) = stack.pop() {
+    while let Some((gi, m, name, depth, up, local, occurrence)) = stack.pop() {
         visits += 1;
         if depth > MAX_DEPTH || visits > MAX_FACES {
             warnings.push(format!(
@@ -254,6 +282,14 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
             .get(&gi)
             .and_then(|ms| ms.iter().find_map(|&i| product_of_rep.get(&reps[i].0).and_then(|(_, n)| n.clone())));
         let name = own_name.or(name);
+        let node = plan.nodes.len();
+        plan.nodes.push(PlanNode {
+            parent: up,
+            name: name.clone(),
+            occurrence,
+            local: out_map(local),
+            world: out_map(m),
+        });
         for &i in members.get(&gi).map_or(&[][..], Vec::as_slice) {
             let u = units[i];
             for &it in &reps[i].1 {
@@ -277,13 +313,13 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
                     angle: u.rad,
                     uncertainty: u.uncertainty / u.mm,
                     name: name.clone(),
-                    instance: visits,
+                    instance: node,
                 });
             }
         }
         if let Some(kids) = children.get(&gi) {
-            for (c, cm, cname) in kids.iter().rev() {
-                stack.push((*c, m * *cm, cname.clone().or(name.clone()), depth + 1));
+            for (c, cm, cname, occ) in kids.iter().rev() {
+                stack.push((*c, m * *cm, cname.clone().or(name.clone()), depth + 1, Some(node), *cm, occ.clone()));
             }
         }
     }
@@ -306,14 +342,21 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
         let top = ["MANIFOLD_SOLID_BREP", "BREP_WITH_VOIDS", "FACETED_BREP", "SHELL_BASED_SURFACE_MODEL"];
         if top.iter().any(|n| e.has(n)) && !emitted.contains(&e.id()) && !nested.contains(&e.id()) {
             warnings.push(format!("#{} {}: not in any representation; read in place", e.id(), e.type_name()));
-            visits += 1;
+            let node = plan.nodes.len();
+            plan.nodes.push(PlanNode {
+                parent: None,
+                name: None,
+                occurrence: None,
+                local: DAffine3::IDENTITY,
+                world: DAffine3::IDENTITY,
+            });
             plan.placed.push(Placed {
                 item: e.id(),
                 m: DAffine3::IDENTITY,
                 angle: 1.0,
                 uncertainty: 0.0,
                 name: None,
-                instance: visits,
+                instance: node,
             });
         }
     }
@@ -333,6 +376,100 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
     });
     plan.tolerance = (tol > 0.0 && tol.is_finite()).then_some(tol);
     Ok(plan)
+}
+
+/// The product tree and the part instances of the read faces. `placed`
+/// gives each face's placement (the first `exact` faces are exact, the
+/// rest tessellated), `face_parts` its part instance. Two instances share a
+/// shape when their faces come from the same items, in the same order and
+/// numbers; nodes without an instance below them are left out, and several
+/// roots get a common unnamed root.
+pub(super) fn tree(
+    nodes: &[PlanNode],
+    placed: &[Option<&Placed>],
+    exact: usize,
+    face_parts: &[u32],
+    parts: usize,
+) -> Assembly {
+    // Each instance's node, and its faces' items run by run.
+    type Run = (bool, u64, u64, u64, u32);
+    let mut node_of = alloc::vec![usize::MAX; parts];
+    let mut runs: Vec<Vec<Run>> = alloc::vec![Vec::new(); parts];
+    for (f, (p, &k)) in placed.iter().zip(face_parts).enumerate() {
+        let k = k as usize;
+        let Some(p) = p else { continue };
+        node_of[k] = p.instance;
+        let key = (f >= exact, p.item, p.angle.to_bits(), p.uncertainty.to_bits());
+        match runs[k].last_mut() {
+            Some(r) if (r.0, r.1, r.2, r.3) == key => r.4 += 1,
+            _ => runs[k].push((key.0, key.1, key.2, key.3, 1)),
+        }
+    }
+    let mut shape_of: HashMap<Vec<Run>, usize> = HashMap::default();
+    let shapes: Vec<usize> = runs
+        .into_iter()
+        .map(|r| {
+            let next = shape_of.len();
+            *shape_of.entry(r).or_insert(next)
+        })
+        .collect();
+    // Nodes that hold an instance, or have one below them.
+    let mut keep = alloc::vec![false; nodes.len()];
+    for &n in &node_of {
+        let mut at = (n < nodes.len()).then_some(n);
+        while let Some(i) = at {
+            if keep[i] {
+                break;
+            }
+            keep[i] = true;
+            at = nodes[i].parent;
+        }
+    }
+    let roots: Vec<usize> = (0..nodes.len()).filter(|&i| keep[i] && nodes[i].parent.is_none()).collect();
+    let shared_root = roots.len() != 1;
+    let mut out: Vec<AssemblyNode> = Vec::new();
+    if shared_root {
+        out.push(AssemblyNode::new(""));
+    }
+    let mut index = alloc::vec![usize::MAX; nodes.len()];
+    for (i, n) in nodes.iter().enumerate() {
+        if !keep[i] {
+            continue;
+        }
+        index[i] = out.len();
+        let mut a = AssemblyNode::new(n.name.clone().unwrap_or_default());
+        a.occurrence = n.occurrence.clone();
+        a.matrix = n.local;
+        out.push(a);
+    }
+    // Children in the walk's order (a parent is always visited before its children).
+    for (i, n) in nodes.iter().enumerate() {
+        if !keep[i] {
+            continue;
+        }
+        let parent = match n.parent {
+            Some(p) => index[p],
+            None if shared_root => 0,
+            None => continue,
+        };
+        if let Some(p) = out.get_mut(parent) {
+            p.children.push(index[i]);
+        }
+    }
+    let root_world = |n: usize| nodes.get(n).map_or(DAffine3::IDENTITY, |n| n.world);
+    let mut instances = Vec::with_capacity(parts);
+    for (k, &n) in node_of.iter().enumerate() {
+        let node = index.get(n).copied().unwrap_or(0);
+        if let Some(a) = out.get_mut(node) {
+            a.instances.push(k);
+        }
+        instances.push(PartInstance { node, shape: shapes[k], matrix: root_world(n) });
+    }
+    let mut assembly = Assembly::single("", 0);
+    assembly.nodes = out;
+    assembly.instances = instances;
+    assembly.face_instances = face_parts.to_vec();
+    assembly
 }
 
 /// The affine map with its translation turned from `mm` per unit into millimetres.
@@ -471,8 +608,8 @@ fn rep_products(g: &Graph) -> HashMap<u64, (u64, Option<String>)> {
 }
 
 /// For each transformed relation a `CONTEXT_DEPENDENT_SHAPE_REPRESENTATION`
-/// names: the child part's name and product definition.
-fn cdsr_products(g: &Graph) -> HashMap<u64, (Option<String>, u64)> {
+/// names: the child part's name and product definition, and the occurrence's name.
+fn cdsr_products(g: &Graph) -> HashMap<u64, (Option<String>, u64, Option<String>)> {
     let mut out = HashMap::default();
     for e in g.all() {
         if !e.has("CONTEXT_DEPENDENT_SHAPE_REPRESENTATION") {
@@ -486,7 +623,8 @@ fn cdsr_products(g: &Graph) -> HashMap<u64, (Option<String>, u64)> {
         }
         let na = nauo.attrs();
         let Ok(child) = na.ent(4) else { continue };
-        out.insert(rel, (product_name(child), child.id()));
+        let occurrence = na.string(1).ok().map(|s| String::from(s.trim())).filter(|s| !s.is_empty());
+        out.insert(rel, (product_name(child), child.id(), occurrence));
     }
     out
 }

@@ -30,7 +30,7 @@ use alloc::string::String;
 use alloc::vec::Vec;
 use core::ops::Range;
 
-use crate::model::SkippedFace;
+use crate::model::{Assembly, SkippedFace};
 use crate::{Error, Model};
 
 /// Deepest chain of references followed (composite curves, offsets,
@@ -83,6 +83,10 @@ pub struct StepModel {
     /// For each face of the mesh, its colour (red, green, blue in 0..=1) from the file's
     /// `STYLED_ITEM`s: the face's own, else its shell's, else its solid's.
     pub face_colours: Vec<Option<[f32; 3]>>,
+    /// The product tree (names, placements) and the part instances, numbered
+    /// as [`StepModel::parts`]: instances placed from the same items of the
+    /// file share a shape, so that they can be meshed once.
+    pub assembly: Assembly,
 }
 
 /// Reads a STEP file (ISO 10303-21).
@@ -122,13 +126,13 @@ pub fn read_step_with_shells(bytes: &[u8]) -> Result<(Model, Vec<StepShell>), Er
 pub fn read_step_parts(bytes: &[u8]) -> Result<StepModel, Error> {
     let g = parser::parse(bytes)?;
     let mut warnings = g.forgiven.warnings();
-    let assembly::Plan { placed, units, tolerance } = assembly::plan(&g, &mut warnings)?;
+    let assembly::Plan { placed, nodes, units, tolerance } = assembly::plan(&g, &mut warnings)?;
     // Exact shapes and tessellated ones are read apart, each with its own
     // share of the placements.
     let (tess_placed, exact_placed): (Vec<assembly::Placed>, Vec<assembly::Placed>) =
         placed.into_iter().partition(|p| g.find(p.item).is_some_and(tessellated::is_tessellated));
-    let exact_plan = assembly::Plan { placed: exact_placed, units: units.clone(), tolerance };
-    let tess_plan = assembly::Plan { placed: tess_placed, units: units.clone(), tolerance };
+    let exact_plan = assembly::Plan { placed: exact_placed, nodes: Vec::new(), units: units.clone(), tolerance };
+    let tess_plan = assembly::Plan { placed: tess_placed, nodes: Vec::new(), units: units.clone(), tolerance };
     let shapes = shapes::read_shapes(&g, &exact_plan, &mut warnings)?;
     let exact = if shapes.faces.is_empty() {
         crate::collections::HashSet::default()
@@ -171,6 +175,7 @@ pub fn read_step_parts(bytes: &[u8]) -> Result<StepModel, Error> {
         });
         face_parts.push(k);
     }
+    let assembly = assembly::tree(&nodes, &placed, shapes.placement.len(), &face_parts, parts.len());
     // Each shell instance is a body of its own. A part instance whose exact
     // faces are one body (a solid, a shell) takes into it the tessellated
     // faces it lists on their own and its tessellated shells: they are the
@@ -230,7 +235,7 @@ pub fn read_step_parts(bytes: &[u8]) -> Result<StepModel, Error> {
         })
         .collect();
     let model = Model { units, faces, warnings, tolerance, bodies, tessellated, skipped };
-    Ok(StepModel { model, shells, parts, face_parts, face_colours })
+    Ok(StepModel { model, shells, parts, face_parts, face_colours, assembly })
 }
 
 /// Why a file that parsed gave no face at all: what it holds instead.

@@ -8,7 +8,7 @@ self.onmessage = async (event) => {
   try {
     await ready;
     let progressCalls = 0;
-    const result = meshWithProgress(event.data, 'json', { toleranceRel: 1e-3 }, () => {
+    const result = meshWithProgress(event.data, 'json', { toleranceRel: 1e-3, flatten: true }, () => {
       progressCalls++;
     });
     self.postMessage({ triangles: result.report.triangles, progressCalls });
