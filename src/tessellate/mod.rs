@@ -220,7 +220,16 @@ pub fn mesh_model_with_progress(
         let loops = loops_of(f);
         let ready = made.into_iter().find(|(g, l, _)| core::ptr::eq(*g, f) && l.same_as(&face_lim)).map(|(_, _, o)| o);
         match Chosen::new(index, f, loops, face_lim, face_crit, fit_error, ready) {
-            Ok(c) => chosen.push(Some(c)),
+            Ok(c) => {
+                if let Some(along) = c.capped_grid() {
+                    report.warnings.push(format!(
+                        "face {index}: the grid along {along} stopped at its cap of {} lines (the surface's \
+                         normals or sag never settle there); refinement still holds the tolerance",
+                        params::MAX_PARAMS
+                    ));
+                }
+                chosen.push(Some(c));
+            }
             // One face that cannot be meshed does not sink the others; a
             // model where none can is the first face's error.
             Err(Error::Mesh { face, message }) if model.faces.len() > 1 => {
@@ -591,6 +600,23 @@ impl<'a> Chosen<'a> {
             lim,
             crit,
         })
+    }
+
+    /// The direction (`"u"` or `"v"`) whose grid lines reached
+    /// [`params::MAX_PARAMS`], where the interval tests stopped splitting
+    /// before they passed.
+    fn capped_grid(&self) -> Option<&'static str> {
+        #[cfg(feature = "std")]
+        {
+            let capped = |p: &[f64]| p.len() >= params::MAX_PARAMS;
+            if capped(&self.outline.pu) {
+                return Some("u");
+            }
+            if capped(&self.outline.pv) {
+                return Some("v");
+            }
+        }
+        None
     }
 
     /// Whether a loop of the sewn outline passes one node twice.

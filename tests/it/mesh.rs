@@ -666,3 +666,30 @@ fn mesh_sliver_knot_span_meshes_like_its_clean_twin() {
         );
     }
 }
+
+/// A grid direction that reaches its cap of lines says so: a strip whose
+/// edge limit asks for five times the cap along its length gets a warning
+/// naming the face and the direction. (The budget then skips the strip, so
+/// that the test does not refine its 40 000 triangles; a speck of a face
+/// first keeps the model meshable.)
+#[test]
+fn mesh_warns_when_a_grid_direction_reaches_its_cap() {
+    let square = |o: DVec3, w: f64, h: f64| {
+        let pts =
+            vec![vec![o, o + DVec3::new(0.0, h, 0.0)], vec![o + DVec3::new(w, 0.0, 0.0), o + DVec3::new(w, h, 0.0)]];
+        let s = NurbsSurface::try_new([1, 1], vec![0.0, 0.0, 1.0, 1.0], vec![0.0, 0.0, 1.0, 1.0], &pts, None)
+            .expect("square");
+        Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] }
+    };
+    let speck = square(DVec3::new(5.0, 0.0, 0.0), 5e-6, 5e-6);
+    let strip = square(DVec3::ZERO, 1.0, 1e-4);
+    let model = Model { faces: vec![speck, strip], ..Default::default() };
+    // A tolerance far below the edge limit: sewing then looks at a few of
+    // the border's 40 000 nodes at a time, not at thousands.
+    let opts = MeshOptions::default().with_relative_tolerance(1e-6).with_max_edge(Some(1e-5)).with_max_triangles(1000);
+    let r = mesh_model(&model, &opts).expect("meshes");
+    let capped: Vec<&String> = r.report.warnings.iter().filter(|w| w.contains("stopped at its cap")).collect();
+    assert_eq!(capped.len(), 1, "{:?}", r.report.warnings);
+    assert!(capped[0].starts_with("face 1: the grid along u"), "{}", capped[0]);
+    assert_eq!(r.report.faces_skipped, 1, "{:?}", r.report.warnings);
+}
