@@ -147,7 +147,10 @@ fn face_lookup(mesh: &Mesh) -> impl Fn(usize) -> u32 + '_ {
 
 /// A free edge is a crack when a vertex or midpoint of a free edge of another
 /// face of its body lies within `sew` (and within a fifth of the edge's
-/// length) of its quarter, half or three-quarter point.
+/// length) of its quarter, half or three-quarter point. A vertex on the
+/// edge's own face's border too is not: the two faces are joined there, and
+/// the edge passes it where its own face is narrower than `sew` (a strip
+/// whose far side comes near a corner it shares with a neighbour).
 fn count_cracks(free: &[(u32, u32, u32)], pos: &dyn Fn(u32) -> DVec3, sew: f64, body: &dyn Fn(u32) -> u32) -> usize {
     if free.is_empty() || !(sew > 0.0 && sew.is_finite()) {
         return 0;
@@ -181,7 +184,7 @@ fn count_cracks(free: &[(u32, u32, u32)], pos: &dyn Fn(u32) -> DVec3, sew: f64, 
                 let other = f != face
                     && body(f) == body(face)
                     && match tag {
-                        Tag::Vertex(v) => v != a && v != b,
+                        Tag::Vertex(v) => v != a && v != b && !seen.contains(&(v, face)),
                         Tag::Mid => true,
                     };
                 other && p.distance(q) < reach
@@ -229,4 +232,46 @@ pub(crate) fn min_angle(t: [DVec3; 3]) -> f64 {
         m = m.min(ang);
     }
     m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::FaceRange;
+
+    /// Two faces on the plane z = 0: `a`'s triangles, then `b`'s.
+    fn two_faces(pts: &[(f64, f64)], a: &[[u32; 3]], b: &[[u32; 3]]) -> Mesh {
+        let indices: Vec<u32> = a.iter().chain(b).flatten().copied().collect();
+        Mesh {
+            positions: pts.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect(),
+            normals: Vec::new(),
+            indices,
+            face_ranges: alloc::vec![
+                FaceRange { first: 0, count: a.len() as u32 },
+                FaceRange { first: a.len() as u32, count: b.len() as u32 }
+            ],
+        }
+    }
+
+    /// A T-junction: face b's border has a node in the middle of face a's
+    /// edge, which a lacks. That edge is a crack.
+    #[test]
+    fn a_node_of_another_face_along_a_free_edge_is_a_crack() {
+        let pts = [(0.0, 0.0), (4.0, 0.0), (2.0, -2.0), (2.0, 0.0), (1.0, 2.0), (3.0, 2.0)];
+        let m = two_faces(&pts, &[[0, 2, 1]], &[[0, 3, 4], [3, 1, 5], [3, 5, 4]]);
+        assert_eq!(edge_counts(&m, 1e-9, 1.0).free_edges, 1);
+    }
+
+    /// A strip 0.5 wide (face a, its top border through node 4) that face b
+    /// touches at node 4 alone: the strip's bottom edge passes node 4 at
+    /// half a unit, within the sewing distance, yet the two faces are
+    /// joined there, and nothing is missing.
+    #[test]
+    fn a_corner_both_faces_have_is_no_crack_of_a_narrow_face() {
+        let pts = [(0.0, 0.0), (10.0, 0.0), (10.0, 0.5), (0.0, 0.5), (5.0, 0.5), (4.0, 3.0), (6.0, 3.0)];
+        let m = two_faces(&pts, &[[0, 1, 4], [1, 2, 4], [0, 4, 3]], &[[4, 6, 5]]);
+        let c = edge_counts(&m, 1e-9, 1.0);
+        assert_eq!(c.boundary_edges, 8);
+        assert_eq!(c.free_edges, 0);
+    }
 }
