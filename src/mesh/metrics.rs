@@ -32,6 +32,22 @@ pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
 /// crack only next to another border of its own body, so parts of an
 /// assembly that touch are counted each on its own.
 pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol: f64) -> EdgeCounts {
+    edge_census(mesh, bodies, weld_tol, sew_tol).0
+}
+
+/// Where two faces' borders run side by side unjoined (see [`edge_census`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Gap {
+    /// The two faces, the lower index first.
+    pub faces: (u32, u32),
+    /// The widest distance, over their cracks, from a crack edge to the
+    /// nearest border point of the other face beside it.
+    pub width: f64,
+}
+
+/// As [`edge_counts_in_bodies`], with the gaps of the cracks: per pair of
+/// faces whose borders crack apart, how far apart they lie.
+pub(crate) fn edge_census(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol: f64) -> (EdgeCounts, Vec<Gap>) {
     let (mut map, mut nverts) = weld_positions(&mesh.positions, weld_tol);
     let face_of = face_lookup(mesh);
     let body_of_face = |f: u32| crate::model::body_of(bodies, f as usize);
@@ -133,8 +149,17 @@ pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol
     }
     drop((at, start, around));
     out.boundary_edges = free.len();
-    out.free_edges = count_cracks(&free, &pos, sew_tol, &body_of_face);
-    out
+    let cracks = find_cracks(&free, &pos, sew_tol, &body_of_face);
+    out.free_edges = cracks.len();
+    let mut gaps: Vec<Gap> = Vec::new();
+    for (faces, width) in cracks {
+        match gaps.iter_mut().find(|g| g.faces == faces) {
+            Some(g) => g.width = g.width.max(width),
+            None => gaps.push(Gap { faces, width }),
+        }
+    }
+    gaps.sort_by(|a, b| a.faces.cmp(&b.faces));
+    (out, gaps)
 }
 
 /// Face index of each triangle, from the mesh's face ranges (0 when absent).
@@ -151,9 +176,17 @@ fn face_lookup(mesh: &Mesh) -> impl Fn(usize) -> u32 + '_ {
 /// edge's own face's border too is not: the two faces are joined there, and
 /// the edge passes it where its own face is narrower than `sew` (a strip
 /// whose far side comes near a corner it shares with a neighbour).
-fn count_cracks(free: &[(u32, u32, u32)], pos: &dyn Fn(u32) -> DVec3, sew: f64, body: &dyn Fn(u32) -> u32) -> usize {
+/// Returns, per crack, the two faces (lower first) and the distance from the
+/// edge to the nearest border point of the other face beside it.
+fn find_cracks(
+    free: &[(u32, u32, u32)],
+    pos: &dyn Fn(u32) -> DVec3,
+    sew: f64,
+    body: &dyn Fn(u32) -> u32,
+) -> Vec<((u32, u32), f64)> {
+    let mut cracks = Vec::new();
     if free.is_empty() || !(sew > 0.0 && sew.is_finite()) {
-        return 0;
+        return cracks;
     }
     // Points of interest: free-edge vertices (tag = vertex id) and midpoints (tag = edge index).
     #[derive(Clone, Copy)]
@@ -173,28 +206,41 @@ fn count_cracks(free: &[(u32, u32, u32)], pos: &dyn Fn(u32) -> DVec3, sew: f64, 
         let m = (pos(a) + pos(b)) * 0.5;
         grid.insert(m, (m, Tag::Mid, f));
     }
-    let mut cracks = 0;
     for &(a, b, face) in free {
         let (pa, pb) = (pos(a), pos(b));
         // Relative to the edge too: an open border's own neighbours sit half an edge away.
         let reach = sew.min(0.2 * pa.distance(pb));
-        let hit = [0.25, 0.5, 0.75].iter().any(|&f| {
-            let q = pa.lerp(pb, f);
-            grid.near(q).any(|&(p, tag, f)| {
+        // The nearest other face's border point beside the edge, and that face.
+        let mut hit: Option<(f64, u32)> = None;
+        for q in [0.25, 0.5, 0.75].map(|f| pa.lerp(pb, f)) {
+            for &(p, tag, f) in grid.near(q) {
                 let other = f != face
                     && body(f) == body(face)
                     && match tag {
                         Tag::Vertex(v) => v != a && v != b && !seen.contains(&(v, face)),
                         Tag::Mid => true,
                     };
-                other && p.distance(q) < reach
-            })
-        });
-        if hit {
-            cracks += 1;
+                if other && p.distance(q) < reach {
+                    let width = to_segment(p, pa, pb);
+                    if hit.is_none_or(|h| width < h.0) {
+                        hit = Some((width, f));
+                    }
+                }
+            }
+        }
+        if let Some((width, f)) = hit {
+            cracks.push(((face.min(f), face.max(f)), width));
         }
     }
     cracks
+}
+
+/// Distance from `p` to the segment `ab`.
+fn to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let l2 = ab.length_squared();
+    let t = if l2 > 0.0 { ((p - a).dot(ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    p.distance(a + ab * t)
 }
 
 /// Triangle angle distribution.
@@ -260,6 +306,14 @@ mod tests {
         let pts = [(0.0, 0.0), (4.0, 0.0), (2.0, -2.0), (2.0, 0.0), (1.0, 2.0), (3.0, 2.0)];
         let m = two_faces(&pts, &[[0, 2, 1]], &[[0, 3, 4], [3, 1, 5], [3, 5, 4]]);
         assert_eq!(edge_counts(&m, 1e-9, 1.0).free_edges, 1);
+        // The node lies on the edge: a gap of nothing between faces 0 and 1.
+        assert_eq!(edge_census(&m, &[], 1e-9, 1.0).1, [Gap { faces: (0, 1), width: 0.0 }]);
+        // Lifted 0.3 off it, the nearest of face 1's border points (the
+        // midpoints of its edges to that node) lie 0.15 off.
+        let mut lifted = m.clone();
+        lifted.positions[3].z = 0.3;
+        let gaps = edge_census(&lifted, &[], 1e-9, 1.0).1;
+        assert!(gaps.len() == 1 && (gaps[0].width - 0.15).abs() < 1e-12, "{gaps:?}");
     }
 
     /// A strip 0.5 wide (face a, its top border through node 4) that face b

@@ -8,8 +8,8 @@ use alloc::vec::Vec;
 use glam::DVec3;
 use serde::Serialize;
 
-pub(crate) use metrics::min_angle;
 pub use metrics::{angle_stats, edge_counts, edge_counts_in_bodies, AngleStats, EdgeCounts};
+pub(crate) use metrics::{edge_census, min_angle};
 pub use weld::{weld_mesh, weld_positions};
 
 /// An indexed triangle mesh. Every face owns its vertices (so normals can break

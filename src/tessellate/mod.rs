@@ -23,7 +23,7 @@ use alloc::format;
 use alloc::vec::Vec;
 use glam::DVec2;
 
-use crate::mesh::{angle_stats, edge_counts_in_bodies, FaceRange};
+use crate::mesh::{angle_stats, edge_census, FaceRange};
 use crate::nurbs::{Aabb, Surface};
 use crate::reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
 use crate::{Error, Mesh, Model, Report};
@@ -432,7 +432,15 @@ pub fn mesh_model_with_progress(
     report.mean_deviation = if dev_count > 0 { dev_sum / dev_count as f64 } else { 0.0 };
     report.triangles = mesh.triangle_count();
     report.vertices = mesh.positions.len();
-    let edges = edge_counts_in_bodies(&mesh, &model.bodies, (tol * 1e-3).min(tight * 0.5), tol);
+    let (edges, gaps) = edge_census(&mesh, &model.bodies, (tol * 1e-3).min(tight * 0.5), tol);
+    // A crack wider than sewing reaches is the file's own gap: say where.
+    for g in gaps.iter().filter(|g| g.width > sew_tol) {
+        report.warnings.push(format!(
+            "faces {} and {}: their borders lie {:.3e} apart where they meet, farther than sewing closes \
+             ({sew_tol:.3e}); the crack between them is left open",
+            g.faces.0, g.faces.1, g.width
+        ));
+    }
     report.free_edges = edges.free_edges;
     report.boundary_edges = edges.boundary_edges;
     report.nonmanifold_edges = edges.nonmanifold_edges;

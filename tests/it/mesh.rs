@@ -498,6 +498,24 @@ fn mesh_sews_one_gapped_border_in_a_model_that_otherwise_meets_exactly() {
     assert!(open(1.5 * tol) > r.report.boundary_edges, "a gap of 1.5 tolerances was sewn");
 }
 
+/// A gap wider than the sewing distance (0.4 of the tolerance) but within
+/// the tolerance is a crack the file has, not one the mesher left: the
+/// report names the two faces and the measured width.
+#[test]
+fn mesh_names_a_gap_wider_than_sewing_and_its_width() {
+    let tol = 1.0;
+    let r = mesh_model(&row_with_one_gap(0.7 * tol), &MeshOptions::default().with_tolerance(tol)).expect("meshes");
+    assert!(r.report.free_edges > 0, "the gap is a crack");
+    let gaps: Vec<&String> = r.report.warnings.iter().filter(|w| w.contains("apart where they meet")).collect();
+    assert_eq!(gaps.len(), 1, "{:?}", r.report.warnings);
+    assert!(gaps[0].starts_with("faces 29 and 30: their borders lie "), "{}", gaps[0]);
+    let width: f64 = gaps[0]["faces 29 and 30: their borders lie ".len()..].split(' ').next().unwrap().parse().unwrap();
+    assert!(width >= 0.7 * tol - 1e-9 && width < tol, "{width}");
+    // Sewn gaps leave no such warning.
+    let sewn = mesh_model(&row_with_one_gap(0.3 * tol), &MeshOptions::default().with_tolerance(tol)).expect("meshes");
+    assert!(sewn.report.warnings.iter().all(|w| !w.contains("apart where they meet")), "{:?}", sewn.report.warnings);
+}
+
 /// Three flat faces round a corner that misses: the right face's corner
 /// stops `miss` short of the others', leaving a sliver between its top
 /// border and the face above.
