@@ -89,6 +89,7 @@ fn run(file: &str, rel: f64, abs: Option<f64>, all: bool) -> Result<(), String> 
             warnings: Vec::new(),
             tolerance: None,
             bodies: Vec::new(),
+            ..Default::default()
         };
         let mut row = serde_json::json!({
             "file": name, "face": index, "ratio": ratio, "tolerance": tol, "detect_us": detect_us,

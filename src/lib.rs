@@ -28,6 +28,7 @@ mod reparam;
 mod tessellate;
 #[cfg(test)]
 mod testing;
+mod units;
 #[cfg(all(target_arch = "wasm32", target_os = "unknown"))]
 mod wasm;
 
@@ -38,15 +39,15 @@ pub use fit::{
 };
 pub use io::{
     read_iges, read_json, read_mesh, read_model, read_msh, read_step, read_step_parts, read_step_with_shells,
-    write_glb, write_iges, write_msh, write_obj, write_stl, write_unv, Format, MeshFormat, StepModel, StepShell,
-    UNV_SHELL_TRIANGLE,
+    write_glb, write_glb_scaled, write_iges, write_msh, write_obj, write_stl, write_unv, Format, MeshFormat, StepModel,
+    StepShell, UNV_SHELL_TRIANGLE,
 };
 pub use measure::{measure_mesh, MeasureOptions, MeshMeasure};
 pub use mesh::{
-    angle_stats, edge_counts, edge_counts_in_bodies, weld_mesh, weld_positions, AngleStats, EdgeCounts, FaceRange,
-    Mesh, Report,
+    angle_stats, edge_counts, edge_counts_around_skipped, edge_counts_in_bodies, weld_mesh, weld_positions, AngleStats,
+    EdgeCounts, FaceRange, Mesh, Report,
 };
-pub use model::{Face, FaceSurface, Model, TrimLoop};
+pub use model::{Face, FaceSurface, Model, SkippedFace, TessellatedFace, TrimLoop};
 pub use nurbs::{
     project_to_surface, Aabb, BasisDers, CurveDerivs, KnotVector, NurbsCurve, NurbsError, NurbsSurface, Projection,
     ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
@@ -67,6 +68,7 @@ pub use tessellate::stages;
 pub use tessellate::{
     mesh_model, mesh_model_with_progress, share_of_faces, MeshMode, MeshOptions, MeshResult, OptionsError, Tolerance,
 };
+pub use units::{mesh_model_in_units, mm_per_unit, Units};
 
 /// Reads `bytes` in `format` and meshes the model: the one call both doors use.
 ///

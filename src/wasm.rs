@@ -16,14 +16,15 @@ use js_sys::{Array, Float32Array, Function, Object, Reflect, Uint32Array, JSON};
 use wasm_bindgen::prelude::*;
 
 use crate::{fit_points, read_points, FitOptions, FitResult, PointFormat};
+use crate::{mesh_model_in_units, Units};
 use crate::{offset_mesh, read_mesh, repair_mesh_timed, Bucketing, MeshFormat, RepairOptions};
 use crate::{read_model, read_step_parts, Error, Format, MeshMode, MeshOptions, MeshResult, QualityMethod};
 // `tests/wasm_node.rs` compiles this file into a crate where `crate::` is the
 // test itself, which does not import this name; take it from the library there.
 #[cfg(not(test))]
-use crate::{mesh_model_with_progress, Reparam};
+use crate::Reparam;
 #[cfg(test)]
-use surfmesh::{mesh_model_with_progress, Reparam};
+use surfmesh::Reparam;
 
 #[cfg_attr(not(test), wasm_bindgen(typescript_custom_section))]
 #[cfg_attr(test, allow(dead_code))]
@@ -58,6 +59,12 @@ export interface MeshOptions {
    * (count 0 in faceRanges). Bodies share no border, so the shares together are the whole mesh.
    */
   share?: [number, number];
+  /**
+   * Length unit of the result: "file" (default: the file's own unit, nothing scaled), "mm", "cm",
+   * "m", "in" or "ft". The mesh is scaled into it, with the report's tolerance and deviations;
+   * absolute options (tolerance, maxEdge, minEdge, size) are taken in it too.
+   */
+  units?: "file" | "mm" | "cm" | "m" | "in" | "ft";
 }
 
 /** What `mesh` returns. */
@@ -76,7 +83,10 @@ export interface MeshOutput {
   faceColors: Float32Array;
   /** Part names: one per part instance of a STEP assembly ("" when unnamed); one "" for other formats. */
   parts: string[];
-  /** The measured report (tolerance, triangles, max_deviation, warnings, ...). */
+  /** Length unit of `positions` and of the report's lengths ("mm", "in", "m", ...; also `report.units`). */
+  units: string;
+  /** The measured report (tolerance, triangles, max_deviation, warnings, ...); `faces_tessellated`
+   * counts the faces given as triangles (STEP tessellated faces), which max_deviation does not cover. */
   report: Record<string, any>;
 }
 
@@ -174,7 +184,7 @@ export function meshWithProgress(
 "#;
 
 /// Option names `mesh` accepts, in the order they are read.
-const OPTION_NAMES: [&str; 12] = [
+const OPTION_NAMES: [&str; 13] = [
     "tolerance",
     "toleranceRel",
     "angle",
@@ -187,6 +197,7 @@ const OPTION_NAMES: [&str; 12] = [
     "sizeRel",
     "method",
     "share",
+    "units",
 ];
 
 /// The crate version, so a page can show which mesher produced a mesh.
@@ -213,8 +224,8 @@ pub fn memory_bytes() -> f64 {
 /// that is invalid.
 #[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
 pub fn mesh(bytes: Vec<u8>, format: &str, options: JsValue) -> Result<JsValue, JsError> {
-    let options = read_options(&options).map_err(|e| JsError::new(&e))?;
-    run(bytes, format, &options, &mut |_, _| true).map_err(|e| JsError::new(&one_line(&e.to_string())))
+    let (options, units) = read_options(&options).map_err(|e| JsError::new(&e))?;
+    run(bytes, format, &options, units, &mut |_, _| true).map_err(|e| JsError::new(&one_line(&e.to_string())))
 }
 
 /// As [`mesh`], calling the JS function `progress(faces_done, faces_total)`
@@ -232,7 +243,7 @@ pub fn mesh_with_progress(
     options: JsValue,
     progress: &Function,
 ) -> Result<JsValue, JsValue> {
-    let options = read_options(&options).map_err(|e| JsValue::from(JsError::new(&e)))?;
+    let (options, units) = read_options(&options).map_err(|e| JsValue::from(JsError::new(&e)))?;
     let mut thrown: Option<JsValue> = None;
     let mut call = |done: usize, total: usize| -> bool {
         match progress.call2(&JsValue::NULL, &JsValue::from(done as f64), &JsValue::from(total as f64)) {
@@ -243,7 +254,7 @@ pub fn mesh_with_progress(
             }
         }
     };
-    let result = run(bytes, format, &options, &mut call);
+    let result = run(bytes, format, &options, units, &mut call);
     match (result, thrown) {
         (_, Some(e)) => Err(e),
         (Ok(out), None) => Ok(out),
@@ -263,6 +274,7 @@ fn run(
     bytes: Vec<u8>,
     format: &str,
     options: &MeshOptions,
+    units: Units,
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<JsValue, Error> {
     options.validate()?;
@@ -278,7 +290,7 @@ fn run(
     };
     drop(bytes);
     let t1 = now_ms();
-    let mut result = mesh_model_with_progress(&model, options, progress)?;
+    let mut result = mesh_model_in_units(&model, options, units, progress)?;
     drop(model);
     let t2 = now_ms();
     if let (Some(t0), Some(t1), Some(t2)) = (t0, t1, t2) {
@@ -320,11 +332,12 @@ fn now_ms() -> Option<f64> {
     Some(js_sys::Date::now())
 }
 
-/// Reads the JS options object; every key must be known and every value a number.
-fn read_options(value: &JsValue) -> Result<MeshOptions, String> {
+/// Reads the JS options object (every key must be known and every value of
+/// its type) into the meshing options and the unit of the result.
+fn read_options(value: &JsValue) -> Result<(MeshOptions, Units), String> {
     let mut options = MeshOptions::default();
     if value.is_undefined() || value.is_null() {
-        return Ok(options);
+        return Ok((options, Units::File));
     }
     if !value.is_object() || Array::is_array(value) {
         return Err(format!("options: expected an object like {{ toleranceRel: 0.001 }}, found {}", type_name(value)));
@@ -398,7 +411,13 @@ fn read_options(value: &JsValue) -> Result<MeshOptions, String> {
             _ => return Err("option share: expected [index, count] with whole numbers, index < count".into()),
         }
     }
-    Ok(options)
+    let units = Reflect::get(object, &JsValue::from_str("units")).map_err(|_| "option units: cannot be read")?;
+    let units = match units.as_string() {
+        Some(name) => Units::from_name(&name).map_err(|e| e.to_string())?,
+        None if units.is_undefined() || units.is_null() => Units::File,
+        None => return Err(format!("option units: expected a string, found {}", type_name(&units))),
+    };
+    Ok((options, units))
 }
 
 /// A string-valued option: the index of its value in `allowed`, `None` when absent.
@@ -438,7 +457,7 @@ fn type_name(value: &JsValue) -> String {
     }
 }
 
-/// Builds `{ positions, normals, indices, faceRanges, faceParts, faceColors, parts, report }`.
+/// Builds `{ positions, normals, indices, faceRanges, faceParts, faceColors, parts, units, report }`.
 fn to_js(result: &MeshResult, parts: &Parts) -> Result<JsValue, Error> {
     let mesh = &result.mesh;
     let flat =
@@ -457,7 +476,7 @@ fn to_js(result: &MeshResult, parts: &Parts) -> Result<JsValue, Error> {
     // One f32 copy at a time, each freed once JS has its own.
     let positions: JsValue = Float32Array::from(flat(&mesh.positions).as_slice()).into();
     let normals: JsValue = Float32Array::from(flat(&mesh.normals).as_slice()).into();
-    let fields: [(&str, JsValue); 8] = [
+    let fields: [(&str, JsValue); 9] = [
         ("positions", positions),
         ("normals", normals),
         ("indices", Uint32Array::from(mesh.indices.as_slice()).into()),
@@ -465,6 +484,7 @@ fn to_js(result: &MeshResult, parts: &Parts) -> Result<JsValue, Error> {
         ("faceParts", Uint32Array::from(parts.faces.as_slice()).into()),
         ("faceColors", Float32Array::from(colours.as_slice()).into()),
         ("parts", names.into()),
+        ("units", JsValue::from_str(&result.report.units)),
         ("report", report),
     ];
     for (name, value) in fields {

@@ -4,10 +4,13 @@
 #![cfg(not(target_arch = "wasm32"))]
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 
 use surfmesh::{mesh_model, read_model, Format, MeshOptions};
+
+/// The test corpus (`tests/corpus`).
+#[path = "it/corpus_files.rs"]
+mod corpus_files;
 
 struct Counting;
 static NOW: AtomicUsize = AtomicUsize::new(0);
@@ -51,12 +54,7 @@ static A: Counting = Counting;
 /// faces kept awake between refinement visits. The output is 28 bytes a triangle.
 #[test]
 fn meshing_the_largest_model_peaks_under_205_bytes_a_triangle() {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus/trj6_pm4-ec-203.stp");
-    if !file.exists() {
-        eprintln!("SKIPPED: no corpus file {} (needs ../shared/corpus)", file.display());
-        return;
-    }
-    let bytes = std::fs::read(&file).unwrap();
+    let bytes = corpus_files::corpus_bytes("trj6_pm4-ec-203.stp");
     let model = read_model(&bytes, Format::detect(&bytes).unwrap()).unwrap();
     let before = NOW.load(Relaxed);
     PEAK.store(before, Relaxed);

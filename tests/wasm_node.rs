@@ -12,9 +12,9 @@ extern crate alloc;
 // Names `src/wasm.rs` reaches through `crate::`.
 #[allow(unused_imports)]
 use surfmesh::{
-    fit_points, mesh_model, offset_mesh, read_mesh, read_model, read_points, read_step_parts, repair_mesh_timed,
-    Bucketing, Error, FitOptions, FitResult, Format, MeshFormat, MeshMode, MeshOptions, MeshResult, PointFormat,
-    QualityMethod, RepairOptions,
+    fit_points, mesh_model, mesh_model_in_units, offset_mesh, read_mesh, read_model, read_points, read_step_parts,
+    repair_mesh_timed, Bucketing, Error, FitOptions, FitResult, Format, MeshFormat, MeshMode, MeshOptions, MeshResult,
+    PointFormat, QualityMethod, RepairOptions, Units,
 };
 
 #[path = "../src/wasm.rs"]
@@ -640,6 +640,56 @@ fn step_assembly_parts_and_colours_reach_js() {
     // The module's memory in whole 64 KiB pages, at least what the meshes above needed.
     let bytes = binding::memory_bytes();
     assert!(bytes >= 65536.0 && bytes % 65536.0 == 0.0, "{bytes}");
+}
+
+/// A tessellated solid placed by an assembly: its four faces pass through
+/// with their part and colours, and the report counts them as tessellated.
+#[wasm_bindgen_test]
+fn step_tessellated_faces_reach_js_counted() {
+    let bytes = include_bytes!("data/step_tess_solid.stp");
+    let v =
+        binding::mesh(bytes.to_vec(), "step", JsValue::UNDEFINED).unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+    let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
+    assert_eq!(get("faceRanges").dyn_into::<Uint32Array>().expect("faceRanges").to_vec(), [0, 1, 1, 1, 2, 1, 3, 1]);
+    let parts: Vec<String> =
+        get("parts").dyn_into::<Array>().expect("parts").iter().map(|p| p.as_string().expect("name")).collect();
+    assert_eq!(parts, ["Tetra"]);
+    let colours = get("faceColors").dyn_into::<Float32Array>().expect("faceColors").to_vec();
+    assert_eq!(&colours[0..3], &[0.8, 0.2, 0.1]);
+    assert_eq!(&colours[9..12], &[0.0, 0.0, 1.0]);
+    let report = get("report");
+    let field = |f: &str| Reflect::get(&report, &f.into()).unwrap().as_f64().unwrap();
+    assert_eq!((field("faces"), field("faces_tessellated"), field("triangles")), (4.0, 4.0, 4.0));
+}
+
+/// The `units` option scales the inch box into millimetres (positions and
+/// the report's tolerance), and the result names its unit; the default is
+/// the file's own unit; a unit that is not offered throws.
+#[wasm_bindgen_test]
+fn units_option_scales_the_result_and_names_its_unit() {
+    let bytes = include_bytes!("data/step_box_inch.stp");
+    let run = |opts: JsValue| {
+        let v = binding::mesh(bytes.to_vec(), "step", opts).unwrap_or_else(|e| panic!("{:?}", JsValue::from(e)));
+        let get = |name: &str| Reflect::get(&v, &name.into()).expect("result field");
+        let positions = get("positions").dyn_into::<Float32Array>().expect("positions").to_vec();
+        let max_x = positions.chunks(3).map(|p| p[0]).fold(f32::NEG_INFINITY, f32::max);
+        let report = get("report");
+        let tol = Reflect::get(&report, &"tolerance".into()).unwrap().as_f64().unwrap();
+        let units = get("units").as_string().expect("units");
+        assert_eq!(Reflect::get(&report, &"units".into()).unwrap().as_string().as_deref(), Some(units.as_str()));
+        (units, max_x, tol)
+    };
+    let (file_units, file_x, file_tol) = run(options(&[("toleranceRel", num(1e-2))]));
+    assert_eq!((file_units.as_str(), file_x), ("in", 2.0));
+    let (mm, mm_x, mm_tol) = run(options(&[("toleranceRel", num(1e-2)), ("units", "mm".into())]));
+    assert_eq!(mm, "mm");
+    assert!((mm_x - 50.8).abs() < 1e-4, "{mm_x}");
+    assert!((mm_tol - 25.4 * file_tol).abs() < 1e-9 * mm_tol, "{mm_tol} vs {file_tol}");
+    let m = match binding::mesh(bytes.to_vec(), "step", options(&[("units", "yd".into())])) {
+        Ok(_) => panic!("units yd accepted"),
+        Err(e) => String::from(JsValue::from(e).unchecked_into::<js_sys::Error>().message()),
+    };
+    assert!(m.starts_with("option units: expected"), "{m}");
 }
 
 /// Paper 001 by default: a crowded surface is flagged and rebuilt without

@@ -3,6 +3,8 @@
 
 #[path = "surfmesh/args.rs"]
 mod args;
+#[path = "surfmesh/check.rs"]
+mod check;
 #[path = "surfmesh/fit.rs"]
 mod fit;
 #[path = "surfmesh/repair.rs"]
@@ -18,12 +20,15 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use args::{Command, MeshArgs, OutputFormat};
-use surfmesh::{mesh_model, read_model, write_glb, write_msh, write_obj, write_stl, write_unv, Error, Format};
+use surfmesh::{
+    mesh_model_in_units, mm_per_unit, read_model, write_glb_scaled, write_msh, write_obj, write_stl, write_unv, Error,
+    Format,
+};
 
 fn main() -> ExitCode {
     match args::parse(std::env::args_os().skip(1).collect()) {
         Ok(Command::Help) => {
-            print!("{}\n{}\n{}\n{}", args::USAGE, repair::USAGE, fit::USAGE, reparam::USAGE);
+            print!("{}\n{}\n{}\n{}\n{}", args::USAGE, check::USAGE, repair::USAGE, fit::USAGE, reparam::USAGE);
             ExitCode::SUCCESS
         }
         Ok(Command::Version) => {
@@ -41,6 +46,14 @@ fn main() -> ExitCode {
         Ok(Command::Repair(a)) => finish(&a.input, repair::run_repair(&a)),
         Ok(Command::Fit(a)) => finish(&a.input, fit::run(&a)),
         Ok(Command::Reparam(a)) => finish(&a.input, reparam::run(&a)),
+        Ok(Command::Check(a)) => match check::run(&a) {
+            Ok(true) => ExitCode::SUCCESS,
+            Ok(false) => ExitCode::from(1),
+            Err(message) => {
+                eprintln!("surfmesh: {}: {}", a.dir.display(), one_line(&message));
+                ExitCode::from(1)
+            }
+        },
         Err(message) => {
             eprintln!("surfmesh: {}", one_line(&message));
             ExitCode::from(2)
@@ -77,7 +90,7 @@ fn mesh(m: &MeshArgs) -> Result<(), String> {
     let model = read_model(&bytes, format).map_err(|e| e.to_string())?;
     let parse_ms = millis(start);
     let start = Instant::now();
-    let mut result = mesh_model(&model, &m.options).map_err(|e| e.to_string())?;
+    let mut result = mesh_model_in_units(&model, &m.options, m.units, &mut |_, _| true).map_err(|e| e.to_string())?;
     let report = &mut result.report;
     report.time_ms = millis(start);
     report.parse_ms = parse_ms;
@@ -92,7 +105,18 @@ fn mesh(m: &MeshArgs) -> Result<(), String> {
         let bytes = match kind {
             OutputFormat::Stl => write_stl(&result.mesh),
             OutputFormat::Obj => write_obj(&result.mesh),
-            OutputFormat::Glb => write_glb(&result.mesh),
+            OutputFormat::Glb => {
+                // glTF's lengths are metres.
+                let mm = mm_per_unit(&result.report.units).unwrap_or_else(|| {
+                    eprintln!(
+                        "surfmesh: {}: length unit '{}' unknown: the GLB takes it as millimetres",
+                        m.input.display(),
+                        result.report.units
+                    );
+                    1.0
+                });
+                write_glb_scaled(&result.mesh, mm / 1000.0)
+            }
             OutputFormat::Msh => write_msh(&result.mesh),
             OutputFormat::Unv => write_unv(&result.mesh),
         };
@@ -108,13 +132,21 @@ fn mesh(m: &MeshArgs) -> Result<(), String> {
 
     let r = &result.report;
     let verdict = if r.max_deviation <= r.tolerance { "<=" } else { "EXCEEDS" };
+    // Faces without an exact surface are not measured: the line says so.
+    let unverified = match r.faces_tessellated {
+        0 => String::new(),
+        n if n == r.faces => format!(" (all {n} faces tessellated: not verified)"),
+        1 => " (1 tessellated face not verified)".into(),
+        n => format!(" ({n} tessellated faces not verified)"),
+    };
     eprintln!(
-        "surfmesh: {}: {} triangles, max deviation {:.3e} {verdict} tolerance {:.3e} {}, {:.1} ms (parse {:.1} ms)",
+        "surfmesh: {}: {} triangles, max deviation {:.3e} {verdict} tolerance {:.3e} {}{unverified}, {:.1} ms \
+         (parse {:.1} ms)",
         m.input.display(),
         r.triangles,
         r.max_deviation,
         r.tolerance,
-        model.units,
+        r.units,
         r.time_ms,
         r.parse_ms
     );

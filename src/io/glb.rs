@@ -24,8 +24,18 @@ const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 /// primitive per face range, sharing `f32` positions (with the min/max the
 /// spec requires) and normals (when there is one per vertex), `u32` indices.
 /// Triangles whose indices point past the vertex list are left out; a mesh
-/// without triangles gives a valid file with an empty scene.
+/// without triangles gives a valid file with an empty scene. glTF lengths
+/// are metres: the positions are written as they are, taken as metres
+/// ([`write_glb_scaled`] converts a mesh in another unit).
 pub fn write_glb(mesh: &Mesh) -> Vec<u8> {
+    write_glb_scaled(mesh, 1.0)
+}
+
+/// As [`write_glb`], the positions multiplied by `metres_per_unit` (the
+/// size of the mesh's length unit in metres: 0.001 for millimetres,
+/// 0.0254 for inches), so the file is in metres as glTF defines them.
+pub fn write_glb_scaled(mesh: &Mesh, metres_per_unit: f64) -> Vec<u8> {
+    let k = if metres_per_unit > 0.0 && metres_per_unit.is_finite() { metres_per_unit } else { 1.0 };
     let n = mesh.positions.len();
     let with_normals = mesh.normals.len() == n;
     // Index lists of the non-empty faces.
@@ -45,7 +55,7 @@ pub fn write_glb(mesh: &Mesh) -> Vec<u8> {
     let mut bin = Vec::new();
     let (mut min, mut max) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for p in &mesh.positions {
-        let c = f32s(*p);
+        let c = f32s(*p * k);
         for ((lo, hi), x) in min.iter_mut().zip(&mut max).zip(c) {
             *lo = lo.min(x);
             *hi = hi.max(x);

@@ -13,7 +13,7 @@ mod unv;
 
 use alloc::format;
 
-pub use glb::write_glb;
+pub use glb::{write_glb, write_glb_scaled};
 pub use iges::read_iges;
 pub use iges_write::write_iges;
 pub use json::read_json;

@@ -27,7 +27,7 @@ use alloc::vec::Vec;
 use glam::DVec3;
 use serde::Serialize;
 
-use crate::mesh::{angle_stats, edge_counts, weld_positions, FaceRange, Mesh};
+use crate::mesh::{angle_stats, edge_counts_around_skipped, weld_positions, FaceRange, Mesh};
 use crate::model::Model;
 use crate::nurbs::{Aabb, ProjectionOptions};
 use bvh::{closest_on_triangle, Bvh};
@@ -127,8 +127,9 @@ pub struct MeshMeasure {
     pub uncovered_samples: usize,
     /// Edges with one triangle after welding (open boundary and cracks).
     pub boundary_edges: usize,
-    /// Cracks: boundary edges along another face's border. Needs face ranges;
-    /// 0 by definition for a mesh without them (see `boundary_edges`).
+    /// Cracks: boundary edges along another face's border (needs face
+    /// ranges; without them only the next kind counts, see
+    /// `boundary_edges`), or along a face the reader skipped.
     pub free_edges: usize,
     /// Edges with more than two triangles.
     pub nonmanifold_edges: usize,
@@ -195,7 +196,8 @@ pub fn measure_mesh(model: &Model, mesh: &Mesh, options: &MeasureOptions) -> Mes
     coverage(model, &plans, &mesh, options.coverage_samples, &mut out);
 
     let weld = options.weld.filter(|w| *w > 0.0 && w.is_finite()).unwrap_or(1e-3 * tolerance);
-    let edges = edge_counts(&mesh, weld, tolerance);
+    // Edges along faces the reader skipped are cracks, as the mesher counts them.
+    let edges = edge_counts_around_skipped(&mesh, &[], &model.skipped, weld, tolerance);
     out.boundary_edges = edges.boundary_edges;
     out.free_edges = edges.free_edges;
     out.nonmanifold_edges = edges.nonmanifold_edges;

@@ -4,6 +4,8 @@ use alloc::vec::Vec;
 use glam::DVec3;
 
 use super::{weld::weld_positions, Mesh};
+use crate::model::SkippedFace;
+use crate::nurbs::{Aabb, NurbsCurve};
 
 /// Edge census after welding coincident vertices.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -19,6 +21,9 @@ pub struct EdgeCounts {
     pub nonmanifold_edges: usize,
     /// Edges whose two triangles run the same way (orientation flips).
     pub misoriented_edges: usize,
+    /// Of the free edges, those that run along the border of a face the
+    /// reader skipped: the hole it leaves.
+    pub hole_edges: usize,
 }
 
 /// Counts boundary, crack and non-manifold edges after welding vertices closer
@@ -32,7 +37,22 @@ pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
 /// crack only next to another border of its own body, so parts of an
 /// assembly that touch are counted each on its own.
 pub fn edge_counts_in_bodies(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol: f64) -> EdgeCounts {
-    edge_census(mesh, bodies, weld_tol, sew_tol).0
+    edge_counts_around_skipped(mesh, bodies, &[], weld_tol, sew_tol)
+}
+
+/// As [`edge_counts_in_bodies`], where `skipped` are the faces the reader
+/// could not build: a boundary edge that runs along one's border (its
+/// quarter, half and three-quarter points within twice `sew_tol` of it, in
+/// the same body) is a crack too, the hole the missing face leaves, and not
+/// the model's own boundary.
+pub fn edge_counts_around_skipped(
+    mesh: &Mesh,
+    bodies: &[u32],
+    skipped: &[SkippedFace],
+    weld_tol: f64,
+    sew_tol: f64,
+) -> EdgeCounts {
+    edge_census(mesh, bodies, skipped, weld_tol, sew_tol).0
 }
 
 /// Where two faces' borders run side by side unjoined (see [`edge_census`]).
@@ -45,9 +65,15 @@ pub(crate) struct Gap {
     pub width: f64,
 }
 
-/// As [`edge_counts_in_bodies`], with the gaps of the cracks: per pair of
-/// faces whose borders crack apart, how far apart they lie.
-pub(crate) fn edge_census(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol: f64) -> (EdgeCounts, Vec<Gap>) {
+/// As [`edge_counts_around_skipped`], with the gaps of the cracks: per pair
+/// of faces whose borders crack apart, how far apart they lie.
+pub(crate) fn edge_census(
+    mesh: &Mesh,
+    bodies: &[u32],
+    skipped: &[SkippedFace],
+    weld_tol: f64,
+    sew_tol: f64,
+) -> (EdgeCounts, Vec<Gap>) {
     let (mut map, mut nverts) = weld_positions(&mesh.positions, weld_tol);
     let face_of = face_lookup(mesh);
     let body_of_face = |f: u32| crate::model::body_of(bodies, f as usize);
@@ -149,8 +175,9 @@ pub(crate) fn edge_census(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol: f
     }
     drop((at, start, around));
     out.boundary_edges = free.len();
-    let cracks = find_cracks(&free, &pos, sew_tol, &body_of_face);
-    out.free_edges = cracks.len();
+    let (cracks, holes) = find_cracks(&free, &pos, sew_tol, &body_of_face, skipped);
+    out.free_edges = cracks.len() + holes;
+    out.hole_edges = holes;
     let mut gaps: Vec<Gap> = Vec::new();
     for (faces, width) in cracks {
         match gaps.iter_mut().find(|g| g.faces == faces) {
@@ -160,6 +187,23 @@ pub(crate) fn edge_census(mesh: &Mesh, bodies: &[u32], weld_tol: f64, sew_tol: f
     }
     gaps.sort_by(|a, b| a.faces.cmp(&b.faces));
     (out, gaps)
+}
+
+/// The report's line about faces the reader skipped, if any: how many, and
+/// how many edges of the mesh run open along them (`holes`).
+pub(crate) fn holes_warning(skipped: &[SkippedFace], holes: usize, warnings: &mut Vec<alloc::string::String>) {
+    if skipped.is_empty() {
+        return;
+    }
+    let n = skipped.len();
+    warnings.push(if holes > 0 {
+        alloc::format!(
+            "{n} face(s) of the file could not be read: the mesh has holes there, \
+             {holes} open edges along their borders (counted as cracks)"
+        )
+    } else {
+        alloc::format!("{n} face(s) of the file could not be read: the mesh lacks them")
+    });
 }
 
 /// Face index of each triangle, from the mesh's face ranges (0 when absent).
@@ -175,18 +219,22 @@ fn face_lookup(mesh: &Mesh) -> impl Fn(usize) -> u32 + '_ {
 /// length) of its quarter, half or three-quarter point. A vertex on the
 /// edge's own face's border too is not: the two faces are joined there, and
 /// the edge passes it where its own face is narrower than `sew` (a strip
-/// whose far side comes near a corner it shares with a neighbour).
-/// Returns, per crack, the two faces (lower first) and the distance from the
-/// edge to the nearest border point of the other face beside it.
+/// whose far side comes near a corner it shares with a neighbour). A free
+/// edge that runs along the border of a skipped face of its body
+/// ([`Holes::along`]) is a crack too, the missing face's hole.
+/// Returns, per crack between two faces, the faces (lower first) and the
+/// distance from the edge to the nearest border point of the other face
+/// beside it; and how many cracks run along skipped faces.
 fn find_cracks(
     free: &[(u32, u32, u32)],
     pos: &dyn Fn(u32) -> DVec3,
     sew: f64,
     body: &dyn Fn(u32) -> u32,
-) -> Vec<((u32, u32), f64)> {
+    skipped: &[SkippedFace],
+) -> (Vec<((u32, u32), f64)>, usize) {
     let mut cracks = Vec::new();
     if free.is_empty() || !(sew > 0.0 && sew.is_finite()) {
-        return cracks;
+        return (cracks, 0);
     }
     // Points of interest: free-edge vertices (tag = vertex id) and midpoints (tag = edge index).
     #[derive(Clone, Copy)]
@@ -206,6 +254,8 @@ fn find_cracks(
         let m = (pos(a) + pos(b)) * 0.5;
         grid.insert(m, (m, Tag::Mid, f));
     }
+    let holes = Holes::new(skipped, 2.0 * sew);
+    let mut along = 0;
     for &(a, b, face) in free {
         let (pa, pb) = (pos(a), pos(b));
         // Relative to the edge too: an open border's own neighbours sit half an edge away.
@@ -230,9 +280,45 @@ fn find_cracks(
         }
         if let Some((width, f)) = hit {
             cracks.push(((face.min(f), face.max(f)), width));
+        } else if holes.along(pa, pb, body(face)) {
+            along += 1;
         }
     }
-    cracks
+    (cracks, along)
+}
+
+/// The border curves of skipped faces, each with its body and its box, for [`Holes::along`].
+struct Holes<'a> {
+    curves: Vec<(&'a NurbsCurve, u32, Aabb)>,
+    reach: f64,
+}
+
+impl<'a> Holes<'a> {
+    fn new(skipped: &'a [SkippedFace], reach: f64) -> Self {
+        let mut curves = Vec::new();
+        for s in skipped {
+            for c in &s.border {
+                let b = c.bbox();
+                if !b.is_empty() {
+                    curves.push((c, s.body, b));
+                }
+            }
+        }
+        Self { curves, reach }
+    }
+
+    /// Whether the edge `pa`–`pb` of body `body` runs along one skipped
+    /// face's border: its quarter, half and three-quarter points all lie
+    /// within the reach of one of that face's curves (an edge that only
+    /// meets the border at a corner has at least one of them farther).
+    fn along(&self, pa: DVec3, pb: DVec3, body: u32) -> bool {
+        let points = [0.25, 0.5, 0.75].map(|f| pa.lerp(pb, f));
+        self.curves.iter().any(|(c, b, bbox)| {
+            *b == body
+                && points.iter().all(|&q| bbox.contains(q, self.reach))
+                && points.iter().all(|&q| c.project(q).2 <= self.reach)
+        })
+    }
 }
 
 /// Distance from `p` to the segment `ab`.
@@ -307,12 +393,12 @@ mod tests {
         let m = two_faces(&pts, &[[0, 2, 1]], &[[0, 3, 4], [3, 1, 5], [3, 5, 4]]);
         assert_eq!(edge_counts(&m, 1e-9, 1.0).free_edges, 1);
         // The node lies on the edge: a gap of nothing between faces 0 and 1.
-        assert_eq!(edge_census(&m, &[], 1e-9, 1.0).1, [Gap { faces: (0, 1), width: 0.0 }]);
+        assert_eq!(edge_census(&m, &[], &[], 1e-9, 1.0).1, [Gap { faces: (0, 1), width: 0.0 }]);
         // Lifted 0.3 off it, the nearest of face 1's border points (the
         // midpoints of its edges to that node) lie 0.15 off.
         let mut lifted = m.clone();
         lifted.positions[3].z = 0.3;
-        let gaps = edge_census(&lifted, &[], 1e-9, 1.0).1;
+        let gaps = edge_census(&lifted, &[], &[], 1e-9, 1.0).1;
         assert!(gaps.len() == 1 && (gaps[0].width - 0.15).abs() < 1e-12, "{gaps:?}");
     }
 

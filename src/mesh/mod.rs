@@ -8,8 +8,10 @@ use alloc::vec::Vec;
 use glam::DVec3;
 use serde::Serialize;
 
-pub use metrics::{angle_stats, edge_counts, edge_counts_in_bodies, AngleStats, EdgeCounts};
-pub(crate) use metrics::{edge_census, min_angle};
+pub use metrics::{
+    angle_stats, edge_counts, edge_counts_around_skipped, edge_counts_in_bodies, AngleStats, EdgeCounts,
+};
+pub(crate) use metrics::{edge_census, holes_warning, min_angle};
 pub use weld::{weld_mesh, weld_positions};
 
 /// An indexed triangle mesh. Every face owns its vertices (so normals can break
@@ -51,14 +53,25 @@ impl Mesh {
 /// What a mesh run measured; serialized as the CLI's JSON report.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct Report {
+    /// Length unit of the mesh and of every length here (the file's own
+    /// unit, or the one asked for: see [`crate::mesh_model_in_units`]).
+    pub units: String,
     /// Absolute chordal tolerance used, model units.
     pub tolerance: f64,
     /// Angle limit used, radians.
     pub angle: f64,
     /// Faces in the model.
     pub faces: usize,
+    /// Faces of the file the reader could not build (skipped with a
+    /// warning), not in `faces`: the file has `faces + faces_unread`. The
+    /// edges their neighbours leave open along them count in `free_edges`.
+    pub faces_unread: usize,
     /// Faces that produced no triangles (skipped with a warning).
     pub faces_skipped: usize,
+    /// Faces the file gives as triangles only (STEP tessellated faces): no
+    /// exact surface, so their triangles are passed through as they are and
+    /// the deviation figures do not cover them.
+    pub faces_tessellated: usize,
     /// Bodies in the model: sets of faces that share no border with each
     /// other (solids, sheets, assembly parts); the `share` option splits by them.
     pub bodies: usize,
@@ -66,7 +79,8 @@ pub struct Report {
     pub triangles: usize,
     /// Vertices in the mesh (per-face copies counted).
     pub vertices: usize,
-    /// Largest measured distance from the mesh to the exact surface.
+    /// Largest measured distance from the mesh to the exact surface (over
+    /// the faces that have one: not the tessellated faces).
     pub max_deviation: f64,
     /// Mean of the measured distances over all samples.
     pub mean_deviation: f64,
@@ -74,7 +88,8 @@ pub struct Report {
     pub min_angle_deg: f64,
     /// 1st-percentile triangle angle, degrees.
     pub p1_angle_deg: f64,
-    /// Cracks: free edges after welding that are not on the model's open boundary.
+    /// Cracks: free edges after welding that are not on the model's open
+    /// boundary, among them those along faces the reader skipped.
     pub free_edges: usize,
     /// All edges with one triangle after welding (cracks plus open boundary).
     pub boundary_edges: usize,

@@ -23,7 +23,27 @@ pub struct Model {
     /// Per face, the body (shell, solid, part instance) it belongs to, when
     /// the file says: faces of different bodies are never sewn together,
     /// and each body's edges are counted on their own. Empty: one body.
+    /// Indexed like the mesh's faces: [`Model::faces`], then [`Model::tessellated`].
     pub bodies: Vec<u32>,
+    /// Faces the file gives as triangles only (STEP AP242 tessellated
+    /// geometry), in file order. They follow the exact faces: tessellated
+    /// face `k` is face `faces.len() + k` of the mesh, its bodies and its report.
+    pub tessellated: Vec<TessellatedFace>,
+    /// Faces the file has that the reader could not build (each skipped
+    /// with a warning): not in [`Model::faces`], but counted, and their
+    /// borders make the edges their neighbours leave open there cracks.
+    pub skipped: Vec<SkippedFace>,
+}
+
+/// A face of the file the reader could not build: what is known of it.
+#[derive(Debug, Clone, Default)]
+pub struct SkippedFace {
+    /// The body it belongs to (as in [`Model::bodies`]).
+    pub body: u32,
+    /// The model-space curves of its border, as far as they could be read
+    /// (empty when none could): where a face beside it ends along them,
+    /// the mesh has a hole, not the model's own boundary.
+    pub border: Vec<NurbsCurve>,
 }
 
 impl Model {
@@ -31,6 +51,27 @@ impl Model {
     pub fn body(&self, face: usize) -> u32 {
         body_of(&self.bodies, face)
     }
+
+    /// Faces of the mesh: the exact ones, then the tessellated ones.
+    pub fn face_count(&self) -> usize {
+        self.faces.len() + self.tessellated.len()
+    }
+}
+
+/// A face given as triangles, without an exact surface: its triangles pass
+/// to the mesh as they are, so its deviation cannot be measured.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TessellatedFace {
+    /// Optional name from the file.
+    pub name: Option<String>,
+    /// Vertex positions, model units.
+    pub positions: Vec<DVec3>,
+    /// Unit normals, one per position, as the file gives them; empty when it
+    /// gives none (the mesh then takes the triangles' own).
+    pub normals: Vec<DVec3>,
+    /// Three indices into `positions` per triangle, counter-clockwise seen
+    /// from the face's outside.
+    pub triangles: Vec<[u32; 3]>,
 }
 
 /// The body of face `face` by [`Model::bodies`] (0 past its end, as for a model without bodies).

@@ -1,5 +1,6 @@
 //! Exact rational B-spline forms of analytic curves and surfaces: lines,
-//! circular and elliptic arcs of any sweep, conic segments, bilinear patches,
+//! circular and elliptic arcs of any sweep, hyperbola and parabola arcs,
+//! conic segments, bilinear patches,
 //! surfaces of revolution, extrusions and ruled surfaces. Importers (IGES,
 //! STEP) turn their analytic entities into NURBS with these.
 //!
@@ -122,6 +123,67 @@ pub fn circle_arc(c: DVec3, x: DVec3, y: DVec3, radius: f64, start: f64, end: f6
     ellipse_arc(c, x * radius, y * radius, start, end)
 }
 
+/// Largest span of the parameter `t` in one piece of a hyperbola arc: its
+/// middle weight `cosh(span / 2)` stays at most `cosh 1 ≈ 1.54`.
+const MAX_HYPERBOLA_PIECE: f64 = 2.0;
+
+/// The hyperbola arc `c + cosh t·x + sinh t·y` for `t` from `start` to `end`
+/// (`end > start`; `x`, `y` the semi-axes along the real and imaginary
+/// axes). Exact: each piece (at most [`MAX_HYPERBOLA_PIECE`] of `t`, 1 to
+/// 64 of them) is the rational quadratic from `P(t0)` to `P(t1)` whose middle
+/// point is where their tangents meet, `c + (cosh m·x + sinh m·y) / cosh h`
+/// with weight `cosh h` (`m` the middle and `h` the half span of `t`: the
+/// ellipse's construction with `cosh`, `sinh` for `cos`, `sin`). The knots
+/// are the pieces' ends in `t`.
+///
+/// # Errors
+/// An empty span or non-finite input (a span so far out that `cosh` overflows).
+pub fn hyperbola_arc(c: DVec3, x: DVec3, y: DVec3, start: f64, end: f64) -> Result<NurbsCurve, NurbsError> {
+    if end.is_nan() || start.is_nan() || end <= start {
+        return Err(NurbsError::BadMultiplicity { index: 0 });
+    }
+    let n = (libm::ceil((end - start) / MAX_HYPERBOLA_PIECE) as usize).clamp(1, 64);
+    let d = (end - start) / n as f64;
+    let h = 0.5 * d;
+    let at = |t: f64| c + x * libm::cosh(t) + y * libm::sinh(t);
+    let w_mid = libm::cosh(h);
+    let mut knots = Vec::with_capacity(2 * n + 4);
+    let mut pts = Vec::with_capacity(2 * n + 1);
+    let mut weights = Vec::with_capacity(2 * n + 1);
+    knots.extend([start; 3]);
+    pts.push(at(start));
+    weights.push(1.0);
+    for k in 0..n {
+        let t0 = start + k as f64 * d;
+        let t1 = if k + 1 == n { end } else { t0 + d };
+        let m = 0.5 * (t0 + t1);
+        pts.push(c + (x * libm::cosh(m) + y * libm::sinh(m)) / w_mid);
+        weights.push(w_mid);
+        pts.push(at(t1));
+        weights.push(1.0);
+        if k + 1 < n {
+            knots.extend([t1, t1]);
+        }
+    }
+    knots.extend([end; 3]);
+    NurbsCurve::try_new(2, knots, pts, Some(weights))
+}
+
+/// The parabola arc `c + t²·x + t·y` for `t` from `start` to `end` (`end >
+/// start`): one polynomial quadratic Bézier piece, its parameter `t` itself.
+///
+/// # Errors
+/// An empty span or non-finite input.
+pub fn parabola_arc(c: DVec3, x: DVec3, y: DVec3, start: f64, end: f64) -> Result<NurbsCurve, NurbsError> {
+    if end.is_nan() || start.is_nan() || end <= start {
+        return Err(NurbsError::BadMultiplicity { index: 0 });
+    }
+    let at = |t: f64| c + x * (t * t) + y * t;
+    // The middle point: on the tangent at the start, half the span along it.
+    let p1 = at(start) + (x * (2.0 * start) + y) * (0.5 * (end - start));
+    NurbsCurve::try_new(2, alloc::vec![start, start, start, end, end, end], alloc::vec![at(start), p1, at(end)], None)
+}
+
 /// The rational quadratic segment with control points `p0`, `p1`, `p2`
 /// and middle weight `w` (a conic: ellipse for `w < 1`, parabola `w = 1`,
 /// hyperbola `w > 1`), over the parameter range `[0, 1]`.
@@ -242,4 +304,53 @@ pub fn ruled(c0: &NurbsCurve, c1: &NurbsCurve) -> Result<NurbsSurface, NurbsErro
     }
     let kv = KnotVector::try_new(1, alloc::vec![0.0, 0.0, 1.0, 1.0])?;
     NurbsSurface::from_parts(a.knots().clone(), kv, &points, rational.then_some(weights.as_slice()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Samples of `c` at `n + 1` even parameters.
+    fn samples(c: &NurbsCurve, n: usize) -> Vec<DVec3> {
+        let (a, b) = c.domain();
+        (0..=n).map(|k| c.point(a + (b - a) * k as f64 / n as f64)).collect()
+    }
+
+    #[test]
+    fn a_hyperbola_arc_lies_on_its_hyperbola_whatever_its_span() {
+        let (c, a, b) = (DVec3::new(1.0, 2.0, 3.0), 3.0, 2.0);
+        let (x, y) = (DVec3::X * a, DVec3::new(0.0, 0.6, 0.8) * b);
+        for (t0, t1, pieces) in [(-0.5, 0.7, 1), (-3.0, 4.5, 4), (0.1, 0.2, 1)] {
+            let arc = hyperbola_arc(c, x, y, t0, t1).unwrap();
+            assert_eq!(arc.knots().knots().len(), 2 * pieces + 4, "pieces of at most 2 in t");
+            let (s, e) = arc.domain();
+            let ends = [c + x * libm::cosh(t0) + y * libm::sinh(t0), c + x * libm::cosh(t1) + y * libm::sinh(t1)];
+            assert!(arc.point(s).distance(ends[0]) < 1e-12 && arc.point(e).distance(ends[1]) < 1e-9);
+            let mut last_v = f64::NEG_INFINITY;
+            for p in samples(&arc, 200) {
+                let w = p - c;
+                let (u, v) = (w.dot(x) / (a * a), w.dot(y) / (b * b));
+                // In the plane of x and y, on the branch u > 0, with u² − v² = 1.
+                assert!((w - x * u - y * v).length() < 1e-9, "off the plane: {p}");
+                assert!(u > 0.0 && (u * u - v * v - 1.0).abs() < 1e-9 * u * u, "({u}, {v}) off the hyperbola");
+                // It runs one way along the branch, from t0 to t1.
+                assert!(v > last_v && v >= libm::sinh(t0) - 1e-9 && v <= libm::sinh(t1) + 1e-9);
+                last_v = v;
+            }
+        }
+        assert!(hyperbola_arc(c, x, y, 1.0, 1.0).is_err());
+        assert!(hyperbola_arc(c, x, y, 0.0, 2000.0).is_err(), "cosh overflows: an error, not a curve of infinities");
+    }
+
+    #[test]
+    fn a_parabola_arc_is_its_parabola_at_every_parameter() {
+        let (c, x, y) = (DVec3::new(0.0, 1.0, 0.0), DVec3::new(0.5, 0.0, 0.0), DVec3::new(0.0, 0.0, 2.0));
+        let arc = parabola_arc(c, x, y, -2.0, 3.0).unwrap();
+        assert_eq!(arc.domain(), (-2.0, 3.0));
+        for k in 0..=50 {
+            let t = -2.0 + 5.0 * k as f64 / 50.0;
+            assert!(arc.point(t).distance(c + x * (t * t) + y * t) < 1e-12, "t = {t}");
+        }
+        assert!(parabola_arc(c, x, y, 3.0, -2.0).is_err());
+    }
 }

@@ -267,11 +267,22 @@ impl NurbsSurface {
 
     /// Inserts knot `t` once along u (`along_u`) or v; same shape.
     pub fn insert_knot(&self, along_u: bool, t: f64) -> Self {
+        let kv = if along_u { &self.ku } else { &self.kv };
+        let (a, b) = kv.domain();
+        if !(t > a && t < b) {
+            return self.clone();
+        }
+        self.insert_in_domain(along_u, t)
+    }
+
+    /// As [`NurbsSurface::insert_knot`], for `t` anywhere in the closed domain
+    /// (its ends included, which clamping needs).
+    fn insert_in_domain(&self, along_u: bool, t: f64) -> Self {
         let (nu, nv) = (self.ku.control_count(), self.kv.control_count());
         let kv = if along_u { &self.ku } else { &self.kv };
         let (a, b) = kv.domain();
         let p = kv.degree();
-        if !(t > a && t < b) || kv.multiplicity(t) >= p {
+        if !(t >= a && t <= b) || kv.multiplicity(t) >= p {
             return self.clone();
         }
         let span = kv.span(t);
@@ -311,6 +322,51 @@ impl NurbsSurface {
                 pts.extend(refine(&self.points[i * nv..(i + 1) * nv]));
             }
             Self { ku: self.ku.clone(), kv: new_knots, points: pts, rational: self.rational }
+        }
+    }
+
+    /// The same surface over the same domain with its knots along u
+    /// (`along_u`) or v clamped: each end of the domain a knot of
+    /// multiplicity degree + 1, so the first and last control rows lie on the
+    /// surface's edges. A periodic (unclamped) B-spline from a file needs this
+    /// before its seam can be moved.
+    pub fn clamped(&self, along_u: bool) -> Self {
+        let kv = if along_u { &self.ku } else { &self.kv };
+        let (a, b) = kv.domain();
+        let p = kv.degree();
+        let mut s = self.clone();
+        for t in [a, b] {
+            for _ in 0..p {
+                let before = s.points.len();
+                s = s.insert_in_domain(along_u, t);
+                if s.points.len() == before {
+                    break;
+                }
+            }
+        }
+        let k = if along_u { s.ku.knots() } else { s.kv.knots() };
+        let (Some(last_a), Some(first_b)) = (k.iter().rposition(|&x| x == a), k.iter().position(|&x| x == b)) else {
+            return self.clone();
+        };
+        if last_a < p || first_b + p >= k.len() || (last_a - p == 0 && first_b + p + 1 == k.len()) {
+            return s;
+        }
+        let (s0, e0) = (last_a - p, first_b + p);
+        let mut knots: Vec<f64> = k[s0..=e0].to_vec();
+        knots[0] = a;
+        knots[e0 - s0] = b;
+        let rows = knots.len() - p - 1;
+        let Ok(kn) = KnotVector::try_new(p, knots) else { return self.clone() };
+        let (nu, nv) = (s.ku.control_count(), s.kv.control_count());
+        if along_u {
+            let points = s.points[s0 * nv..(s0 + rows) * nv].to_vec();
+            Self { ku: kn, kv: s.kv.clone(), points, rational: s.rational }
+        } else {
+            let mut points = Vec::with_capacity(nu * rows);
+            for i in 0..nu {
+                points.extend_from_slice(&s.points[i * nv + s0..i * nv + s0 + rows]);
+            }
+            Self { ku: s.ku.clone(), kv: kn, points, rational: s.rational }
         }
     }
 

@@ -23,7 +23,7 @@ use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 use serde::Serialize;
 
-use crate::mesh::{angle_stats, edge_counts, weld_positions, FaceRange};
+use crate::mesh::{angle_stats, edge_counts_around_skipped, weld_positions, FaceRange};
 use crate::model::Face;
 use crate::nurbs::Surface;
 use crate::nurbs::{project_to_surface, ProjectionOptions};
@@ -191,7 +191,8 @@ pub(crate) fn mesh_quality(
     report.mean_deviation = if dev_count > 0 { dev_sum / dev_count as f64 } else { 0.0 };
     report.triangles = mesh.triangle_count();
     report.vertices = mesh.positions.len();
-    let edges = edge_counts(&mesh, (sew * 0.5).min(tol * 1e-3), tol.max(sew));
+    let edges = edge_counts_around_skipped(&mesh, &[], &model.skipped, (sew * 0.5).min(tol * 1e-3), tol.max(sew));
+    crate::mesh::holes_warning(&model.skipped, edges.hole_edges, &mut report.warnings);
     report.free_edges = edges.free_edges;
     report.boundary_edges = edges.boundary_edges;
     report.nonmanifold_edges = edges.nonmanifold_edges;

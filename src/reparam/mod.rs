@@ -545,6 +545,7 @@ mod tests {
             warnings: Vec::new(),
             tolerance: None,
             bodies: Vec::new(),
+            ..Default::default()
         };
         let m = crate::mesh_model(&model, &crate::MeshOptions::default().with_tolerance(0.01)).unwrap();
         assert!(m.report.triangles > 0 && m.report.faces_skipped == 0, "{:?}", m.report.warnings);

@@ -15,6 +15,7 @@ mod refine;
 mod sew;
 #[cfg(feature = "std")]
 pub mod stages;
+mod tessellated;
 mod trial;
 #[cfg(feature = "std")]
 mod trim;
@@ -23,7 +24,7 @@ use alloc::format;
 use alloc::vec::Vec;
 use glam::DVec2;
 
-use crate::mesh::{angle_stats, edge_census, FaceRange};
+use crate::mesh::{angle_stats, edge_census, holes_warning, FaceRange};
 use crate::nurbs::{Aabb, Surface};
 use crate::reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
 use crate::{Error, Mesh, Model, Report};
@@ -68,34 +69,55 @@ pub fn mesh_model_with_progress(
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<MeshResult, Error> {
     let bodies = {
-        let mut ids: Vec<u32> = (0..model.faces.len()).map(|f| crate::model::body_of(&model.bodies, f)).collect();
+        let mut ids: Vec<u32> = (0..model.face_count()).map(|f| crate::model::body_of(&model.bodies, f)).collect();
         ids.sort_unstable();
         ids.dedup();
         ids.len()
     };
-    if options.mode == MeshMode::Quality {
+    // A model of tessellated faces only has nothing to mesh in quality mode:
+    // it takes the path below, which passes them through.
+    if options.mode == MeshMode::Quality && !model.faces.is_empty() {
         let mut r = crate::quality::mesh_quality(model, options, progress)?;
+        // Tessellated faces are passed through unsewn.
+        tessellated::append_unsewn(model, &mut r.mesh, &mut r.report);
         r.report.bodies = bodies;
+        r.report.units = model.units.clone();
+        r.report.faces_unread = model.skipped.len();
         return Ok(r);
     }
     // A share meshes its bodies only; the other faces stay empty (not skipped).
     let mine = match options.share {
-        Some((index, count)) => share_of_faces(&model.bodies, model.faces.len(), index, count),
-        None => alloc::vec![true; model.faces.len()],
+        Some((index, count)) => share_of_faces(&model.bodies, model.face_count(), index, count),
+        None => alloc::vec![true; model.face_count()],
     };
     if options.share.is_some() && !mine.contains(&true) {
         // More shares than bodies: this one returns at once, without the
         // bounding box a tolerance needs (its report's tolerance stays 0).
         options.validate()?;
-        let mesh = Mesh { face_ranges: alloc::vec![FaceRange::default(); model.faces.len()], ..Mesh::default() };
-        let report = Report { angle: options.angle, faces: model.faces.len(), bodies, ..Report::default() };
+        let mesh = Mesh { face_ranges: alloc::vec![FaceRange::default(); model.face_count()], ..Mesh::default() };
+        let report = Report {
+            units: model.units.clone(),
+            angle: options.angle,
+            faces: model.face_count(),
+            faces_unread: model.skipped.len(),
+            bodies,
+            ..Report::default()
+        };
         return Ok(MeshResult { mesh, report });
     }
     let Setup { tol, diag, lim, crit } = setup(model, options)?;
     let aim = crit.tol;
-    let mut report =
-        Report { tolerance: tol, angle: options.angle, faces: model.faces.len(), bodies, ..Report::default() };
+    let mut report = Report {
+        units: model.units.clone(),
+        tolerance: tol,
+        angle: options.angle,
+        faces: model.face_count(),
+        faces_unread: model.skipped.len(),
+        bodies,
+        ..Report::default()
+    };
     report.warnings.extend(model.warnings.iter().cloned());
+    let mut facets = tessellated::Facets::new(model, &mine);
     // Paper 001: faces whose parameters crowd are rebuilt on even ones first.
     let rebuilt = reparameterize(model, &mine, options.reparam, tol, &mut report);
     // Untrimmed faces are meshed as trimmed by their domain's border, so
@@ -250,7 +272,7 @@ pub fn mesh_model_with_progress(
         Some(s) => (s, auto_tight.min(s)),
         None => (0.4 * tol, auto_tight),
     };
-    let ids = unify_outlines(&mut chosen, &model.bodies, sew_tol, tight, aim + sew_tol);
+    let ids = unify_outlines(&mut chosen, &model.bodies, &facets, sew_tol, tight, aim + sew_tol);
     // Every face's first mesh (grid and trim band) on those nodes; each
     // outline is freed once its mesh is built (only whether it is pinched
     // is asked later).
@@ -293,6 +315,8 @@ pub fn mesh_model_with_progress(
     if let Some(e) = first_failure.filter(|_| works.iter().all(|w| w.mesh.tris.is_empty())) {
         return Err(e);
     }
+    // Borders along tessellated faces take their vertices before refinement.
+    tessellated::snap_borders(&mut works, &facets, &model.bodies, sew_tol);
     // Refinement keeps shared borders shared: a split of a shared edge is
     // made on every side; then every node takes one position.
     let budget_hit = sew::refine_all(&mut works, ids, sew_tol, options.max_triangles, progress)?;
@@ -344,6 +368,8 @@ pub fn mesh_model_with_progress(
     for w in works.iter_mut() {
         w.mesh.rest();
     }
+    // The tessellated faces take the exact borders' nodes along theirs.
+    tessellated::split_rims(&mut works, &mut facets, &model.bodies, sew_tol);
     let (mut dev_sum, mut dev_count) = (0.0, 0u64);
     for (index, (w, fit_error)) in works.iter_mut().zip(&fit_errors).enumerate() {
         let out = w.mesh.outcome(w.surface, &w.crit);
@@ -425,6 +451,7 @@ pub fn mesh_model_with_progress(
         }
         mesh.face_ranges.push(FaceRange { first, count: wm.tris.len() as u32 });
     }
+    let dropped = facets.append_to(&mut mesh);
     // The room the last growth left, given back before the mesh is measured.
     mesh.positions.shrink_to_fit();
     mesh.normals.shrink_to_fit();
@@ -432,7 +459,8 @@ pub fn mesh_model_with_progress(
     report.mean_deviation = if dev_count > 0 { dev_sum / dev_count as f64 } else { 0.0 };
     report.triangles = mesh.triangle_count();
     report.vertices = mesh.positions.len();
-    let (edges, gaps) = edge_census(&mesh, &model.bodies, (tol * 1e-3).min(tight * 0.5), tol);
+    let (edges, gaps) = edge_census(&mesh, &model.bodies, &model.skipped, (tol * 1e-3).min(tight * 0.5), tol);
+    holes_warning(&model.skipped, edges.hole_edges, &mut report.warnings);
     // A crack wider than sewing reaches is the file's own gap: say where.
     for g in gaps.iter().filter(|g| g.width > sew_tol) {
         report.warnings.push(format!(
@@ -447,6 +475,7 @@ pub fn mesh_model_with_progress(
     let angles = angle_stats(&mesh);
     report.min_angle_deg = angles.min_deg;
     report.p1_angle_deg = angles.p1_deg;
+    tessellated::finish_report(model, &mine, &mesh, dropped, &mut report);
     Ok(MeshResult { mesh, report })
 }
 
@@ -541,7 +570,7 @@ pub(crate) struct Setup {
 /// Validates `options` and turns them into the limits for `model`.
 fn setup(model: &Model, options: &MeshOptions) -> Result<Setup, Error> {
     options.validate()?;
-    if model.faces.is_empty() {
+    if model.face_count() == 0 {
         return Err(Error::Model { location: "model".into(), message: "has no faces".into() });
     }
     let diag = trimmed_bbox(model).diagonal();
@@ -655,19 +684,28 @@ impl<'a> Chosen<'a> {
     }
 }
 
-/// Sews the outlines of the faces to be meshed (see [`sew::unify`]); returns the node ids given.
-fn unify_outlines(chosen: &mut [Option<Chosen<'_>>], bodies: &[u32], sew_tol: f64, tight: f64, reach: f64) -> u32 {
+/// Sews the outlines of the faces to be meshed (see [`sew::unify`]), after
+/// the tessellated faces' border vertices are pinned on them; returns the node ids given.
+fn unify_outlines(
+    chosen: &mut [Option<Chosen<'_>>],
+    bodies: &[u32],
+    facets: &tessellated::Facets<'_>,
+    sew_tol: f64,
+    tight: f64,
+    reach: f64,
+) -> u32 {
     #[cfg(feature = "std")]
     {
         // A rebuilt face's border lies up to its fit error from its neighbours'.
         let moved: Vec<f64> = chosen.iter().map(|c| c.as_ref().map_or(0.0, |c| c.fit_error)).collect();
         let mut faces: Vec<Option<(&dyn Surface, &mut face::Outline<'_>)>> =
             chosen.iter_mut().map(|c| c.as_mut().map(|c| (&c.face.surface as &dyn Surface, &mut c.outline))).collect();
+        tessellated::pin_outlines(&mut faces, bodies, facets, sew_tol);
         sew::unify(&mut faces, bodies, &moved, sew_tol, tight, reach)
     }
     #[cfg(not(feature = "std"))]
     {
-        let _ = (chosen, bodies, sew_tol, tight, reach);
+        let _ = (chosen, bodies, facets, sew_tol, tight, reach);
         0
     }
 }
@@ -685,6 +723,11 @@ fn face_is_supported(f: &crate::Face) -> bool {
 /// its loops' parameter box (points inside the region) and the loops themselves.
 pub(crate) fn trimmed_bbox(model: &Model) -> Aabb {
     let mut b = Aabb::EMPTY;
+    for t in &model.tessellated {
+        for &p in t.positions.iter().filter(|p| p.is_finite()) {
+            b.add_point(p);
+        }
+    }
     for f in &model.faces {
         let s: &dyn Surface = &f.surface;
         let [mut lo, mut hi] = s.domain();

@@ -67,7 +67,7 @@ fn golden(dist: &dyn Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
 /// fraction `s0`: a segment's curve parameter need not follow its chord, so
 /// a coarse scan of the whole span brackets the minimum when the window
 /// about `s0` ends at its edge.
-fn nearest_fraction(dist: &dyn Fn(f64) -> f64, s0: f64) -> (f64, f64) {
+pub(super) fn nearest_fraction(dist: &dyn Fn(f64) -> f64, s0: f64) -> (f64, f64) {
     let (lo, hi) = ((s0 - 0.25).max(0.0), (s0 + 0.25).min(1.0));
     let (s, d) = golden(dist, lo, hi);
     let at_edge = (s - lo < 1e-6 && lo > 0.0) || (hi - s < 1e-6 && hi < 1.0);

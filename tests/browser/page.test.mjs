@@ -242,6 +242,16 @@ test('a STEP assembly meshes, and a picked face names its part', async () => {
   });
 });
 
+test('a STEP file of tessellated faces meshes, counted apart and without a deviation claimed', async () => {
+  const bytes = readFileSync(join(root, 'tests', 'data', 'step_tess_solid.stp'));
+  const state = await settle(() => page.setInputFiles('#file-input', { name: 'tetra.stp', mimeType: 'application/octet-stream', buffer: bytes }));
+  assert.equal(state, 'ready', await page.textContent('#error-message'));
+  assert.equal(await page.textContent('#stat-faces'), '4 (4 tessellated)');
+  assert.equal(await page.textContent('#stat-max-deviation'), '— (tessellated faces only)');
+  assert.equal(await stat('stat-triangles'), 4);
+  assert.equal(await stat('stat-open-edges'), 0, 'a closed tetrahedron');
+});
+
 test('STL, OBJ and GLB exports hold the triangles the page shows', async () => {
   await settle(() => page.selectOption('#sample', 'can.json'));
   assert.equal(await page.getAttribute('body', 'data-state'), 'ready');

@@ -532,9 +532,11 @@ fn cli_help_prints_usage() {
 
 // ---------------------------------------------------------------- command line, success
 
-const REPORT_FIELDS: [&str; 13] = [
+const REPORT_FIELDS: [&str; 15] = [
+    "units",
     "tolerance",
     "faces",
+    "faces_unread",
     "triangles",
     "vertices",
     "max_deviation",
@@ -628,6 +630,132 @@ fn cli_meshes_the_plane_to_every_format() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// `--units` scales the mesh and the report's lengths from the file's unit
+/// (the box is 2 × 1 × 0.5 inches) and names the unit; the GLB is in metres
+/// whatever the unit of the mesh, as glTF defines its lengths.
+#[test]
+fn cli_units_scale_the_mesh_and_the_glb_is_in_metres() {
+    let dir = scratch("units");
+    let input = data("step_box_inch.stp");
+    let mut runs = Vec::new();
+    for units in ["file", "mm", "m"] {
+        let (stl, glb, rep) = (dir.join(format!("{units}.stl")), dir.join(format!("{units}.glb")), dir.join("r.json"));
+        for out in [&stl, &glb] {
+            let os = |s: &'static str| std::ffi::OsStr::new(s);
+            let mut args = vec![os("mesh"), input.as_os_str(), os("--tol-rel"), os("0.01"), os("-o"), out.as_os_str()];
+            args.extend([os("--report"), rep.as_os_str()]);
+            if units != "file" {
+                args.extend([os("--units"), os(units)]);
+            }
+            mesh_ok(&args);
+        }
+        let report = check_report(&std::fs::read(&rep).unwrap());
+        // Binary STL: the mesh's own coordinates, in the unit asked for.
+        let bytes = std::fs::read(&stl).unwrap();
+        let n = u32_at(&bytes, 80) as usize;
+        let mut max = [f32::NEG_INFINITY; 3];
+        for t in 0..n {
+            for v in 0..3 {
+                for (k, m) in max.iter_mut().enumerate() {
+                    let at = 84 + 50 * t + 12 + 12 * v + 4 * k;
+                    *m = m.max(f32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()));
+                }
+            }
+        }
+        let (doc, _) = open_glb(&std::fs::read(&glb).unwrap());
+        let glb_max: Vec<f64> =
+            doc["accessors"][0]["max"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        runs.push((units, report, max, glb_max));
+    }
+    let inch_mm = 25.4;
+    for (units, report, max, glb_max) in &runs {
+        let (name, per_inch) = match *units {
+            "file" => ("in", 1.0),
+            "mm" => ("mm", inch_mm),
+            _ => ("m", inch_mm / 1000.0),
+        };
+        assert_eq!(report["units"], name, "{units}");
+        for (k, size) in [2.0, 1.0, 0.5].iter().enumerate() {
+            let want = size * per_inch;
+            assert!((max[k] as f64 - want).abs() <= 1e-6 * want, "{units}: box corner {k} at {} not {want}", max[k]);
+            let metres = size * inch_mm / 1000.0;
+            assert!((glb_max[k] - metres).abs() <= 1e-6 * metres, "{units}: GLB corner {k} at {} m", glb_max[k]);
+        }
+        // The tolerance scales with the mesh: the same relative tolerance of the same box.
+        let tol_in = runs[0].1["tolerance"].as_f64().unwrap();
+        let tol = report["tolerance"].as_f64().unwrap();
+        assert!((tol - tol_in * per_inch).abs() <= 1e-9 * tol, "{units}: tolerance {tol}");
+        assert_eq!(report["triangles"], runs[0].1["triangles"], "{units}: the same mesh, scaled");
+    }
+    let bad = run(&["mesh".as_ref(), input.as_os_str(), "--units".as_ref(), "yd".as_ref()]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(stderr(&bad).contains("option units: expected"), "{}", stderr(&bad));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `check` meshes every model file of a folder (and its folders, not hidden
+/// ones; notes such as SOURCES.md are not models), one row per file sorted
+/// by name: a file that fails has its error in its row and makes the exit
+/// status 1; a face the reader could not build counts among the file's
+/// faces, and the edges left open along it as cracks.
+#[test]
+fn cli_check_sweeps_a_folder_into_rows() {
+    let dir = scratch("check");
+    let models = dir.join("models");
+    std::fs::create_dir_all(models.join("sub")).unwrap();
+    std::fs::create_dir_all(models.join(".hidden")).unwrap();
+    for (from, to) in [
+        ("plane.json", "b_plane.json"),
+        ("step_bad_face.stp", "a_box.stp"),
+        ("bad_syntax.json", "c_bad.json"),
+        ("iges_plate.igs", "sub/plate.igs"),
+        ("plane.json", ".hidden/plane.json"),
+        ("plane.json", ".dot.json"),
+    ] {
+        std::fs::copy(data(from), models.join(to)).unwrap();
+    }
+    // No extension: found by its first bytes; a note is not a model.
+    std::fs::copy(data("step_box_inch.stp"), models.join("BOX")).unwrap();
+    std::fs::write(models.join("SOURCES.md"), "# where the files come from\n").unwrap();
+    let json = dir.join("rows.json");
+    let os = |s: &'static str| std::ffi::OsStr::new(s);
+    let out = run(&[os("check"), models.as_os_str(), os("--tol-rel"), os("0.01"), os("--json"), json.as_os_str()]);
+    assert_eq!(out.status.code(), Some(1), "one file fails: {}", stderr(&out));
+    let table = String::from_utf8(out.stdout).unwrap();
+    let sweep: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(sweep["tolerance"], "relative 0.01");
+    let rows = sweep["files"].as_array().unwrap();
+    let names: Vec<&str> = rows.iter().map(|r| r["file"].as_str().unwrap()).collect();
+    assert_eq!(names, ["BOX", "a_box.stp", "b_plane.json", "c_bad.json", "sub/plate.igs"], "{table}");
+    let row = |name: &str| rows.iter().find(|r| r["file"] == name).unwrap();
+    let bad = row("c_bad.json");
+    assert_eq!(bad["ok"], false);
+    assert!(bad["error"].as_str().unwrap().starts_with("JSON line 3"), "{bad}");
+    assert!(table.lines().any(|l| l.starts_with("c_bad.json") && l.contains("ERROR JSON line 3")), "{table}");
+    let open_box = row("a_box.stp");
+    assert_eq!((open_box["faces_in_file"].as_u64(), open_box["faces_meshed"].as_u64()), (Some(6), Some(5)));
+    assert_eq!(open_box["faces_unread"], 1);
+    assert!(open_box["cracks"].as_u64().unwrap() >= 4, "{open_box}");
+    assert!(open_box["first_warning"].as_str().unwrap().starts_with("#53 ADVANCED_FACE: skipped"), "{open_box}");
+    let whole = row("BOX");
+    assert_eq!((whole["ok"].as_bool(), whole["faces_meshed"].as_u64()), (Some(true), Some(6)));
+    assert_eq!((whole["cracks"].as_u64(), whole["units"].as_str()), (Some(0), Some("in")));
+    for r in rows.iter().filter(|r| r["ok"] == true) {
+        assert!(r["deviation_ratio"].as_f64().unwrap() <= 1.0, "{r}");
+        assert!(r["tolerance"].as_f64().unwrap() > 0.0 && r["time_ms"].as_f64().unwrap() >= 0.0, "{r}");
+    }
+    let totals = table.lines().last().unwrap();
+    assert!(totals.starts_with("total: 5 files, 4 meshed, 1 failed; faces 14/15 (1 unread, 0 empty)"), "{totals}");
+    // Every file meshing: exit status 0.
+    std::fs::remove_file(models.join("c_bad.json")).unwrap();
+    let out = run(&[os("check"), models.as_os_str(), os("--tol-rel"), os("0.01"), os("--jobs"), os("1")]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    // Usage errors: exit status 2.
+    assert_eq!(run(&[os("check")]).status.code(), Some(2));
+    assert_eq!(run(&[os("check"), models.as_os_str(), os("--timeout"), os("0")]).status.code(), Some(2));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 #[test]
 fn cli_prints_the_report_without_outputs_and_honours_tol_rel() {
     let out = mesh_ok(&["mesh".as_ref(), data("plane.json").as_os_str(), "--tol-rel".as_ref(), "0.001".as_ref()]);
@@ -715,6 +843,12 @@ fn cli_meshes_step_by_extension_content_and_name() {
         assert_eq!(r["faces"], 3);
         assert_eq!(r["boundary_edges"], 0);
     }
+    // Tessellated faces: counted in the report, and the summary line says
+    // they are not verified.
+    let out = mesh_ok(&["mesh".as_ref(), data("step_tess_mixed.stp").as_os_str()]);
+    let r = check_report(&out.stdout);
+    assert_eq!((r["faces"].as_u64(), r["faces_tessellated"].as_u64()), (Some(2), Some(1)));
+    assert!(stderr(&out).contains("(1 tessellated face not verified)"), "{}", stderr(&out));
     let out = run(&["mesh".as_ref(), data("step_unclosed_string.stp").as_os_str()]);
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("STEP line 10, #7: string not closed by a quote"), "{}", stderr(&out));
@@ -764,11 +898,7 @@ fn strictly_inside(polygon: &[glam::DVec2], p: glam::DVec2, margin: f64) -> bool
 /// afresh in each process, and each run wrote another OBJ.
 #[test]
 fn two_runs_write_the_same_mesh() {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus/trj7_b1-ec-214.stp");
-    if !file.exists() {
-        eprintln!("SKIPPED: no corpus file {} (needs ../shared/corpus)", file.display());
-        return;
-    }
+    let file = crate::corpus_files::corpus_path("trj7_b1-ec-214.stp");
     let dir = scratch("two-runs");
     let outs: Vec<PathBuf> = (0..2).map(|i| dir.join(format!("run{i}.obj"))).collect();
     // Both processes at once: a debug build takes a while on this file.

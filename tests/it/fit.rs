@@ -290,11 +290,7 @@ fn two_spheres_joined_by_a_blend_give_one_closed_g1_surface() {
 
 #[test]
 fn points_of_a_corpus_surface_give_an_open_g1_sheet_near_it() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus/PRO20359-L1.igs");
-    let bytes = std::fs::read(&path).unwrap_or_else(|e| {
-        panic!("the corpus is expected beside the repository (../shared/corpus): {}: {e}", path.display())
-    });
-    let model = read_iges(&bytes).unwrap();
+    let model = read_iges(&crate::corpus_files::corpus_bytes("PRO20359-L1.igs")).unwrap();
     let surface = &model.faces[0].surface;
     let [lo, hi] = surface.domain();
     let mut rng = Rng(4);

@@ -1,4 +1,4 @@
-//! IGES corpus: the IGES files of the shared corpus (`../shared/corpus`, see
+//! IGES corpus: the IGES files of the test corpus (`tests/corpus`, see
 //! its SOURCES.md). Every one must read; the files in [`MESHED`] must also
 //! mesh at relative tolerances 1e-2 and 1e-3 with a measured deviation
 //! within the tolerance, no inverted triangle, no crack between faces, and
@@ -9,29 +9,11 @@
 //! files under [`DEBUG_MAX_BYTES`], to stay within CI's time;
 //! `cargo test --release` meshes them all.
 
-use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use surfmesh::{mesh_model, read_iges, MeshOptions, Model};
 
-fn corpus_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("shared").join("corpus")
-}
-
-/// IGES files of the corpus, sorted by name.
-fn corpus_files() -> Option<Vec<PathBuf>> {
-    let entries = std::fs::read_dir(corpus_dir()).ok()?;
-    let mut files: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.extension()
-                .and_then(|e| e.to_str())
-                .is_some_and(|e| e.eq_ignore_ascii_case("igs") || e.eq_ignore_ascii_case("iges"))
-        })
-        .collect();
-    files.sort();
-    Some(files)
-}
+use crate::corpus_files::{corpus_bytes, corpus_names};
 
 /// Files that must meet the whole acceptance.
 const MESHED: [&str; 14] = [
@@ -64,11 +46,7 @@ fn skipped_faces(model: &Model) -> usize {
 
 #[test]
 fn corpus_reads_and_meshes_within_tolerance_without_cracks() {
-    let Some(files) = corpus_files() else {
-        eprintln!("SKIPPED: no corpus at {} (the IGES corpus test needs ../shared/corpus)", corpus_dir().display());
-        return;
-    };
-    let names: Vec<String> = files.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    let names = corpus_names(&["igs", "iges"]);
     for m in MESHED {
         assert!(names.iter().any(|n| n == m), "{m} is not in the corpus");
     }
@@ -77,8 +55,8 @@ fn corpus_reads_and_meshes_within_tolerance_without_cracks() {
         "{:<28} {:>6} {:>5} {:>5} {:>8} {:>11} {:>11} {:>4} {:>5} {:>6} {:>7}",
         "file", "rel", "faces", "skip", "tris", "max dev", "tolerance", "inv", "free", "bound", "ms"
     );
-    for (path, name) in files.iter().zip(&names) {
-        let bytes = std::fs::read(path).unwrap();
+    for name in &names {
+        let bytes = corpus_bytes(name);
         let start = Instant::now();
         let model = match read_iges(&bytes) {
             Ok(m) => m,

@@ -1,6 +1,7 @@
 //! Native integration tests, one binary.
 
 mod cli;
+mod corpus_files;
 mod fit;
 mod iges;
 mod mesh;
@@ -10,6 +11,7 @@ mod repair;
 mod reparam;
 mod shapes;
 mod step;
+mod tessellated;
 
 /// Triangles with two corners at one point (up to rounding): no area, a
 /// NaN normal for a viewer, and the worst of every quality measure.

@@ -375,7 +375,14 @@ fn flat_and_wavy() -> Model {
     let flat = height_patch(0.0, 10.0, |_, _| 0.0);
     let wavy = height_patch(10.0, 20.0, |x, t| if x > 10.0 { 8.0 * (t * 6.0).sin() } else { 0.0 });
     let face = |s| Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] };
-    Model { units: "mm".into(), faces: vec![face(flat), face(wavy)], warnings: vec![], tolerance: None, bodies: vec![] }
+    Model {
+        units: "mm".into(),
+        faces: vec![face(flat), face(wavy)],
+        warnings: vec![],
+        tolerance: None,
+        bodies: vec![],
+        ..Default::default()
+    }
 }
 
 #[test]
@@ -457,6 +464,7 @@ fn mesh_split_surface_halves_reproduce_the_original() {
             warnings: vec![],
             tolerance: None,
             bodies: vec![],
+            ..Default::default()
         };
         let r = mesh(&model, 1e-3);
         check_common("split sphere", &r, 1e-3);
@@ -478,7 +486,7 @@ fn row_with_one_gap(gap: f64) -> Model {
     let face = |s| Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] };
     let mut faces: Vec<Face> = (0..30).map(|i| face(patch(10.0 * i as f64, i % 2 == 1))).collect();
     faces.push(face(patch(300.0 + gap, false)));
-    Model { units: "mm".into(), faces, warnings: vec![], tolerance: None, bodies: vec![] }
+    Model { units: "mm".into(), faces, warnings: vec![], tolerance: None, bodies: vec![], ..Default::default() }
 }
 
 #[test]
@@ -625,6 +633,7 @@ fn mesh_folded_strip_keeps_its_panels_flat_and_few() {
         warnings: vec![],
         tolerance: None,
         bodies: vec![],
+        ..Default::default()
     };
     for rel in RELS {
         let r = mesh(&model, rel);

@@ -1005,3 +1005,44 @@ proptest! {
         prop_assert!(b.diagonal() > 0.0 && !b.is_empty());
     }
 }
+
+/// Clamping an unclamped (periodic) knot vector keeps the surface and its
+/// domain, and puts the first and last control rows on its edges, which a
+/// seam move needs.
+#[test]
+fn surface_clamping_keeps_shape_and_clamps_the_ends() {
+    let (nu, nv) = (9, 3);
+    let knots_u: Vec<f64> = (0..nu + 4).map(|i| (i as f64 - 3.0) * 0.25).collect();
+    let knots_v = vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0];
+    let points: Vec<Vec<DVec3>> = (0..nu)
+        .map(|i| (0..nv).map(|j| DVec3::new(i as f64, (i * i % 5) as f64 + j as f64, (j * i) as f64 * 0.3)).collect())
+        .collect();
+    let weights: Vec<Vec<f64>> =
+        (0..nu).map(|i| (0..nv).map(|j| 1.0 + 0.1 * ((i + 2 * j) % 4) as f64).collect()).collect();
+    let s = NurbsSurface::try_new([3, 2], knots_u, knots_v, &points, Some(&weights)).unwrap();
+    let c = s.clamped(true);
+    assert_eq!(c.domain(), s.domain());
+    let ku = c.knots_u().knots();
+    let [lo, hi] = s.domain();
+    assert!(ku[..4].iter().all(|&k| k == lo.x) && ku[ku.len() - 4..].iter().all(|&k| k == hi.x), "{ku:?}");
+    assert_eq!(c.knots_v(), s.knots_v());
+    let mut worst = 0.0f64;
+    for i in 0..=40 {
+        for j in 0..=10 {
+            let uv = lo + (hi - lo) * DVec2::new(i as f64 / 40.0, j as f64 / 10.0);
+            worst = worst.max(s.point(uv).distance(c.point(uv)));
+        }
+    }
+    assert!(worst <= 1e-12 * 30.0, "shape moved by {worst}");
+    // Clamped ends interpolate the corners.
+    let [cu, cv] = c.counts();
+    for (i, u) in [(0, lo.x), (cu - 1, hi.x)] {
+        for (j, v) in [(0, lo.y), (cv - 1, hi.y)] {
+            let h = c.homogeneous(i, j);
+            let gap = (h.truncate() / h.w).distance(s.point(DVec2::new(u, v)));
+            assert!(gap < 1e-12 * 30.0, "control point ({i}, {j}) is {gap} off the corner");
+        }
+    }
+    // Already clamped: unchanged.
+    assert_eq!(c.clamped(true), c);
+}

@@ -5,9 +5,8 @@ use std::process::Command;
 
 use glam::DVec3;
 use surfmesh::{
-    measure_mesh, mesh_model, read_json, read_model, read_msh, weld_mesh, write_msh, write_unv, Error, FaceRange,
-    Format, MeasureOptions, Mesh, MeshMode, MeshOptions, MeshResult, Model, QualityMethod, QualityOptions,
-    UNV_SHELL_TRIANGLE,
+    measure_mesh, mesh_model, read_json, read_msh, weld_mesh, write_msh, write_unv, Error, FaceRange, MeasureOptions,
+    Mesh, MeshMode, MeshOptions, MeshResult, Model, QualityMethod, QualityOptions, UNV_SHELL_TRIANGLE,
 };
 
 fn data(name: &str) -> PathBuf {
@@ -18,14 +17,9 @@ fn shape(name: &str) -> Model {
     read_json(&std::fs::read(data(name)).unwrap()).unwrap()
 }
 
-/// A corpus file (`../shared/corpus`), or `None` with a note when the corpus is absent.
-fn corpus(name: &str) -> Option<Model> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus").join(name);
-    let Ok(bytes) = std::fs::read(&path) else {
-        eprintln!("SKIPPED: {} is missing (the quality corpus checks need ../shared/corpus)", path.display());
-        return None;
-    };
-    Some(read_model(&bytes, Format::Iges).unwrap())
+/// A file of the test corpus (`tests/corpus`), read.
+fn corpus(name: &str) -> Model {
+    crate::corpus_files::corpus_model(name)
 }
 
 fn quality(q: QualityOptions) -> MeshOptions {
@@ -117,10 +111,10 @@ fn quality_faces_meet_node_to_node_where_one_side_is_split() {
 
 #[test]
 fn quality_closed_solids_stay_closed_with_every_method() {
-    let mut models = vec![("torus.json", shape("torus.json"), 0.08)];
-    if let Some(m) = corpus("cube_10x10_inventor.igs") {
-        models.push(("cube_10x10_inventor.igs", m, 0.08));
-    }
+    let models = [
+        ("torus.json", shape("torus.json"), 0.08),
+        ("cube_10x10_inventor.igs", corpus("cube_10x10_inventor.igs"), 0.08),
+    ];
     for (name, model, rel) in &models {
         for method in [QualityMethod::Looping, QualityMethod::Delaunay, QualityMethod::Best] {
             let q = QualityOptions::default().with_relative_size(*rel).with_method(method);
@@ -145,10 +139,8 @@ fn quality_curved_and_trimmed_faces_meet_the_acceptance() {
         accept(name, &shape(name), QualityOptions::default().with_relative_size(rel), name == "sphere.json");
     }
     for name in ["OCC26138_Torus.igs", "OCC8842_cylinder_CATIA.igs", "PRO20358-W10.igs"] {
-        if let Some(model) = corpus(name) {
-            let closed = name == "OCC8842_cylinder_CATIA.igs";
-            accept(name, &model, QualityOptions::default().with_relative_size(0.05), closed);
-        }
+        let closed = name == "OCC8842_cylinder_CATIA.igs";
+        accept(name, &corpus(name), QualityOptions::default().with_relative_size(0.05), closed);
     }
 }
 

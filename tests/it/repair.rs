@@ -388,12 +388,7 @@ fn repair_inward_offset_of_a_corpus_cube_folds_at_its_edges() {
     // A 10 mm cube from Inventor, meshed finely: vertex normals along the
     // edges point diagonally, so an inward offset larger than the mesh
     // spacing folds the triangles next to every edge over each other.
-    let Ok(bytes) =
-        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus/cube_10x10_inventor.igs"))
-    else {
-        panic!("the corpus is expected beside the repository (../shared/corpus)");
-    };
-    let model = read_iges(&bytes).unwrap();
+    let model = read_iges(&crate::corpus_files::corpus_bytes("cube_10x10_inventor.igs")).unwrap();
     let opts = MeshOptions::default().with_max_edge(Some(1.5));
     let r = mesh_model(&model, &opts).unwrap();
     let mut m = weld_mesh(&r.mesh, 1e-6);
@@ -441,11 +436,7 @@ fn the_tests_own_intersection_checks_see_crossing_touching_and_coplanar_pairs() 
 
 /// A corpus part meshed with edges up to `max_edge`, welded.
 fn corpus_mesh(name: &str, max_edge: f64) -> Mesh {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus").join(name);
-    let Ok(bytes) = std::fs::read(&path) else {
-        panic!("the corpus is expected beside the repository (../shared/corpus): {}", path.display());
-    };
-    let model = read_iges(&bytes).unwrap();
+    let model = read_iges(&crate::corpus_files::corpus_bytes(name)).unwrap();
     let r = mesh_model(&model, &MeshOptions::default().with_max_edge(Some(max_edge))).unwrap();
     let diag = bbox_diagonal(&r.mesh);
     let mut m = weld_mesh(&r.mesh, 1e-9 * diag);

@@ -6,9 +6,9 @@ use glam::DVec3;
 
 use crate::shapes::{unit_circle, CIRCLE_KNOTS};
 use surfmesh::{
-    measure_mesh, mesh_model, read_iges, read_json, read_model, reparameterize_model, step_ratio, write_iges, Face,
-    FaceSurface, Format, MeasureOptions, MeshOptions, MeshResult, Model, NurbsCurve, NurbsSurface, Reparam, Surface,
-    Tolerance, TrimLoop, FIT_LIMIT, RATIO_LIMIT,
+    measure_mesh, mesh_model, read_iges, read_json, reparameterize_model, step_ratio, write_iges, Face, FaceSurface,
+    MeasureOptions, MeshOptions, MeshResult, Model, NurbsCurve, NurbsSurface, Reparam, Surface, Tolerance, TrimLoop,
+    FIT_LIMIT, RATIO_LIMIT,
 };
 
 /// A wavy sheet whose u parameter crowds: the first 80% of the u range (8 of
@@ -42,6 +42,7 @@ fn model(loops: Vec<TrimLoop>) -> Model {
         warnings: Vec::new(),
         tolerance: None,
         bodies: Vec::new(),
+        ..Default::default()
     }
 }
 
@@ -221,6 +222,7 @@ fn reparam_force_on_degenerate_faces_falls_back_or_holds_tolerance() {
         warnings: Vec::new(),
         tolerance: None,
         bodies: Vec::new(),
+        ..Default::default()
     };
     let r = mesh_model(&m, &MeshOptions::default().with_tolerance(0.01).with_reparam(Reparam::Force));
     let r = r.unwrap();
@@ -307,11 +309,9 @@ fn reparam_command_writes_iges() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// A corpus file (`../shared/corpus`), when the corpus is there.
-fn corpus(name: &str) -> Option<Model> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus").join(name);
-    let bytes = std::fs::read(path).ok()?;
-    Some(read_model(&bytes, Format::detect(&bytes).unwrap()).unwrap())
+/// A file of the test corpus (`tests/corpus`), read.
+fn corpus(name: &str) -> Model {
+    crate::corpus_files::corpus_model(name)
 }
 
 /// Face `index` of `m` as a model of its own, checked to be one the ratio test flags.
@@ -322,6 +322,7 @@ fn flagged_face(m: &Model, file: &str, index: usize) -> Model {
         warnings: Vec::new(),
         tolerance: None,
         bodies: Vec::new(),
+        ..Default::default()
     };
     assert!(step_ratio(&one.faces[0].surface) > RATIO_LIMIT, "{file} face {index}");
     one
@@ -367,10 +368,7 @@ fn reparam_flagged_corpus_faces_win() {
     let mut tols = std::collections::HashMap::new();
     let mut models = std::collections::HashMap::new();
     for (file, index, rel) in rows {
-        let Some(m) = models.entry(file).or_insert_with(|| corpus(file)).as_ref() else {
-            println!("{file}: corpus not found, skipped");
-            continue;
-        };
+        let m = models.entry(file).or_insert_with(|| corpus(file));
         let tol = *tols
             .entry((file, rel.to_bits()))
             .or_insert_with(|| reparameterize_model(m, Reparam::Off, Tolerance::Relative(rel)).unwrap().tolerance);
@@ -412,11 +410,7 @@ fn reparam_auto_sews_rebuilt_faces_to_their_neighbours() {
         ("trj6_pm4-ec-203.stp", &[312, 386, 387, 388, 396, 397, 398], 2),
     ];
     for (file, faces, least) in parts {
-        let Some(m) = corpus(file) else {
-            println!("{file}: corpus not found, skipped");
-            continue;
-        };
-        sews_part(&m, faces, least);
+        sews_part(&corpus(file), faces, least);
     }
 }
 
@@ -429,6 +423,7 @@ fn sews_part(m: &Model, faces: &[usize], least: usize) {
         warnings: Vec::new(),
         tolerance: m.tolerance,
         bodies: Vec::new(),
+        ..Default::default()
     };
     for rel in [1e-2, 1e-3] {
         // The whole model's tolerance, as these faces get it there.
@@ -458,25 +453,21 @@ fn sews_part(m: &Model, faces: &[usize], least: usize) {
 /// its fit error of the original's), so the angles tie.
 #[test]
 fn reparam_losing_corpus_faces_mesh_as_off() {
-    for (file, index, rel) in [("asmo_car.igs", 2, 1e-3)] {
-        let Some(m) = corpus(file) else {
-            println!("{file}: corpus not found, skipped");
-            continue;
-        };
-        let tol = reparameterize_model(&m, Reparam::Off, Tolerance::Relative(rel)).unwrap().tolerance;
-        let one = flagged_face(&m, file, index);
-        let run = |mode| mesh_model(&one, &MeshOptions::default().with_tolerance(tol).with_reparam(mode)).unwrap();
-        let (off, auto) = (run(Reparam::Off), run(Reparam::Auto));
-        let (o, a) = (&off.report, &auto.report);
-        println!(
-            "{file} face {index} at {rel}: off {} tris p1 {:.3}°, auto {} tris p1 {:.3}°: {:?}",
-            o.triangles, o.p1_angle_deg, a.triangles, a.p1_angle_deg, a.warnings
-        );
-        assert_eq!(a.reparameterized.len(), 1, "{file} face {index} at {rel}");
-        assert!(!a.reparameterized[0].rebuilt, "{file} face {index} at {rel}");
-        assert!(a.warnings.iter().any(|w| w.ends_with("meshed the original")), "{:?}", a.warnings);
-        assert_eq!(auto.mesh.indices, off.mesh.indices, "{file} face {index} at {rel}");
-        assert_eq!(auto.mesh.positions, off.mesh.positions, "{file} face {index} at {rel}");
-        assert!(a.max_deviation <= tol && a.inverted_triangles == 0, "{file} face {index} at {rel}");
-    }
+    let (file, index, rel) = ("asmo_car.igs", 2, 1e-3);
+    let m = corpus(file);
+    let tol = reparameterize_model(&m, Reparam::Off, Tolerance::Relative(rel)).unwrap().tolerance;
+    let one = flagged_face(&m, file, index);
+    let run = |mode| mesh_model(&one, &MeshOptions::default().with_tolerance(tol).with_reparam(mode)).unwrap();
+    let (off, auto) = (run(Reparam::Off), run(Reparam::Auto));
+    let (o, a) = (&off.report, &auto.report);
+    println!(
+        "{file} face {index} at {rel}: off {} tris p1 {:.3}°, auto {} tris p1 {:.3}°: {:?}",
+        o.triangles, o.p1_angle_deg, a.triangles, a.p1_angle_deg, a.warnings
+    );
+    assert_eq!(a.reparameterized.len(), 1, "{file} face {index} at {rel}");
+    assert!(!a.reparameterized[0].rebuilt, "{file} face {index} at {rel}");
+    assert!(a.warnings.iter().any(|w| w.ends_with("meshed the original")), "{:?}", a.warnings);
+    assert_eq!(auto.mesh.indices, off.mesh.indices, "{file} face {index} at {rel}");
+    assert_eq!(auto.mesh.positions, off.mesh.positions, "{file} face {index} at {rel}");
+    assert!(a.max_deviation <= tol && a.inverted_triangles == 0, "{file} face {index} at {rel}");
 }

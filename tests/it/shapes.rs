@@ -205,6 +205,7 @@ impl ModelSpec {
             warnings: Vec::new(),
             tolerance: None,
             bodies: Vec::new(),
+            ..Default::default()
         }
     }
 

@@ -1,22 +1,20 @@
 //! STEP: small files written for these tests (tests/data/step_*.stp) check
 //! units, assemblies, analytic surfaces, seams, poles and apexes, skipped
-//! faces and hostile input; the shared corpus (`../shared/corpus`, see its
+//! faces and hostile input; the test corpus (`tests/corpus`, see its
 //! SOURCES.md) checks real files: every face read, and the files listed in
 //! [`MESHED`] meshed within tolerance and watertight.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use surfmesh::{
-    edge_counts, mesh_model, read_model, read_step, read_step_parts, read_step_with_shells, Format, Mesh, MeshOptions,
-    MeshResult, Model, StepShell,
+    edge_counts, mesh_model, mesh_model_in_units, read_model, read_step, read_step_parts, read_step_with_shells,
+    Format, Mesh, MeshOptions, MeshResult, Model, StepShell, Units,
 };
+
+use crate::corpus_files::{corpus_bytes, corpus_names};
 
 fn data(name: &str) -> Vec<u8> {
     std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join("data").join(name)).unwrap()
-}
-
-fn corpus_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("shared").join("corpus")
 }
 
 /// The triangles of the given faces as one mesh.
@@ -219,6 +217,97 @@ fn a_bad_face_is_skipped_with_its_id_and_the_rest_is_read() {
     assert!(w[0].starts_with("#53 ADVANCED_FACE: skipped") && w[0].contains("expected an axis placement"), "{}", w[0]);
 }
 
+/// Meshing in another unit is the file's mesh scaled: an absolute
+/// tolerance given in millimetres for the inch box meshes as the same
+/// tolerance in inches does, every position and length 25.4 times larger.
+#[test]
+fn meshing_in_millimetres_scales_the_inch_box() {
+    let model = read_step(&data("step_box_inch.stp")).unwrap();
+    assert_eq!(model.units, "in");
+    let inch = mesh_model(&model, &MeshOptions::default().with_tolerance(0.01)).unwrap();
+    let options = MeshOptions::default().with_tolerance(0.254);
+    let mm = mesh_model_in_units(&model, &options, Units::Mm, &mut |_, _| true).unwrap();
+    assert_eq!((inch.report.units.as_str(), mm.report.units.as_str()), ("in", "mm"));
+    assert_eq!(mm.mesh.indices, inch.mesh.indices);
+    for (a, b) in mm.mesh.positions.iter().zip(&inch.mesh.positions) {
+        assert!(a.distance(*b * 25.4) < 1e-9, "{a} vs {b}");
+    }
+    let top = mm.mesh.positions.iter().map(|p| p.x).fold(f64::NEG_INFINITY, f64::max);
+    assert!((top - 50.8).abs() < 1e-9, "{top}");
+    assert!((mm.report.tolerance - 0.254).abs() < 1e-12);
+    assert!((mm.report.max_deviation - 25.4 * inch.report.max_deviation).abs() <= 1e-9);
+    // `File` changes nothing; a JSON model in metres comes out in millimetres.
+    let same = mesh_model_in_units(&model, &MeshOptions::default().with_tolerance(0.01), Units::File, &mut |_, _| true);
+    assert_eq!(same.unwrap().mesh.positions, inch.mesh.positions);
+    let json =
+        String::from_utf8(std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/plane.json")).unwrap())
+            .unwrap();
+    let mut metres = surfmesh::read_json(json.as_bytes()).unwrap();
+    metres.units = "m".into();
+    let a = mesh_model(&metres, &MeshOptions::default()).unwrap();
+    let b = mesh_model_in_units(&metres, &MeshOptions::default(), Units::Mm, &mut |_, _| true).unwrap();
+    assert_eq!(b.report.units, "mm");
+    assert!((b.report.tolerance - 1000.0 * a.report.tolerance).abs() <= 1e-9 * b.report.tolerance);
+    // A unit this does not know cannot be converted, and says so.
+    metres.units = "furlong".into();
+    let e = mesh_model_in_units(&metres, &MeshOptions::default(), Units::Mm, &mut |_, _| true).unwrap_err();
+    assert!(e.to_string().contains("'furlong'"), "{e}");
+}
+
+/// A closed box whose bottom face cannot be read: the mesh has a hole
+/// there, and the report says so. The edges the four side faces leave open
+/// along the missing face's border are cracks (free edges), not the model's
+/// own boundary, and the faces of the file are counted with the missing one.
+#[test]
+fn a_skipped_face_of_a_closed_box_leaves_free_edges_and_a_warning() {
+    let model = read_step(&data("step_bad_face.stp")).unwrap();
+    assert_eq!((model.faces.len(), model.skipped.len()), (5, 1));
+    // Its border: the four edges of the unit square at z = 0.
+    let border = &model.skipped[0].border;
+    assert_eq!(border.len(), 4);
+    for c in border {
+        let (a, b) = c.domain();
+        assert!(c.point(a).z.abs() < 1e-12 && c.point(b).z.abs() < 1e-12);
+    }
+    for rel in [1e-2, 1e-3] {
+        let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(rel)).unwrap();
+        let rep = &r.report;
+        assert_eq!((rep.faces, rep.faces_unread, rep.faces_skipped), (5, 1, 0));
+        // Every open edge runs round the hole: at least one per side.
+        assert!(rep.boundary_edges >= 4, "rel {rel}: {} boundary edges", rep.boundary_edges);
+        assert_eq!(rep.free_edges, rep.boundary_edges, "rel {rel}: every open edge is a crack");
+        let on_hole = hole_edges_at_z0(&r.mesh, rep.tolerance);
+        assert_eq!(on_hole, rep.boundary_edges, "rel {rel}: the open edges are the missing face's border");
+        assert!(
+            rep.warnings.iter().any(|w| w.starts_with("1 face(s) of the file could not be read: the mesh has holes")),
+            "{:?}",
+            rep.warnings
+        );
+        assert!(rep.max_deviation <= rep.tolerance && rep.inverted_triangles == 0);
+    }
+    // The same box whole: no hole, no crack, no warning about one.
+    let whole = read_step(&data("step_box_inch.stp")).unwrap();
+    let r = mesh_model(&whole, &MeshOptions::default().with_relative_tolerance(1e-2)).unwrap();
+    assert_eq!((r.report.faces_unread, r.report.free_edges, r.report.boundary_edges), (0, 0, 0));
+    assert!(!r.report.warnings.iter().any(|w| w.contains("could not be read")));
+}
+
+/// Edges of `mesh` with one triangle after welding whose two ends lie on the plane z = 0.
+fn hole_edges_at_z0(mesh: &Mesh, tol: f64) -> usize {
+    let (map, _) = surfmesh::weld_positions(&mesh.positions, tol * 1e-3);
+    // Per welded edge: how many triangles use it, and one of its two vertices' heights.
+    let mut uses: std::collections::HashMap<(u32, u32), (usize, f64, f64)> = std::collections::HashMap::new();
+    for t in mesh.indices.chunks_exact(3) {
+        for k in 0..3 {
+            let (p, q) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            let key = (map[p].min(map[q]), map[p].max(map[q]));
+            let e = uses.entry(key).or_insert((0, mesh.positions[p].z, mesh.positions[q].z));
+            e.0 += 1;
+        }
+    }
+    uses.values().filter(|(n, za, zb)| *n == 1 && za.abs() < tol && zb.abs() < tol).count()
+}
+
 #[test]
 fn hostile_and_malformed_files_are_errors_naming_the_instance() {
     let m = read_step(&data("step_hostile_knots.stp")).unwrap_err().to_string();
@@ -258,14 +347,9 @@ const MESHED_BUT_STRIPS: [&str; 1] = ["trj7_b1-ec-214.stp"];
 /// unoptimized); `cargo test --release` takes them all.
 const DEBUG_MAX_BYTES: usize = 200_000;
 
-fn corpus_files() -> Option<Vec<PathBuf>> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(corpus_dir())
-        .ok()?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().and_then(|e| e.to_str()).is_some_and(|e| e == "stp" || e == "step"))
-        .collect();
-    files.sort();
-    Some(files)
+/// STEP files of the test corpus, sorted by name.
+fn corpus_files() -> Vec<String> {
+    corpus_names(&["stp", "step"])
 }
 
 /// Faces the file lists (ADVANCED_FACE / FACE_SURFACE instances).
@@ -277,14 +361,10 @@ fn faces_in_file(text: &str) -> usize {
 
 #[test]
 fn corpus_reads_every_face() {
-    let Some(files) = corpus_files() else {
-        eprintln!("no corpus at {}: STEP corpus test not run", corpus_dir().display());
-        return;
-    };
+    let files = corpus_files();
     assert!(files.len() >= 16, "the corpus holds {} STEP files", files.len());
-    for path in files {
-        let name = path.file_name().unwrap().to_string_lossy().to_string();
-        let bytes = std::fs::read(&path).unwrap();
+    for name in files {
+        let bytes = corpus_bytes(&name);
         if cfg!(debug_assertions) && bytes.len() > DEBUG_MAX_BYTES {
             eprintln!("{name}: not read in an unoptimized build (run the tests with --release)");
             continue;
@@ -307,20 +387,19 @@ fn corpus_reads_every_face() {
 /// with no triangle that has two corners at one point.
 #[test]
 fn corpus_meshes_within_tolerance_watertight() {
-    let Some(files) = corpus_files() else {
-        eprintln!("no corpus at {}: STEP corpus test not run", corpus_dir().display());
-        return;
-    };
+    let files = corpus_files();
+    for m in MESHED.iter().chain(&MESHED_BUT_STRIPS) {
+        assert!(files.iter().any(|n| n == m), "{m} is not in the corpus");
+    }
     let mut failures = Vec::new();
     println!(
         "{:<30} {:>9} {:>8} {:>10} {:>10} {:>4} {:>5} {:>6} {:>5} {:>7}",
         "file", "faces", "tris", "max dev", "tolerance", "inv", "free", "shellB", "misor", "ms"
     );
-    for path in files {
-        let name = path.file_name().unwrap().to_string_lossy().to_string();
+    for name in files {
         let strips_allowed = MESHED_BUT_STRIPS.contains(&name.as_str());
         let must = MESHED.contains(&name.as_str()) || strips_allowed;
-        let bytes = std::fs::read(&path).unwrap();
+        let bytes = corpus_bytes(&name);
         if cfg!(debug_assertions) && bytes.len() > DEBUG_MAX_BYTES {
             continue;
         }
@@ -414,11 +493,7 @@ fn corpus_meshes_within_tolerance_watertight() {
 /// never split where a neighbour's nodes are, and the closed shell opens.
 #[test]
 fn corpus_fuselage_rebuilt_faces_keep_the_shell_closed() {
-    let path = corpus_dir().join("bug28366_fuselage.stp");
-    let Ok(bytes) = std::fs::read(&path) else {
-        eprintln!("no corpus at {}: test not run", corpus_dir().display());
-        return;
-    };
+    let bytes = corpus_bytes("bug28366_fuselage.stp");
     let (model, shells) = read_step_with_shells(&bytes).expect("reads");
     let options = MeshOptions::default().with_relative_tolerance(1e-3).with_reparam(surfmesh::Reparam::Auto);
     let r = mesh_model(&model, &options).expect("meshes");
@@ -481,4 +556,193 @@ fn shares_of_the_bodies_make_the_whole_mesh() {
     assert_eq!(empty.report.faces_skipped, 0);
     assert_eq!(empty.mesh.face_ranges.len(), 12, "every face is listed, with no triangles");
     assert!(mesh_model(&model, &options.clone().with_share(2, 2)).is_err(), "an index past the count is refused");
+}
+
+/// Area of the given faces' triangles.
+fn area(mesh: &Mesh, faces: std::ops::Range<usize>) -> f64 {
+    let m = sub_mesh(mesh, faces);
+    m.indices
+        .chunks_exact(3)
+        .map(|t| {
+            let [a, b, c] = [0, 1, 2].map(|k| m.positions[t[k] as usize]);
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .sum()
+}
+
+/// Closed surfaces as real files write them, each a solid: a cylinder whose
+/// two circles start half a turn apart (the seam cut lands where circle
+/// pieces meet), a cone cap past its apex (on the nappe of negative radius,
+/// its seam run out to the apex and back), a sphere wedge whose pole
+/// vertices lie a rounding off the axis. Watertight, within tolerance, with
+/// the exact solid's volume.
+#[test]
+fn closed_surfaces_written_awkwardly_mesh_as_solids() {
+    use std::f64::consts::PI;
+    let cases = [
+        ("step_cylinder_offset_circles.stp", 3, PI * 25.0 * 10.0),
+        ("step_cone_past_apex.stp", 2, PI * 25.0 * 5.0 / 3.0),
+        ("step_sphere_wedge_poles.stp", 3, PI * 60f64.powi(3) / 3.0),
+    ];
+    for (file, faces, exact) in cases {
+        let (model, shells) = read_step_with_shells(&data(file)).unwrap();
+        assert_eq!(model.faces.len(), faces, "{file}: {:?}", model.warnings);
+        for rel in [1e-2, 1e-3] {
+            let r = mesh_checked(file, &model, &shells, rel);
+            let v = volume(&r.mesh, 0..faces);
+            let slack = if rel < 2e-3 { 0.01 } else { 0.05 };
+            assert!((v - exact).abs() < slack * exact, "{file} at {rel}: volume {v}, exact {exact}");
+        }
+    }
+}
+
+/// A trimmed curve runs from its first trim to its second, against its
+/// basis where its sense is false (ISO 10303-42): the quarter cylinder's top
+/// arc goes from 90 back to 0 degrees, not three quarters of the way round.
+#[test]
+fn trimmed_curves_against_their_basis_bound_a_quarter_cylinder() {
+    let model = read_step(&data("step_trimmed_curve_sense.stp")).unwrap();
+    assert_eq!(model.faces.len(), 1, "{:?}", model.warnings);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-3)).unwrap();
+    assert!(r.report.max_deviation <= r.report.tolerance);
+    let exact = 5.0 * std::f64::consts::FRAC_PI_2 * 10.0;
+    let a = area(&r.mesh, 0..1);
+    assert!((a - exact).abs() < 0.005 * exact, "area {a}, exact {exact}");
+    for p in &r.mesh.positions {
+        assert!(p.x >= -1e-6 && p.y >= -1e-6 && (-1e-6..=10.0 + 1e-6).contains(&p.z), "{p} outside the quarter");
+    }
+}
+
+/// A face across the seam of a periodic B-spline surface whose knots are
+/// not clamped (as such surfaces come in files): the seam is moved into the
+/// face's gap after clamping, and the face has the area of its strip.
+#[test]
+fn a_face_across_the_seam_of_an_unclamped_periodic_surface_meshes() {
+    use surfmesh::NurbsCurve;
+    let model = read_step(&data("step_periodic_bspline_seam.stp")).unwrap();
+    assert_eq!(model.faces.len(), 1, "{:?}", model.warnings);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-3)).unwrap();
+    assert!(r.report.max_deviation <= r.report.tolerance);
+    // The tube's cross-section, built here from the file's data: its length
+    // over the face's range (0.85 to 1.15, across the seam) times the height 6.
+    let octagon: Vec<glam::DVec3> = (0..11)
+        .map(|k| {
+            let a = (k % 8) as f64 * std::f64::consts::FRAC_PI_4;
+            glam::DVec3::new(5.0 * a.cos(), 5.0 * a.sin(), 0.0)
+        })
+        .collect();
+    let knots = (0..15).map(|i| (i as f64 - 3.0) / 8.0).collect();
+    let ring = NurbsCurve::try_new(3, knots, octagon, None).unwrap();
+    let length = |a: f64, b: f64| -> f64 {
+        (0..2000)
+            .map(|k| {
+                ring.point(a + (b - a) * k as f64 / 2000.0).distance(ring.point(a + (b - a) * (k + 1) as f64 / 2000.0))
+            })
+            .sum()
+    };
+    let exact = 6.0 * (length(0.85, 1.0) + length(0.0, 0.15));
+    let a = area(&r.mesh, 0..1);
+    assert!((a - exact).abs() < 0.005 * exact, "area {a}, exact {exact}");
+    // Every vertex within the face's angles (its corners' on the ring) and heights.
+    let angle = |p: glam::DVec3| p.y.atan2(p.x);
+    let (from, to) = (angle(ring.point(0.85)), angle(ring.point(0.15)));
+    assert!(from < 0.0 && to > 0.0, "the face's corners lie either side of angle 0");
+    for p in &r.mesh.positions {
+        let a = angle(*p);
+        assert!(a >= from - 1e-3 && a <= to + 1e-3, "{p} at angle {a}, outside {from}..{to}");
+        assert!((2.0 - 1e-6..=8.0 + 1e-6).contains(&p.z), "{p} off the face's heights");
+    }
+}
+
+/// A band round a cylinder whose lower border overhangs in four waves
+/// (angle `t + 1.5 sin 4t`, height `3 + 2 sin 4t`): every line of constant
+/// angle crosses it three or five times, so the face is cut open along a
+/// line where two crossings face the upper circle, and the cut face spans
+/// more than one turn. Its area is the integral of the band's height along
+/// the unrolled border, 5 · 14π.
+#[test]
+fn a_band_whose_border_overhangs_is_cut_where_the_cut_crosses_nothing() {
+    let model = read_step(&data("step_cylinder_wavy_band.stp")).unwrap();
+    assert_eq!(model.faces.len(), 1, "{:?}", model.warnings);
+    for rel in [1e-2, 1e-3] {
+        let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(rel)).unwrap();
+        let rep = &r.report;
+        assert!(rep.max_deviation <= rep.tolerance && rep.inverted_triangles == 0 && rep.free_edges == 0, "{rep:?}");
+        let exact = 70.0 * std::f64::consts::PI;
+        let a = area(&r.mesh, 0..1);
+        let slack = if rel < 2e-3 { 0.005 } else { 0.03 };
+        assert!((a - exact).abs() < slack * exact, "at {rel}: area {a}, exact {exact}");
+        for p in &r.mesh.positions {
+            assert!(
+                (p.x.hypot(p.y) - 5.0).abs() < 0.1 && (1.0 - 1e-6..=10.0 + 1e-6).contains(&p.z),
+                "{p} off the band"
+            );
+        }
+    }
+}
+
+/// A band round a cylinder with a hole across the line where the band would
+/// first be cut open (its loops' common start angle): the cut moves to a
+/// line that crosses only the two circles, and the face keeps its hole (the
+/// unrolled ellipse of semi-axes 1.5 and 1.5 out of the 10 × 10π band).
+#[test]
+fn a_band_with_a_hole_on_the_first_cut_line_is_cut_beside_it() {
+    let model = read_step(&data("step_cylinder_band_hole.stp")).unwrap();
+    assert_eq!(model.faces.len(), 1, "{:?}", model.warnings);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-3)).unwrap();
+    let rep = &r.report;
+    assert!(rep.max_deviation <= rep.tolerance && rep.inverted_triangles == 0 && rep.free_edges == 0, "{rep:?}");
+    let exact = (100.0 - 2.25) * std::f64::consts::PI;
+    let a = area(&r.mesh, 0..1);
+    assert!((a - exact).abs() < 0.003 * exact, "area {a}, exact {exact}");
+    // No vertex inside the hole.
+    for p in &r.mesh.positions {
+        let (x, y) = (5.0 * p.y.atan2(p.x) / 1.5, (p.z - 5.0) / 1.5);
+        assert!(x * x + y * y > 0.95, "{p} inside the hole");
+    }
+}
+
+/// Flaws a tolerant reader forgives, in a file of their own.
+#[path = "step_lenient.rs"]
+mod lenient;
+
+/// A hyperbola arc and a parabola arc, each closed by a chord on a plane,
+/// read as exact conics: every mesh vertex lies in the exact region (up to
+/// the trim curves' fit, a small part of the tolerance), the border follows
+/// the conic, and the areas are the closed forms' within the inscribed error.
+#[test]
+fn hyperbola_and_parabola_edges_are_exact() {
+    let model = read_step(&data("step_hyperbola_parabola.stp")).unwrap();
+    assert_eq!(model.faces.len(), 2, "{:?}", model.warnings);
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-4)).unwrap();
+    let tol = r.report.tolerance;
+    assert!(r.report.max_deviation <= tol);
+    let (a, b, f) = (4.0_f64, 3.0_f64, 1.5_f64);
+    let (ch, sh) = (1f64.cosh(), 1f64.sinh());
+    let face = |k: usize| {
+        let fr = r.mesh.face_ranges[k];
+        (fr.first as usize..(fr.first + fr.count) as usize).map(|t| r.mesh.triangle(t)).collect::<Vec<_>>()
+    };
+    let area =
+        |tris: &[[glam::DVec3; 3]]| tris.iter().map(|[p, q, s]| 0.5 * (*q - *p).cross(*s - *p).length()).sum::<f64>();
+    // Hyperbola (x/a)² − (y/b)² = 1 from t = −1 to 1, closed by x = a·cosh 1;
+    // `gap`: how far a point lies outside the branch along x.
+    let hyp = face(0);
+    let want = a * b * (ch * sh - 1.0);
+    assert!((area(&hyp) - want).abs() < 30.0 * tol, "hyperbola face area {} vs {want}", area(&hyp));
+    let gap = |p: &glam::DVec3| a * (1.0 + (p.y / b).powi(2)).sqrt() - p.x;
+    for p in hyp.iter().flatten() {
+        assert!(gap(p) <= 0.1 * tol && p.x <= a * ch + 1e-9, "vertex {p} outside the hyperbola's segment");
+    }
+    let on_curve = hyp.iter().flatten().filter(|p| gap(p).abs() <= 0.1 * tol).count();
+    assert!(on_curve > 10, "the border follows the hyperbola ({on_curve} vertices on it)");
+    // Parabola x − 20 = y² / 4f from y = −2f to 2f, closed by x = 20 + f.
+    let par = face(1);
+    let want = 8.0 * f * f / 3.0;
+    assert!((area(&par) - want).abs() < 30.0 * tol, "parabola face area {} vs {want}", area(&par));
+    for p in par.iter().flatten() {
+        let gap = 20.0 + p.y * p.y / (4.0 * f) - p.x;
+        assert!(gap <= 0.1 * tol && p.x <= 20.0 + f + 1e-9, "vertex {p} outside the parabola's segment");
+    }
 }

@@ -96,10 +96,18 @@ function setStat(id, text, cls = '') {
 }
 
 function showStats(report, quality) {
-  setStat('stat-faces', report.faces_skipped ? `${report.faces} (${report.faces_skipped} skipped)` : count(report.faces));
+  // Tessellated faces come as the file's triangles: counted apart, and not in the deviation.
+  const tessellated = report.faces_tessellated ?? 0;
+  const notes = [
+    report.faces_skipped ? `${count(report.faces_skipped)} skipped` : '',
+    tessellated ? `${count(tessellated)} tessellated` : '',
+  ].filter(Boolean);
+  setStat('stat-faces', notes.length ? `${count(report.faces)} (${notes.join(', ')})` : count(report.faces));
   setStat('stat-triangles', count(report.triangles));
   setStat('stat-vertices', count(report.vertices));
   setStat('stat-tolerance', fmt(report.tolerance));
+  // Every length of the mesh and the report is in the file's unit.
+  $('stat-units').textContent = report.units ? ` (${report.units})` : '';
   const within = report.max_deviation <= report.tolerance;
   if (report.quality) {
     // Quality mode aims at a size, not a tolerance: the deviation is reported, not judged.
@@ -107,8 +115,13 @@ function showStats(report, quality) {
     const q = report.quality;
     setStat('stat-good-angles', percent(q.good_angle_fraction), q.good_angle_fraction >= 0.99 ? 'ok' : 'bad');
     setStat('stat-edge-band', percent(q.edge_band_fraction), q.edge_band_fraction >= 0.9 ? 'ok' : 'bad');
+  } else if (tessellated > 0 && tessellated === report.faces) {
+    setStat('stat-max-deviation', '— (tessellated faces only)');
+    setStat('stat-good-angles', '—');
+    setStat('stat-edge-band', '—');
   } else {
-    setStat('stat-max-deviation', `${fmt(report.max_deviation)} ${within ? '✓' : '✗'}`, within ? 'ok' : 'bad');
+    const exact = tessellated > 0 ? ' (exact faces)' : '';
+    setStat('stat-max-deviation', `${fmt(report.max_deviation)} ${within ? '✓' : '✗'}${exact}`, within ? 'ok' : 'bad');
     setStat('stat-good-angles', '—');
     setStat('stat-edge-band', '—');
   }
@@ -295,6 +308,7 @@ function remesh({ fresh = false } = {}) {
           ? `${count(r.triangles)} triangles of size ${fmt(r.quality.size)} · ` +
               `${percent(r.quality.good_angle_fraction)} with angles ≥ 25° · ${r.time_ms.toFixed(0)} ms`
           : `${count(r.triangles)} triangles · max deviation ${fmt(r.max_deviation)} ≤ ${fmt(r.tolerance)} · ` +
+              (r.faces_tessellated ? `${count(r.faces_tessellated)} tessellated faces not verified · ` : '') +
               `${r.time_ms.toFixed(0)} ms`,
       );
     },

@@ -312,6 +312,7 @@ export function mergeShares(parts) {
   const report = {
     ...first.report,
     faces_skipped: sum('faces_skipped'),
+    faces_tessellated: sum('faces_tessellated'),
     triangles,
     vertices,
     max_deviation: max('max_deviation'),

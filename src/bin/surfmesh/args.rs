@@ -4,7 +4,7 @@
 use std::ffi::OsString;
 use std::path::PathBuf;
 
-use surfmesh::{Format, MeshMode, MeshOptions, QualityMethod, Reparam};
+use surfmesh::{Format, MeshMode, MeshOptions, QualityMethod, Reparam, Units};
 
 /// What the user asked for.
 pub enum Command {
@@ -22,6 +22,8 @@ pub enum Command {
     Fit(crate::fit::FitArgs),
     /// Rebuild poorly parameterized faces and write IGES (paper 001).
     Reparam(crate::reparam::ReparamArgs),
+    /// Mesh every model file of a folder and tabulate the results.
+    Check(crate::check::CheckArgs),
 }
 
 /// Arguments of `surfmesh mesh`.
@@ -32,6 +34,8 @@ pub struct MeshArgs {
     pub format: Option<Format>,
     /// Meshing options, validated.
     pub options: MeshOptions,
+    /// Length unit of the mesh and the report (and of the absolute options).
+    pub units: Units,
     /// Mesh output file and its format.
     pub output: Option<(PathBuf, OutputFormat)>,
     /// Report output file.
@@ -59,10 +63,11 @@ surfmesh: triangle meshes of trimmed NURBS surfaces within a verified tolerance
 
 Usage:
   surfmesh mesh INPUT [options]
+  surfmesh check DIR [options]            (see Sweeping a folder, below)
   surfmesh --help | --version
 
 Options of `mesh`:
-  --tol X             absolute chordal tolerance, model units
+  --tol X             absolute chordal tolerance, model units (those of --units)
   --tol-rel R         tolerance as a fraction of the model's diagonal (default 0.001)
   --angle A           largest normal turn across a triangle, radians (default 0.5)
   --max-edge L        longest triangle edge allowed, model units
@@ -82,6 +87,10 @@ Options of `mesh`:
   --reparam MODE      rebuild poorly parameterized faces before meshing: auto
                       (default: faces the step-ratio test flags, each rebuild
                       kept only where its mesh wins), off, force
+  --units U           length unit of the mesh, the report and the absolute
+                      options: file (default: the file's own unit), mm, cm,
+                      m, in or ft; the mesh is scaled into it. GLB is always
+                      written in metres, as glTF defines
   --format F          input format: json, iges (igs) or step (stp, p21); default:
                       from the extension, else from the content
   -o, --output FILE   write the mesh; .stl, .obj, .glb, .msh (Gmsh 4.1) or
@@ -109,6 +118,7 @@ pub fn parse(args: Vec<OsString>) -> Result<Command, String> {
         Some("repair") => crate::repair::parse_repair(args).map(Command::Repair),
         Some("fit") => crate::fit::parse(args).map(Command::Fit),
         Some("reparam") => crate::reparam::parse(args).map(Command::Reparam),
+        Some("check") => crate::check::parse(args).map(Command::Check),
         _ => Err(format!("unknown command '{}'; try 'surfmesh --help'", first.to_string_lossy())),
     }
 }
@@ -122,6 +132,7 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
     let mut quality = options.quality.clone();
     let mut output = None;
     let mut report: Option<PathBuf> = None;
+    let mut units = Units::File;
     while let Some(arg) = args.next() {
         let Some(text) = arg.to_str().filter(|t| t.starts_with('-') && t.len() > 1) else {
             if input.replace(PathBuf::from(&arg)).is_some() {
@@ -206,6 +217,9 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
                 output = Some((path, kind));
             }
             "--report" => report = Some(PathBuf::from(value()?)),
+            "--units" => {
+                units = Units::from_name(&value()?.to_string_lossy()).map_err(|e| e.to_string())?;
+            }
             _ => return Err(format!("unknown option '{text}'; try 'surfmesh --help'")),
         }
     }
@@ -232,7 +246,7 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
             return Err("-o and --report name the same file".into());
         }
     }
-    Ok(Command::Mesh(MeshArgs { input, format, options, output, report }))
+    Ok(Command::Mesh(MeshArgs { input, format, options, units, output, report }))
 }
 
 fn number(name: &str, value: OsString) -> Result<f64, String> {

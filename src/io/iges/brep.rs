@@ -53,9 +53,9 @@ pub(super) fn shell_faces(ctx: &Ctx<'_>, de: usize) -> Result<Vec<usize>, Error>
     Ok(faces)
 }
 
-/// The transformation of the 186/514 chain a face sits in, as `parent`.
-pub(super) fn chain_transform(ctx: &Ctx<'_>, parents: &[usize]) -> Result<DAffine3, Error> {
-    let mut m = ctx.world;
+/// The transformation of the 186/514 chain a face sits in, after `base`, as `parent`.
+pub(super) fn chain_transform(ctx: &Ctx<'_>, base: DAffine3, parents: &[usize]) -> Result<DAffine3, Error> {
+    let mut m = base;
     for &p in parents {
         m *= own_transform(ctx.dir, p)?;
     }
@@ -81,7 +81,7 @@ pub(super) fn face_510(ctx: &Ctx<'_>, e: &Entity, parent: DAffine3) -> Result<Fa
 
 /// A 508 loop: each edge's model curve oriented as the loop uses it, and
 /// the parameter-space curves when every edge has them.
-fn loop_508(ctx: &Ctx<'_>, de: usize, m: DAffine3) -> Result<LoopSrc, Error> {
+pub(super) fn loop_508(ctx: &Ctx<'_>, de: usize, m: DAffine3) -> Result<LoopSrc, Error> {
     let e = ctx.entity(de)?;
     if e.kind != 508 {
         return Err(e.error(alloc::format!("a face's loop pointer names type {}, not a loop (508)", e.kind)));

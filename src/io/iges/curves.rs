@@ -38,7 +38,7 @@ pub(super) fn model_curve(ctx: &Ctx<'_>, de: usize, parent: DAffine3, depth: usi
         }
         return Ok(out);
     }
-    let pieces = local_curve(e)?;
+    let pieces = local_curve(ctx, e)?;
     let mut out = Vec::with_capacity(pieces.len());
     for c in pieces {
         let c = if m == DAffine3::IDENTITY { Ok(c) } else { map_points(&c, |p| m.transform_point3(p)) };
@@ -64,7 +64,7 @@ pub(super) fn param_curve(ctx: &Ctx<'_>, de: usize) -> Result<Vec<NurbsCurve>, E
 }
 
 /// The curve in its definition space.
-fn local_curve(e: &Entity) -> Result<Vec<NurbsCurve>, Error> {
+fn local_curve(ctx: &Ctx<'_>, e: &Entity) -> Result<Vec<NurbsCurve>, Error> {
     let wrap = |r: Result<NurbsCurve, crate::NurbsError>| r.map_err(|err| e.error(alloc::format!("{err}")));
     match e.kind {
         100 => Ok(alloc::vec![wrap(arc(e)?)?]),
@@ -81,7 +81,7 @@ fn local_curve(e: &Entity) -> Result<Vec<NurbsCurve>, Error> {
             Ok(alloc::vec![wrap(line(a, b, 0.0, 1.0))?])
         }
         112 => Ok(alloc::vec![spline(e)?]),
-        126 => Ok(alloc::vec![bspline(e)?]),
+        126 => Ok(alloc::vec![bspline(ctx, e)?]),
         k => Err(e.error(alloc::format!("entity type {k} is not a supported curve"))),
     }
 }
@@ -285,7 +285,11 @@ fn spline(e: &Entity) -> Result<NurbsCurve, Error> {
 }
 
 /// 126: rational B-spline curve, restricted to its parameter range V(0)..V(1).
-fn bspline(e: &Entity) -> Result<NurbsCurve, Error> {
+/// A range that is empty (`[0, 0]` is common), inverted or outside the
+/// knots' domain is repaired with a note: an inverted one is read the other
+/// way round, one with nothing of the domain in it gives the whole domain
+/// (the curve as its knots define it).
+fn bspline(ctx: &Ctx<'_>, e: &Entity) -> Result<NurbsCurve, Error> {
     let k = e.int(1)?;
     let m = e.int(2)?;
     if !(1..=MAX_DEGREE as i64).contains(&m) || k < m || k > MAX_CONTROL_POINTS as i64 {
@@ -312,14 +316,23 @@ fn bspline(e: &Entity) -> Result<NurbsCurve, Error> {
     let w = (!polynomial && !all_equal).then_some(weights);
     let c = NurbsCurve::try_new(m, knots, pts, w).map_err(|err| e.error(alloc::format!("{err}")))?;
     let (a, b) = c.domain();
-    let v0 = e.real_or(pbase + 3 * n, a)?;
-    let v1 = e.real_or(pbase + 3 * n + 1, b)?;
-    let (v0, v1) = (v0.min(v1), v0.max(v1));
+    let (r0, r1) = (e.real_or(pbase + 3 * n, a)?, e.real_or(pbase + 3 * n + 1, b)?);
     let eps = 1e-9 * (b - a);
+    let (v0, v1) = (r0.min(r1).max(a), r0.max(r1).min(b));
+    let note = |kind: &'static str, what: alloc::string::String| {
+        let m = alloc::format!("B-spline curve's parameter range [{r0}, {r1}] {what}");
+        ctx.notes.borrow_mut().note(kind, e.de, || alloc::format!("{}", e.error(m)));
+    };
+    if (v1 - v0).is_nan() || v1 - v0 <= eps {
+        note("curve-range-empty", alloc::format!("holds none of the curve; its whole domain [{a}, {b}] is used"));
+        return Ok(c);
+    }
+    if r1 < r0 {
+        note("curve-range-inverted", alloc::format!("is inverted; read as [{v0}, {v1}]"));
+    } else if r0 < a - eps || r1 > b + eps {
+        note("curve-range-outside", alloc::format!("runs past the knots' domain [{a}, {b}]; read as [{v0}, {v1}]"));
+    }
     if v0 > a + eps || v1 < b - eps {
-        if (v1 - v0).is_nan() || v1 - v0 <= eps {
-            return Err(e.error(alloc::format!("B-spline curve's parameter range [{v0}, {v1}] is empty")));
-        }
         return segment(&c, v0, v1).map_err(|err| e.error(alloc::format!("{err}")));
     }
     Ok(c)

@@ -3,11 +3,11 @@
 //! the file is checked against the data actually present before anything is
 //! allocated from it.
 
-use alloc::string::String;
+use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 
 use super::lexer::{Record, Tokenizer, Value};
-use super::{iges_error, Section, MAX_ENTITIES, MAX_PARAMS};
+use super::{iges_error, Notes, Section, MAX_ENTITIES, MAX_PARAMS};
 use crate::Error;
 
 /// One entity: its directory entry fields and parameters.
@@ -30,12 +30,17 @@ pub(super) struct Entity {
     pub pline: usize,
     /// Parameters; `params[0]` is the entity type.
     pub params: Vec<Value>,
+    /// Why its parameter data could not be read (the entity is then
+    /// skipped, and so is whatever needs it): reported once, by the directory.
+    pub damage: Option<Error>,
 }
 
 /// All entities, indexed by `(de - 1) / 2`.
 #[derive(Debug, Default)]
 pub(super) struct Directory {
     pub entities: Vec<Entity>,
+    /// What was forgiven or skipped, one warning per kind.
+    pub notes: Vec<String>,
 }
 
 impl Directory {
@@ -45,7 +50,17 @@ impl Directory {
     /// Odd record counts, shifted columns, non-numeric fields, parameter
     /// data lines that are missing or belong to another entity type.
     pub fn parse(d: &[Record<'_>], p: &[Record<'_>], param: u8, record: u8) -> Result<Self, Error> {
-        if d.len() % 2 != 0 {
+        let mut notes = Notes::default();
+        let d = if d.len() % 2 != 0 && d.len() > 1 {
+            // The last entry lost its second line (a truncated file): the others stand.
+            let line = d.last().map_or(0, |r| r.line);
+            notes.note("odd", 0, || {
+                let m = "odd number of directory records: the last entry's second line is missing \
+                         (file truncated?); that entry is skipped";
+                iges_error(Section::Directory, line, d.len(), m).to_string()
+            });
+            &d[..d.len() - 1]
+        } else if d.len() % 2 != 0 {
             let line = d.last().map_or(0, |r| r.line);
             return Err(iges_error(
                 Section::Directory,
@@ -53,7 +68,9 @@ impl Directory {
                 d.len(),
                 "odd number of directory records: an entry's second line is missing (file truncated?)",
             ));
-        }
+        } else {
+            d
+        };
         if d.len() / 2 > MAX_ENTITIES {
             return Err(iges_error(
                 Section::Directory,
@@ -116,7 +133,13 @@ impl Directory {
             let blanked = digit(0) * 10 + digit(1) == 1;
             let pcount = field(b, 3)?;
             let form = field(b, 4)?;
-            let (pline, params) = parameters(p, de, kind, pstart, pcount, param, record)?;
+            let (pline, params, damage) = match parameters(p, de, kind, pstart, pcount, param, record, &mut notes) {
+                Ok((pline, params)) => (pline, params, None),
+                Err(err) => {
+                    notes.note(damage_kind(&err), de, || alloc::format!("{err}; the entity is skipped"));
+                    (0, alloc::vec![Value::Int(kind)], Some(err))
+                }
+            };
             entities.push(Entity {
                 de,
                 kind: kind as u32,
@@ -126,9 +149,10 @@ impl Directory {
                 blanked,
                 pline,
                 params,
+                damage,
             });
         }
-        Ok(Self { entities })
+        Ok(Self { entities, notes: notes.warnings() })
     }
 
     /// The entity with directory entry number `de`, if there is one.
@@ -140,9 +164,23 @@ impl Directory {
     }
 }
 
-/// The parameters of entity `de`: P records `pstart .. pstart + pcount`
-/// (by position; with a blank count, the run whose back pointer names `de`),
-/// columns 1–64 joined and split into fields.
+/// The kind of a damaged entity's error, so each kind is one warning.
+fn damage_kind(err: &Error) -> &'static str {
+    match err {
+        Error::Iges { message, .. } if message.contains("pointer") => "pointer",
+        Error::Iges { message, .. } if message.contains("directory entry says type") => "type",
+        Error::Iges { message, .. } if message.contains("';'") => "unended",
+        _ => "syntax",
+    }
+}
+
+/// The parameters of entity `de`: P records from `pstart`, `pcount` of
+/// them, and on past the count while the records still point back to `de`
+/// and its data has not ended (a count too small); columns 1–64 joined and
+/// split into fields up to the record delimiter. A count that runs past the
+/// Parameter section is forgiven with a note when the data ends (`;`) before
+/// the section does.
+#[allow(clippy::too_many_arguments)]
 fn parameters(
     p: &[Record<'_>],
     de: usize,
@@ -151,6 +189,7 @@ fn parameters(
     pcount: i64,
     param: u8,
     record: u8,
+    notes: &mut Notes,
 ) -> Result<(usize, Vec<Value>), Error> {
     let bad = |message: String| iges_error(Section::Directory, 0, de, message);
     let first = usize::try_from(pstart).ok().filter(|&s| s >= 1 && s <= p.len()).ok_or_else(|| {
@@ -164,21 +203,47 @@ fn parameters(
     } else {
         p[first - 1..].iter().take_while(|r| back_pointer(r) == Some(de)).count().max(1)
     };
-    let last = first.checked_add(count - 1).filter(|&l| l <= p.len()).ok_or_else(|| {
-        bad(alloc::format!(
-            "parameter data lines {first}..{} run past the Parameter section's {} lines (file truncated?)",
-            first.saturating_add(count - 1),
-            p.len()
-        ))
-    })?;
-    let recs = &p[first - 1..last];
-    let pline = recs[0].line;
-    let mut text: Vec<u8> = Vec::with_capacity(recs.len() * 64);
-    for r in recs {
-        text.extend_from_slice(content(r));
+    let by_count = first.saturating_add(count - 1);
+    let mut last = by_count.min(p.len());
+    let pline = p[first - 1].line;
+    let read = |last: usize| {
+        let mut text: Vec<u8> = Vec::with_capacity((last + 1 - first) * 64);
+        for r in &p[first - 1..last] {
+            text.extend_from_slice(content(r));
+        }
+        let mut tok = Tokenizer::new(&text, param, record);
+        let params = tok.fields(MAX_PARAMS).map_err(|m| iges_error(Section::Parameter, pline, de, m))?;
+        Ok::<_, Error>((params, tok.ended))
+    };
+    let (mut params, mut ended) = read(last)?;
+    if !ended {
+        // A count too small: the lines after it that still point back here.
+        let more = p[last..].iter().take_while(|r| back_pointer(r) == Some(de)).count();
+        if more > 0 {
+            last += more;
+            (params, ended) = read(last)?;
+        }
     }
-    let mut tok = Tokenizer::new(&text, param, record);
-    let mut params = tok.fields(MAX_PARAMS).map_err(|m| iges_error(Section::Parameter, pline, de, m))?;
+    if !ended {
+        return Err(iges_error(
+            Section::Parameter,
+            pline,
+            de,
+            alloc::format!(
+                "parameter data on lines {first}..{last} end without the record delimiter ';' (file truncated?)"
+            ),
+        ));
+    }
+    if by_count > p.len() {
+        notes.note("overrun", de, || {
+            let m = alloc::format!(
+                "parameter data lines {first}..{by_count} run past the Parameter section's {} lines; \
+                 read up to the entity's ';'",
+                p.len()
+            );
+            iges_error(Section::Directory, 0, de, m).to_string()
+        });
+    }
     // Every entity's parameters are held until the faces are built: no
     // room left over from growing (a quarter of the list on average).
     params.shrink_to_fit();

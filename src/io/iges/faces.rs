@@ -6,6 +6,8 @@
 //! A face that cannot be read is skipped with a warning naming its directory
 //! entry and type.
 
+mod skipped;
+
 use crate::collections::HashSet;
 use alloc::string::String;
 use alloc::vec::Vec;
@@ -15,17 +17,22 @@ use super::brep::{chain_transform, face_510, reverse_all, shell_faces};
 use super::curves::{model_curve, param_curve};
 use super::directory::Entity;
 use super::loops::{build_face, FaceSrc, LoopSrc};
+use super::subfigures::{Count, Subfigures};
 use super::surfaces::{is_surface, surface_def};
 use super::xform::own_transform;
 use super::Ctx;
-use crate::model::Face;
+use crate::model::{Face, SkippedFace};
 use crate::Error;
 
 /// The faces of the file, in directory order, with warnings for what was
 /// skipped; the first skip's error is kept for files where nothing is left.
 /// Also each face's body: the B-rep shell (514, or 186's) it belongs to, 0
-/// for faces outside any.
-pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face>, Vec<u32>, Option<Error>) {
+/// for faces outside any; and the faces skipped, with their borders.
+pub(super) fn read_faces(
+    ctx: &Ctx<'_>,
+    warnings: &mut Vec<String>,
+    skipped: &mut Vec<SkippedFace>,
+) -> (Vec<Face>, Vec<u32>, Option<Error>) {
     let dir = ctx.dir;
     // Surfaces that faces (or offsets) use are not faces themselves.
     let mut used: HashSet<usize> = HashSet::default();
@@ -53,11 +60,13 @@ pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face
             }
         }
     }
+    let subfigures = Subfigures::scan(ctx);
     let mut out = Vec::new();
     let mut bodies: Vec<u32> = Vec::new();
-    let mut shell_body: crate::collections::HashMap<usize, u32> = crate::collections::HashMap::default();
+    let mut shell_body: crate::collections::HashMap<(u32, usize), u32> = crate::collections::HashMap::default();
     let mut first_error: Option<Error> = None;
     let mut unsupported: Vec<(u32, usize)> = Vec::new();
+    let shells = Shells { used: &used, in_shell: &in_shell, shell_in_solid: &shell_in_solid };
     // Hidden (blanked) faces are not part of what the file shows, unless
     // the file shows nothing else.
     let face_entity = |e: &Entity| match e.kind {
@@ -69,68 +78,82 @@ pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face
     };
     let any_shown = dir.entities.iter().any(|e| face_entity(e) && !e.blanked);
     let mut hidden = 0usize;
+    let mut count = Count::default();
+    let top = At { m: ctx.world, instance: 0 };
     for e in &dir.entities {
-        if any_shown && e.blanked && face_entity(e) {
+        if any_shown && e.blanked && (face_entity(e) || subfigures.is_root_instance(e)) {
             hidden += 1;
             continue;
         }
-        let jobs: Vec<(usize, Job)> = match e.kind {
-            144 => alloc::vec![(e.de, Job::Trimmed)],
-            143 => alloc::vec![(e.de, Job::Bounded)],
-            186 => match shell_faces(ctx, e.de) {
-                Ok(f) => f.into_iter().map(|f| (f, Job::Brep(alloc::vec![e.de]))).collect(),
-                Err(err) => {
-                    skip(warnings, &mut first_error, e, err);
-                    continue;
-                }
-            },
-            514 if !shell_in_solid.contains(&e.de) => match shell_faces(ctx, e.de) {
-                Ok(f) => f.into_iter().map(|f| (f, Job::Brep(alloc::vec![e.de]))).collect(),
-                Err(err) => {
-                    skip(warnings, &mut first_error, e, err);
-                    continue;
-                }
-            },
-            510 if !in_shell.contains(&e.de) => alloc::vec![(e.de, Job::Brep(Vec::new()))],
-            108 if e.form == 1 && !used.contains(&e.de) => alloc::vec![(e.de, Job::BoundedPlane)],
-            108 => continue,
-            k if is_surface(k) && !used.contains(&e.de) && e.subordinate & 1 == 0 => {
-                alloc::vec![(e.de, Job::Untrimmed)]
+        if subfigures.is_member(e.de) {
+            continue; // read where its subfigure's instances place it
+        }
+        let mut jobs: Vec<(usize, Job, At)> = Vec::new();
+        if subfigures.is_root_instance(e) {
+            let mut placed = Vec::new();
+            if let Err(err) = subfigures.expand(ctx, e.de, ctx.world, 0, &mut count, &mut placed) {
+                skip(warnings, &mut first_error, e, err);
+                continue;
             }
-            308 | 408 | 402 if e.kind != 402 || e.form == 9 => {
+            for p in placed {
+                let Some(member) = dir.get(p.de) else { continue };
+                match shells.jobs(ctx, member, true) {
+                    Ok(j) => jobs.extend(j.into_iter().map(|(de, job)| (de, job, At { m: p.m, instance: p.instance }))),
+                    Err(err) => skip(warnings, &mut first_error, member, err),
+                }
+            }
+        } else {
+            if matches!(e.kind, 402 | 412 | 414 | 420) && (e.kind != 402 || e.form == 9) {
                 match unsupported.iter_mut().find(|(k, _)| *k == e.kind) {
                     Some(x) => x.1 += 1,
                     None => unsupported.push((e.kind, 1)),
                 }
                 continue;
             }
-            _ => continue,
-        };
-        for (de, job) in jobs {
-            let Ok(fe) = ctx.entity(de) else {
-                skip(warnings, &mut first_error, e, ctx.entity(de).err().unwrap_or(Error::Internal("entity".into())));
-                continue;
+            match shells.jobs(ctx, e, false) {
+                Ok(j) => jobs.extend(j.into_iter().map(|(de, job)| (de, job, top))),
+                Err(err) => {
+                    skip(warnings, &mut first_error, e, err);
+                    continue;
+                }
+            }
+        }
+        for (de, job, at) in jobs {
+            let fe = match ctx.entity(de) {
+                Ok(fe) => fe,
+                // Damaged parameter data: the directory's warning named it already.
+                Err(err) if ctx.dir.get(de).is_some_and(|x| x.damage.is_some()) => {
+                    first_error.get_or_insert(err);
+                    continue;
+                }
+                Err(err) => {
+                    skip(warnings, &mut first_error, e, err);
+                    continue;
+                }
             };
             let mut local = Vec::new();
             let result =
-                face_source(ctx, fe, &job).and_then(|src| build_face(src, &mut local).map_err(|m| fe.error(m)));
+                face_source(ctx, fe, &job, at.m).and_then(|src| build_face(src, &mut local).map_err(|m| fe.error(m)));
             for w in local {
                 warnings.push(alloc::format!("DE {} (type {}): {w}", fe.de, fe.kind));
             }
+            let body = match &job {
+                Job::Brep(parents) if !parents.is_empty() => {
+                    let next = shell_body.len() as u32 + 1;
+                    *shell_body.entry((at.instance, parents[0])).or_insert(next)
+                }
+                _ => 0,
+            };
             match result {
                 Ok(mut face) => {
                     face.name = name_of(ctx, fe, &job);
                     out.push(face);
-                    let body = match &job {
-                        Job::Brep(parents) if !parents.is_empty() => {
-                            let next = shell_body.len() as u32 + 1;
-                            *shell_body.entry(parents[0]).or_insert(next)
-                        }
-                        _ => 0,
-                    };
                     bodies.push(body);
                 }
-                Err(err) => skip(warnings, &mut first_error, fe, err),
+                Err(err) => {
+                    skip(warnings, &mut first_error, fe, err);
+                    skipped.push(SkippedFace { body, border: skipped::border(ctx, fe, &job, at.m) });
+                }
             }
         }
     }
@@ -139,14 +162,51 @@ pub(super) fn read_faces(ctx: &Ctx<'_>, warnings: &mut Vec<String>) -> (Vec<Face
             .push(alloc::format!("{hidden} hidden (blanked) surface entities skipped: the file does not show them"));
     }
     for (kind, n) in unsupported {
-        warnings.push(alloc::format!(
-            "{n} entities of type {kind} (subfigures, instances, perforated planes) skipped: not supported"
-        ));
+        let what = if kind == 402 { "perforated planes" } else { "array or network subfigure instances" };
+        warnings.push(alloc::format!("{n} entities of type {kind} ({what}) skipped: not supported"));
     }
-    if bodies.iter().all(|&b| b == 0) {
+    if bodies.iter().all(|&b| b == 0) && skipped.iter().all(|s| s.body == 0) {
         bodies.clear();
     }
     (out, bodies, first_error)
+}
+
+/// Where a face is read: the map of its definition space to the output, and
+/// the subfigure instance placing it (0: none).
+#[derive(Clone, Copy)]
+struct At {
+    m: DAffine3,
+    instance: u32,
+}
+
+/// What decides which entities are faces: surfaces something uses, faces
+/// in shells, shells in solids.
+struct Shells<'s> {
+    used: &'s HashSet<usize>,
+    in_shell: &'s HashSet<usize>,
+    shell_in_solid: &'s HashSet<usize>,
+}
+
+impl Shells<'_> {
+    /// The faces entity `e` stands for (none when it is not a face or is
+    /// part of another's); `member`: listed in a subfigure, where a surface
+    /// is a face whatever its subordinate switch says.
+    fn jobs(&self, ctx: &Ctx<'_>, e: &Entity, member: bool) -> Result<Vec<(usize, Job)>, Error> {
+        Ok(match e.kind {
+            144 => alloc::vec![(e.de, Job::Trimmed)],
+            143 => alloc::vec![(e.de, Job::Bounded)],
+            186 => shell_faces(ctx, e.de)?.into_iter().map(|f| (f, Job::Brep(alloc::vec![e.de]))).collect(),
+            514 if !self.shell_in_solid.contains(&e.de) => {
+                shell_faces(ctx, e.de)?.into_iter().map(|f| (f, Job::Brep(alloc::vec![e.de]))).collect()
+            }
+            510 if !self.in_shell.contains(&e.de) => alloc::vec![(e.de, Job::Brep(Vec::new()))],
+            108 if e.form == 1 && !self.used.contains(&e.de) => alloc::vec![(e.de, Job::BoundedPlane)],
+            k if is_surface(k) && k != 108 && !self.used.contains(&e.de) && (member || e.subordinate & 1 == 0) => {
+                alloc::vec![(e.de, Job::Untrimmed)]
+            }
+            _ => Vec::new(),
+        })
+    }
 }
 
 /// How one face is read.
@@ -167,8 +227,10 @@ fn skip(warnings: &mut Vec<String>, first: &mut Option<Error>, e: &Entity, err: 
     }
 }
 
-fn face_source(ctx: &Ctx<'_>, e: &Entity, job: &Job) -> Result<FaceSrc, Error> {
-    let m = ctx.world * own_transform(ctx.dir, e.de)?;
+/// The source of face `e` read as `job` says, its definition space mapped
+/// to the output by `base` (the Global scale, and a subfigure's placement).
+fn face_source(ctx: &Ctx<'_>, e: &Entity, job: &Job, base: DAffine3) -> Result<FaceSrc, Error> {
+    let m = base * own_transform(ctx.dir, e.de)?;
     match job {
         Job::Trimmed => trimmed_144(ctx, e, m),
         Job::Bounded => bounded_143(ctx, e, m),
@@ -176,18 +238,18 @@ fn face_source(ctx: &Ctx<'_>, e: &Entity, job: &Job) -> Result<FaceSrc, Error> {
             if e.kind != 510 {
                 return Err(e.error(alloc::format!("a shell lists type {} as a face (expected 510)", e.kind)));
             }
-            let parent = chain_transform(ctx, parents)?;
+            let parent = chain_transform(ctx, base, parents)?;
             face_510(ctx, e, parent)
         }
         Job::BoundedPlane => {
-            let (def, native) = surface_def(ctx, e.de, ctx.world, 0)?;
+            let (def, native) = surface_def(ctx, e.de, base, 0)?;
             let boundary = e.ptr(5)?.ok_or_else(|| e.error("bounded plane without a boundary curve"))?;
             let model = model_curve(ctx, boundary, m, 1)?;
             let loops = alloc::vec![LoopSrc { model, params: None }];
             Ok(FaceSrc { def, native, loops, domain_outer: false, resolution: ctx.resolution })
         }
         Job::Untrimmed => {
-            let (def, native) = surface_def(ctx, e.de, ctx.world, 0)?;
+            let (def, native) = surface_def(ctx, e.de, base, 0)?;
             Ok(FaceSrc { def, native, loops: Vec::new(), domain_outer: false, resolution: ctx.resolution })
         }
     }

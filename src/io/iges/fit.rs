@@ -85,21 +85,21 @@ impl Track {
         Some(Self { curve, model: false, ts, qs, free_ends: [[false; 2]; 2], retry: true })
     }
 
-    /// The track cut where its coordinate `k` first crosses `c` modulo the
-    /// period `p` (found by bisection on the curve's parameter): the part
-    /// before and the part after, or `None` when it does not cross.
-    pub(in crate::io) fn split_at(
+    /// The track cut inside sample interval `i` where coordinate `k` equals
+    /// `target` (bisection on the curve's parameter): the part before and the
+    /// part after, each `None` when it would hold a single sample.
+    pub(in crate::io) fn split_in(
         &mut self,
         def: &SurfDef,
+        i: usize,
         k: usize,
-        c: f64,
-        p: f64,
+        target: f64,
         periods: [Option<f64>; 2],
-    ) -> Option<(Self, Self)> {
-        let cell = |x: f64| libm::floor((x - c) / p);
-        let i = (0..self.qs.len().saturating_sub(1)).find(|&i| cell(self.qs[i][k]) != cell(self.qs[i + 1][k]))?;
-        let (x0, x1) = (self.qs[i][k], self.qs[i + 1][k]);
-        let target = c + p * cell(x0).max(cell(x1));
+    ) -> (Option<Self>, Option<Self>) {
+        if i + 1 >= self.qs.len() {
+            return (Some(self.clone()), None);
+        }
+        let x0 = self.qs[i][k];
         let (mut lo, mut hi) = (self.ts[i], self.ts[i + 1]);
         let mut near = self.qs[i];
         let mut at_hi = self.qs[i + 1];
@@ -140,7 +140,24 @@ impl Track {
             a.ts.push(t);
             a.qs.push(cut);
         }
-        (a.ts.len() >= 2 && b.ts.len() >= 2).then_some((a, b))
+        ((a.ts.len() >= 2).then_some(a), (b.ts.len() >= 2).then_some(b))
+    }
+
+    /// The track cut at its sample `j`: the samples up to it and from it,
+    /// each `None` when it would hold that sample alone.
+    pub(in crate::io) fn cut_at_sample(&self, j: usize) -> (Option<Self>, Option<Self>) {
+        let n = self.qs.len();
+        let part = |r: core::ops::Range<usize>, free: [[bool; 2]; 2]| Self {
+            curve: self.curve.clone(),
+            model: self.model,
+            ts: self.ts[r.clone()].to_vec(),
+            qs: self.qs[r].to_vec(),
+            free_ends: free,
+            retry: self.retry,
+        };
+        let head = (j > 0 && j < n).then(|| part(0..j + 1, [self.free_ends[0], [false; 2]]));
+        let tail = (j + 1 < n).then(|| part(j..n, [[false; 2], self.free_ends[1]]));
+        (head, tail)
     }
 
     /// Samples `curve` at [`MIN_SAMPLES`] even parameters plus its inner

@@ -30,27 +30,23 @@ pub(super) struct Sections<'a> {
     /// Line of a last record cut short (no section letter): the file was
     /// truncated there, and the record was dropped.
     pub truncated: Option<usize>,
+    /// What was forgiven in the record layout, one warning each.
+    pub notes: Vec<String>,
 }
 
 /// Splits `bytes` into records. Accepts LF or CRLF line ends, a missing
 /// final newline, blank lines, and lines shorter than 80 columns (trailing
 /// blanks dropped); the section letter is column 73, or, on a line shorter
-/// than that, the letter before the trailing sequence number.
+/// than that, the letter before the trailing sequence number. Forgiven with
+/// a note: records without line breaks between them (one long line of
+/// 80-column records, numbered as if broken), blanks before a record that
+/// push it past 80 columns, and section letters in lower case.
 ///
 /// # Errors
 /// A line with no section letter, a compressed or binary file, or sections
 /// out of order.
 pub(super) fn split_sections(bytes: &[u8]) -> Result<Sections<'_>, Error> {
-    let mut out = Sections::default();
-    let mut last = 0u8; // order: S < G < D < P < T
-    let rank = |c: u8| match c {
-        b'S' => 1,
-        b'G' => 2,
-        b'D' => 3,
-        b'P' => 4,
-        b'T' => 5,
-        _ => 0,
-    };
+    let mut sp = Splitter { out: Sections::default(), last: 0, lowercase: None, shifted: None };
     // The last line with content: cut short there, it is a truncated record.
     let last_line = bytes
         .split(|&b| b == b'\n')
@@ -59,20 +55,105 @@ pub(super) fn split_sections(bytes: &[u8]) -> Result<Sections<'_>, Error> {
         .map(|(i, _)| i + 1)
         .last()
         .unwrap_or(0);
+    let mut offset = 0; // records numbered past the physical lines, once one line held several
     for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
-        let line = i + 1;
+        let line = i + 1 + offset;
         let text = raw.strip_suffix(b"\r").unwrap_or(raw);
         if text.iter().all(|b| b.is_ascii_whitespace()) {
             continue;
+        }
+        if let Some(n) = unbroken(text) {
+            sp.out.notes.push(alloc::format!(
+                "line {}: {n} records of 80 columns with no line breaks between them; read as lines {line}..{}",
+                i + 1,
+                line + n - 1
+            ));
+            for (k, chunk) in text.chunks(80).enumerate() {
+                if !chunk.iter().all(|b| b.is_ascii_whitespace()) && !sp.record(line + k, chunk, false)? {
+                    break;
+                }
+            }
+            offset += n - 1;
+            continue;
+        }
+        if !sp.record(line, text, i + 1 == last_line)? {
+            break;
+        }
+    }
+    if let Some((line, n)) = sp.shifted {
+        sp.out.notes.push(alloc::format!(
+            "line {line}: a record pushed past column 80 by blanks before it; read without them{}",
+            if n > 1 { alloc::format!(" (and {} more like it)", n - 1) } else { String::new() }
+        ));
+    }
+    if let Some((line, n)) = sp.lowercase {
+        sp.out.notes.push(alloc::format!(
+            "line {line}: the section letter in lower case; read as upper case{}",
+            if n > 1 { alloc::format!(" (and {} more like it)", n - 1) } else { String::new() }
+        ));
+    }
+    Ok(sp.out)
+}
+
+/// How many 80-column records a line longer than 80 columns holds when it
+/// is several records without line breaks: each full 80 columns end in a
+/// section letter and a sequence number.
+fn unbroken(text: &[u8]) -> Option<usize> {
+    if text.len() < 160 {
+        return None;
+    }
+    let full = text.len() / 80;
+    let ok = text.chunks(80).take(full).all(|c| {
+        matches!(c[72].to_ascii_uppercase(), b'S' | b'G' | b'D' | b'P' | b'T')
+            && c[73..80].iter().all(|b| b.is_ascii_digit() || *b == b' ')
+            && c[79].is_ascii_digit()
+    });
+    let rest = text.len() - 80 * full;
+    (ok && (rest == 0 || text[80 * full..].iter().all(|b| b.is_ascii_whitespace()) || rest >= 73))
+        .then_some(full + usize::from(rest >= 73))
+}
+
+/// The state of [`split_sections`] between records.
+struct Splitter<'a> {
+    out: Sections<'a>,
+    /// Rank of the last section seen: S < G < D < P < T.
+    last: u8,
+    /// First line whose section letter was in lower case, and how many.
+    lowercase: Option<(usize, usize)>,
+    /// First record pushed past column 80 by leading blanks, and how many.
+    shifted: Option<(usize, usize)>,
+}
+
+impl<'a> Splitter<'a> {
+    /// Files one record; `false` when it was the truncated last one.
+    fn record(&mut self, line: usize, text: &'a [u8], last_line: bool) -> Result<bool, Error> {
+        let rank = |c: u8| match c {
+            b'S' => 1,
+            b'G' => 2,
+            b'D' => 3,
+            b'P' => 4,
+            b'T' => 5,
+            _ => 0,
+        };
+        let mut text = text;
+        // Blanks before a record that push its section letter past column 73.
+        if text.len() > 80 && rank(text[72].to_ascii_uppercase()) == 0 {
+            let lead = text.iter().take_while(|&&b| b == b' ').count();
+            let k = text.len() - 80;
+            if k <= lead && rank(text[72 + k].to_ascii_uppercase()) > 0 {
+                text = &text[k..];
+                let n = self.shifted.map_or(0, |s| s.1);
+                self.shifted = Some((self.shifted.map_or(line, |s| s.0), n + 1));
+            }
         }
         let (letter, data, fixed) = if text.len() >= 73 {
             (text[72], &text[..72], true)
         } else {
             match short_record(text) {
                 Some((letter, cut)) => (letter, &text[..cut], false),
-                None if line == last_line && last >= 3 => {
-                    out.truncated = Some(line);
-                    break;
+                None if last_line && self.last >= 3 => {
+                    self.out.truncated = Some(line);
+                    return Ok(false);
                 }
                 None => {
                     return Err(iges_error(
@@ -84,6 +165,13 @@ pub(super) fn split_sections(bytes: &[u8]) -> Result<Sections<'_>, Error> {
                 }
             }
         };
+        let letter = if rank(letter) == 0 && rank(letter.to_ascii_uppercase()) > 0 {
+            let n = self.lowercase.map_or(0, |s| s.1);
+            self.lowercase = Some((self.lowercase.map_or(line, |s| s.0), n + 1));
+            letter.to_ascii_uppercase()
+        } else {
+            letter
+        };
         let r = rank(letter);
         if r == 0 {
             let message = match letter {
@@ -93,7 +181,7 @@ pub(super) fn split_sections(bytes: &[u8]) -> Result<Sections<'_>, Error> {
             };
             return Err(iges_error(Section::Unknown, line, 0, message));
         }
-        if r < last {
+        if r < self.last {
             return Err(iges_error(
                 Section::from_letter(letter),
                 line,
@@ -101,17 +189,17 @@ pub(super) fn split_sections(bytes: &[u8]) -> Result<Sections<'_>, Error> {
                 "section out of order (expected Start, Global, Directory, Parameter, Terminate)",
             ));
         }
-        last = r;
+        self.last = r;
         let rec = Record { line, data, fixed };
         match letter {
-            b'G' => out.global.push(rec),
-            b'D' => out.directory.push(rec),
-            b'P' => out.parameter.push(rec),
-            b'T' => out.terminate.push(rec),
+            b'G' => self.out.global.push(rec),
+            b'D' => self.out.directory.push(rec),
+            b'P' => self.out.parameter.push(rec),
+            b'T' => self.out.terminate.push(rec),
             _ => {}
         }
+        Ok(true)
     }
-    Ok(out)
 }
 
 /// On a line shorter than 73 columns: the section letter followed by
@@ -132,7 +220,7 @@ fn short_record(text: &[u8]) -> Option<(u8, usize)> {
         end -= 1;
     }
     let letter = *text.get(end.checked_sub(1)?)?;
-    matches!(letter, b'S' | b'G' | b'D' | b'P' | b'T' | b'C' | b'B').then_some((letter, end - 1))
+    matches!(letter.to_ascii_uppercase(), b'S' | b'G' | b'D' | b'P' | b'T' | b'C' | b'B').then_some((letter, end - 1))
 }
 
 /// One free-format field.
@@ -155,11 +243,13 @@ pub(super) struct Tokenizer<'a> {
     pos: usize,
     pub param: u8,
     pub record: u8,
+    /// Whether [`Tokenizer::fields`] stopped at the record delimiter (not at the end of the text).
+    pub ended: bool,
 }
 
 impl<'a> Tokenizer<'a> {
     pub fn new(text: &'a [u8], param: u8, record: u8) -> Self {
-        Self { text, pos: 0, param, record }
+        Self { text, pos: 0, param, record, ended: false }
     }
 
     fn skip_blanks(&mut self) {
@@ -238,6 +328,7 @@ impl<'a> Tokenizer<'a> {
                 if after_delim {
                     out.push(Value::Empty);
                 }
+                self.ended = true;
                 return Ok(out);
             }
             if c == self.param {
@@ -251,7 +342,10 @@ impl<'a> Tokenizer<'a> {
             self.skip_blanks();
             match self.text.get(self.pos) {
                 None => return Ok(out),
-                Some(&d) if d == self.record => return Ok(out),
+                Some(&d) if d == self.record => {
+                    self.ended = true;
+                    return Ok(out);
+                }
                 Some(&d) if d == self.param => {
                     self.pos += 1;
                     after_delim = true;

@@ -8,16 +8,14 @@ use alloc::string::String;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
-use super::fit::{unwrap_near, Track};
-use super::surfaces::{AxisMap, Profile, SurfDef};
+use super::fit::Track;
+use super::surfaces::{AxisMap, SurfDef};
 use super::untangle::untangle;
+use super::wrap::{chain_loop, loop_shape, resolve_windings, windows, Range};
 use crate::model::{Face, FaceSurface, TrimLoop};
 use crate::nurbs::analytic::line;
 use crate::nurbs::reparam::{map_points, reversed, segment, with_end_points};
 use crate::nurbs::{Aabb, NurbsCurve, Surface};
-
-/// A closed interval `(low, high)` of one coordinate.
-type Range = (f64, f64);
 
 /// One boundary loop as the file gives it.
 #[derive(Debug, Clone, Default)]
@@ -119,18 +117,19 @@ pub(in crate::io) fn build_face_oriented(
     let windings: Vec<[i64; 2]> = tracks.iter_mut().map(|lp| chain_loop(lp, periods, left)).collect();
     resolve_windings(&def, &mut tracks, &windings, periods, natural, left)?;
     // One window of the periods for all loops; the NURBS range.
-    let mut bounds: Vec<(DVec2, DVec2)> = loops_2d.iter().map(|lp| pieces_bounds(lp)).collect();
-    bounds.extend(tracks.iter().map(|lp| track_bounds(lp)));
-    let (surface, maps) = if bounds.is_empty() {
+    let mut polys: Vec<Vec<DVec2>> = loops_2d.iter().map(|lp| pieces_poly(lp)).collect();
+    polys.extend(tracks.iter().map(|lp| lp.iter().flat_map(|t| t.qs.iter().copied()).collect()));
+    let (surface, maps) = if polys.is_empty() {
         let [u, v] = natural;
         let (Some(u), Some(v)) = (u, v) else {
             return Err("an unbounded surface without trim curves".into());
         };
         def.build(u, v)?
     } else {
-        let (mut shifts, range) = windows(&bounds, periods, natural)?;
+        let (mut shifts, range) = windows(&polys, periods, natural)?;
         if def.fixed_domain() {
-            // Loops straddling the seam of a closed B-spline: move the seam.
+            // Loops straddling the seam of a closed B-spline: move the seam,
+            // or unroll the surface over more than a period where they wrap further.
             let [lo, hi] = def.build((0.0, 1.0), (0.0, 1.0))?.0.domain();
             for k in 0..2 {
                 let (Some(p), (a, b)) = (periods[k], range[k]) else { continue };
@@ -138,10 +137,13 @@ pub(in crate::io) fn build_face_oriented(
                 if a >= lo[k] - eps && b <= hi[k] + eps {
                     continue;
                 }
+                let cannot = "trim loops cross the seam of a closed surface that cannot be re-cut there";
+                if b - a > p * (1.0 + 1e-6) {
+                    def = def.unroll(k == 0, a, b).ok_or(cannot)?;
+                    continue;
+                }
                 let c = lo[k] + (a - lo[k] - p * libm::floor((a - lo[k]) / p));
-                def = def
-                    .rotate_seam(k == 0, c)
-                    .ok_or("trim loops cross the seam of a closed surface that cannot be re-cut there")?;
+                def = def.rotate_seam(k == 0, c).ok_or(cannot)?;
                 for s in &mut shifts {
                     s[k] += c - a;
                 }
@@ -212,19 +214,14 @@ pub(in crate::io) fn build_face_oriented(
     Ok(Face { name: None, surface, loops })
 }
 
-/// Box of points along the pieces (17 per piece).
-fn pieces_bounds(pieces: &[NurbsCurve]) -> (DVec2, DVec2) {
-    let mut lo = DVec2::splat(f64::INFINITY);
-    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+/// Points along the pieces (17 per piece), a polygon of the loop.
+fn pieces_poly(pieces: &[NurbsCurve]) -> Vec<DVec2> {
+    let mut out = Vec::with_capacity(17 * pieces.len());
     for c in pieces {
         let (a, b) = c.domain();
-        for k in 0..=16 {
-            let q = c.point(a + (b - a) * k as f64 / 16.0).truncate();
-            lo = lo.min(q);
-            hi = hi.max(q);
-        }
+        out.extend((0..=16).map(|k| c.point(a + (b - a) * k as f64 / 16.0).truncate()));
     }
-    (lo, hi)
+    out
 }
 
 /// Box of a loop's samples.
@@ -233,262 +230,6 @@ fn track_bounds(lp: &[Track]) -> (DVec2, DVec2) {
         let (a, b) = t.bounds();
         (lo.min(a), hi.max(b))
     })
-}
-
-/// How good a choice of turns at a loop's pole junctions is, compared in
-/// order: the loop closes, spans at most one period, has the orientation
-/// asked for, and moves fewest junctions (negated).
-type PoleChoice = (bool, bool, bool, i64);
-
-/// Makes a sampled loop continuous piece to piece (each piece moved by
-/// whole periods to start where the previous one ends) and returns the
-/// whole turns it makes around each periodic coordinate.
-///
-/// Where two pieces meet at a point whose coordinate is arbitrary there (a
-/// pole), the nearest period is no guide: knowing the face's side (`left`),
-/// up to four such junctions are tried one period either way, and the
-/// choice that closes the loop with the orientation the face asks for
-/// (counter-clockwise when the face is on the left), spanning at most one
-/// period, is kept.
-fn chain_loop(lp: &mut [Track], periods: [Option<f64>; 2], left: Option<bool>) -> [i64; 2] {
-    let n = lp.len();
-    for i in 1..n {
-        if let (Some(&p), Some(&f)) = (lp[i - 1].qs.last(), lp[i].qs.first()) {
-            let shift = unwrap_near(f, p, periods) - f;
-            lp[i].shift(shift);
-        }
-    }
-    let mut winding = [0i64; 2];
-    for k in 0..2 {
-        let Some(p) = periods[k] else { continue };
-        let pole_at: Vec<bool> = (0..n).map(|j| lp[(j + n - 1) % n].free_ends[1][k] || lp[j].free_ends[0][k]).collect();
-        let poles: Vec<usize> = (1..n).filter(|&j| pole_at[j]).collect();
-        if let (Some(left), true) = (left, !poles.is_empty() && poles.len() <= 4) {
-            let want = if left { 1.0 } else { -1.0 };
-            let closes_at_pole = pole_at.first().copied().unwrap_or(false);
-            let mut best: Option<(PoleChoice, Vec<f64>)> = None;
-            for code in 0..3usize.pow(poles.len() as u32) {
-                // Extra turns at each pole junction, carried to every later piece.
-                let mut extra = alloc::vec![0.0; n];
-                let (mut c, mut acc, mut moved) = (code, 0.0, 0i64);
-                for j in 1..n {
-                    if poles.contains(&j) {
-                        let turn = (c % 3) as i64 - 1;
-                        c /= 3;
-                        acc += turn as f64 * p;
-                        moved += turn.abs();
-                    }
-                    extra[j] = acc;
-                }
-                let (area, lo, hi, first, last) = loop_shape(lp, &extra, k);
-                let turns = if closes_at_pole { 0 } else { libm::round((last - first) / p) as i64 };
-                let key = (turns == 0, hi - lo <= p * (1.0 + 1e-6), area * want > 0.0, -moved);
-                if best.as_ref().is_none_or(|(b, _)| key > *b) {
-                    best = Some((key, extra));
-                }
-            }
-            if let Some((_, extra)) = best {
-                for (t, d) in lp.iter_mut().zip(extra) {
-                    let mut v = DVec2::ZERO;
-                    v[k] = d;
-                    t.shift(v);
-                }
-            }
-        }
-        let first = lp.first().and_then(|t| t.qs.first()).map_or(0.0, |q| q[k]);
-        let last = lp.last().and_then(|t| t.qs.last()).map_or(0.0, |q| q[k]);
-        // Whole turns only: a loop whose ends are apart by a fraction of a
-        // turn has a gap in it (closed by a connector later), not a turn.
-        let turns = libm::round((last - first) / p);
-        let whole = (last - first - turns * p).abs() <= 0.01 * p;
-        winding[k] = if pole_at.first().copied().unwrap_or(false) || !whole { 0 } else { turns as i64 };
-    }
-    winding
-}
-
-/// Signed area of the polygon through a loop's samples (piece `i` moved by
-/// `extra[i]` along coordinate `k`), the range of `k`, and its first and last value.
-fn loop_shape(lp: &[Track], extra: &[f64], k: usize) -> (f64, f64, f64, f64, f64) {
-    let mut area = 0.0;
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    let mut first: Option<DVec2> = None;
-    let mut prev: Option<DVec2> = None;
-    for (t, &d) in lp.iter().zip(extra) {
-        for &q in &t.qs {
-            let mut q = q;
-            q[k] += d;
-            lo = lo.min(q[k]);
-            hi = hi.max(q[k]);
-            match prev {
-                Some(p) => area += p.perp_dot(q),
-                None => first = Some(q),
-            }
-            prev = Some(q);
-        }
-    }
-    if let (Some(p), Some(f)) = (prev, first) {
-        area += p.perp_dot(f);
-        return (0.5 * area, lo, hi, f[k], p[k]);
-    }
-    (0.0, lo, hi, 0.0, 0.0)
-}
-
-/// Loops that go round a periodic coordinate bound the face only with a
-/// partner: two going opposite ways are joined into one by two links along
-/// the seam; a single one is closed along the pole or boundary on the
-/// face's side (which `left` tells).
-fn resolve_windings(
-    def: &SurfDef,
-    tracks: &mut Vec<Vec<Track>>,
-    windings: &[[i64; 2]],
-    periods: [Option<f64>; 2],
-    natural: [Option<Range>; 2],
-    left: Option<bool>,
-) -> Result<(), String> {
-    let mut windings = windings.to_vec();
-    for k in 0..2 {
-        let Some(p) = periods[k] else { continue };
-        let idx: Vec<usize> = (0..tracks.len()).filter(|&i| windings[i][k] != 0).collect();
-        match idx.as_slice() {
-            [] => {}
-            [i] => {
-                let side = left.ok_or("a trim loop winds around the surface's seam (not supported)")?;
-                close_at_bound(&mut tracks[*i], k, windings[*i][k], side, bounds_of(def, natural, 1 - k))?;
-                windings[*i][k] = 0;
-            }
-            [i, j] if windings[*i][k] == -windings[*j][k] => {
-                let b = tracks.remove(*j);
-                let a = tracks.remove(*i);
-                windings.remove(*j);
-                windings.remove(*i);
-                tracks.push(join_across_seam(def, a, b, k, p, periods)?);
-                windings.push([0; 2]);
-            }
-            _ => {
-                return Err(alloc::format!(
-                    "{} trim loops go round the surface's periodic direction; cannot tell how they bound the face",
-                    idx.len()
-                ))
-            }
-        }
-    }
-    Ok(())
-}
-
-/// The range native coordinate `k` is confined to: the entity's own, or
-/// for a cone's profile the side of its apex the cone is on.
-fn bounds_of(def: &SurfDef, natural: [Option<Range>; 2], k: usize) -> Option<Range> {
-    if let Some(r) = natural[k] {
-        return Some(r);
-    }
-    let mut d = def;
-    while let SurfDef::Offset { base, .. } = d {
-        d = base;
-    }
-    match d {
-        SurfDef::Revolution(r) if k == 0 => match &r.profile {
-            Profile::Line { p0, d } if d.x != 0.0 => {
-                let apex = -p0.x / d.x;
-                Some(if d.x > 0.0 { (apex, f64::INFINITY) } else { (f64::NEG_INFINITY, apex) })
-            }
-            _ => None,
-        },
-        _ => None,
-    }
-}
-
-/// Closes a loop going `turns` times round coordinate `k` along the bound
-/// of the other coordinate on the face's side: down to it, along it, back.
-fn close_at_bound(lp: &mut Vec<Track>, k: usize, turns: i64, left: bool, nat: Option<Range>) -> Result<(), String> {
-    let o = 1 - k;
-    // Going +k, the left side is +o for k = 0 and −o for k = 1.
-    let side = if k == 0 { 1.0 } else { -1.0 } * turns.signum() as f64 * if left { 1.0 } else { -1.0 };
-    let bound = nat.map(|(a, b)| if side > 0.0 { b } else { a }).filter(|x| x.is_finite());
-    let Some(bound) = bound else {
-        return Err("a trim loop goes round a surface that is unbounded on the face's side".into());
-    };
-    let (Some(s), Some(e)) =
-        (lp.first().and_then(|t| t.qs.first().copied()), lp.last().and_then(|t| t.qs.last().copied()))
-    else {
-        return Err("an empty trim loop".into());
-    };
-    let (mut e2, mut s2) = (e, s);
-    e2[o] = bound;
-    s2[o] = bound;
-    for (a, b) in [(e, e2), (e2, s2), (s2, s)] {
-        if a.distance(b) > 0.0 {
-            lp.push(Track::link(a, b).ok_or("a link along the surface's bound could not be made")?);
-        }
-    }
-    Ok(())
-}
-
-/// One loop from `a` and `b`, which go round coordinate `k` opposite ways:
-/// `b` is cut where it crosses `a`'s start (modulo the period) and rotated
-/// to start there, then `a`, a link along the seam, `b`, and a link back.
-fn join_across_seam(
-    def: &SurfDef,
-    mut a: Vec<Track>,
-    mut b: Vec<Track>,
-    k: usize,
-    p: f64,
-    periods: [Option<f64>; 2],
-) -> Result<Vec<Track>, String> {
-    let (Some(a0), Some(a1)) =
-        (a.first().and_then(|t| t.qs.first().copied()), a.last().and_then(|t| t.qs.last().copied()))
-    else {
-        return Err("an empty trim loop".into());
-    };
-    let c = a0[k];
-    let b_turn =
-        b.last().and_then(|t| t.qs.last()).zip(b.first().and_then(|t| t.qs.first())).map_or(0.0, |(l, f)| l[k] - f[k]);
-    let b_turn = libm::round(b_turn / p) * p;
-    // Rotate b to start where it crosses c (mod p).
-    let starts_there = b.first().and_then(|t| t.qs.first()).is_some_and(|q| {
-        let r = (q[k] - c) - p * libm::floor((q[k] - c) / p);
-        r.min(p - r) <= 1e-12 * p
-    });
-    let mut rotated: Vec<Track> = Vec::with_capacity(b.len() + 1);
-    if starts_there {
-        rotated = b;
-    } else {
-        let mut cut = None;
-        for (i, t) in b.iter_mut().enumerate() {
-            if let Some(parts) = t.split_at(def, k, c, p, periods) {
-                cut = Some((i, parts));
-                break;
-            }
-        }
-        let Some((i, (head, tail))) = cut else {
-            return Err("a trim loop going round the surface does not cross its partner's seam".into());
-        };
-        let mut shift = DVec2::ZERO;
-        shift[k] = b_turn;
-        rotated.push(tail);
-        rotated.extend(b.iter().skip(i + 1).cloned());
-        for t in b.iter().take(i).cloned().chain(core::iter::once(head)) {
-            let mut t = t;
-            t.shift(shift);
-            rotated.push(t);
-        }
-    }
-    // Line b's start up with a's end.
-    let b0 = rotated.first().and_then(|t| t.qs.first().copied()).unwrap_or(a1);
-    let mut shift = DVec2::ZERO;
-    shift[k] = libm::round((a1[k] - b0[k]) / p) * p;
-    for t in &mut rotated {
-        t.shift(shift);
-    }
-    let b0 = rotated.first().and_then(|t| t.qs.first().copied()).unwrap_or(a1);
-    let b1 = rotated.last().and_then(|t| t.qs.last().copied()).unwrap_or(a0);
-    if a1.distance(b0) > 0.0 {
-        a.push(Track::link(a1, b0).ok_or("a link along the seam could not be made")?);
-    }
-    a.extend(rotated);
-    if b1.distance(a0) > 0.0 {
-        a.push(Track::link(b1, a0).ok_or("a link along the seam could not be made")?);
-    }
-    Ok(a)
 }
 
 /// A face whose only loop runs along the border of its own box in native
@@ -541,55 +282,6 @@ fn rectangle_face(def: &SurfDef, lp: &[Track]) -> Result<Option<Face>, String> {
         def.build((lo.x, hi.x), (lo.y, hi.y))?.0
     };
     Ok(Some(Face { name: None, surface, loops: Vec::new() }))
-}
-
-/// Whole-period shifts per loop that put all loops in one window of each
-/// periodic coordinate (starting at the entity's natural start when that
-/// works as well as any), and the loops' range after the shifts.
-fn windows(
-    bounds: &[(DVec2, DVec2)],
-    periods: [Option<f64>; 2],
-    natural: [Option<(f64, f64)>; 2],
-) -> Result<(Vec<DVec2>, [Range; 2]), String> {
-    let mut shifts = alloc::vec![DVec2::ZERO; bounds.len()];
-    let mut range = [(0.0, 0.0); 2];
-    for k in 0..2 {
-        let lo_all = bounds.iter().map(|b| b.0[k]).fold(f64::INFINITY, f64::min);
-        let hi_all = bounds.iter().map(|b| b.1[k]).fold(f64::NEG_INFINITY, f64::max);
-        range[k] = (lo_all, hi_all);
-        let Some(p) = periods[k] else { continue };
-        let mut starts: Vec<f64> = Vec::new();
-        if let Some((a, _)) = natural[k] {
-            starts.push(a);
-        }
-        starts.extend(bounds.iter().map(|b| b.0[k]));
-        let eps = 1e-9 * p;
-        let mut best: Option<(f64, Vec<f64>, f64, f64)> = None;
-        for &s in &starts {
-            let mut sh = Vec::with_capacity(bounds.len());
-            let (mut wlo, mut whi) = (f64::INFINITY, f64::NEG_INFINITY);
-            for b in bounds {
-                let d = libm::ceil((s - eps - b.0[k]) / p) * p;
-                sh.push(d);
-                wlo = wlo.min(b.0[k] + d);
-                whi = whi.max(b.1[k] + d);
-            }
-            let span = whi - wlo;
-            if best.as_ref().is_none_or(|x| span < x.0 - eps) {
-                best = Some((span, sh, wlo, whi));
-            }
-        }
-        if let Some((span, sh, wlo, whi)) = best {
-            if span > p * (1.0 + 1e-9) {
-                return Err("the trim loops span more than one turn of the surface".into());
-            }
-            for (s, d) in shifts.iter_mut().zip(sh) {
-                s[k] = d;
-            }
-            range[k] = (wlo, whi);
-        }
-    }
-    Ok((shifts, range))
 }
 
 /// The native ranges the surface must cover: the loops' range plus a

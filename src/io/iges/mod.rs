@@ -18,8 +18,10 @@ mod faces;
 mod fit;
 mod lexer;
 pub(super) mod loops;
+mod subfigures;
 pub(super) mod surfaces;
 mod untangle;
+mod wrap;
 mod xform;
 
 use alloc::string::String;
@@ -76,6 +78,36 @@ fn iges_error(section: Section, line: usize, entity: usize, message: impl Into<S
     Error::Iges { section: section.name(), line, entity, message: message.into() }
 }
 
+/// What the reader forgave, one warning per kind: the first occurrence's
+/// message and how many more entities of that kind followed (an entity read
+/// twice, as a curve two faces share is, counts once).
+#[derive(Default)]
+struct Notes {
+    kinds: Vec<(&'static str, String, usize)>,
+    seen: crate::collections::HashSet<(&'static str, usize)>,
+}
+
+impl Notes {
+    /// Notes `kind` for entity `de` (0: none); `message` is made only for the first.
+    fn note(&mut self, kind: &'static str, de: usize, message: impl FnOnce() -> String) {
+        if de != 0 && !self.seen.insert((kind, de)) {
+            return;
+        }
+        match self.kinds.iter_mut().find(|k| k.0 == kind) {
+            Some(k) => k.2 += 1,
+            None => self.kinds.push((kind, message(), 0)),
+        }
+    }
+
+    /// One warning per kind, in the order the kinds were first met.
+    fn warnings(&self) -> Vec<String> {
+        self.kinds
+            .iter()
+            .map(|(_, m, more)| if *more == 0 { m.clone() } else { alloc::format!("{m} (and {more} more like it)") })
+            .collect()
+    }
+}
+
 /// What the readers of entities share.
 struct Ctx<'a> {
     dir: &'a Directory,
@@ -83,14 +115,19 @@ struct Ctx<'a> {
     world: DAffine3,
     /// Minimum resolution, output units.
     resolution: Option<f64>,
+    /// Repairs made while reading entities (see [`Notes`]).
+    notes: core::cell::RefCell<Notes>,
 }
 
 impl Ctx<'_> {
     /// The entity at directory entry `de`.
     ///
     /// # Errors
-    /// No entity there (a bad pointer).
+    /// No entity there (a bad pointer), or one whose parameter data could not be read.
     fn entity(&self, de: usize) -> Result<&Entity, Error> {
+        if let Some(err) = self.dir.get(de).and_then(|e| e.damage.as_ref()) {
+            return Err(err.clone());
+        }
         self.dir.get(de).ok_or_else(|| {
             iges_error(
                 Section::Directory,
@@ -105,6 +142,24 @@ impl Ctx<'_> {
     }
 }
 
+/// Why a file gave no face at all: the entity types it holds instead.
+fn no_faces(dir: &Directory) -> String {
+    let mut kinds: Vec<(u32, usize)> = Vec::new();
+    for e in &dir.entities {
+        match kinds.iter_mut().find(|k| k.0 == e.kind) {
+            Some(k) => k.1 += 1,
+            None => kinds.push((e.kind, 1)),
+        }
+    }
+    kinds.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    let shown: Vec<String> = kinds.iter().take(6).map(|(k, n)| alloc::format!("{n} of type {k}")).collect();
+    let more = if kinds.len() > 6 { ", …" } else { "" };
+    alloc::format!(
+        "no surfaces or faces in the file, only curves, points, annotations or structure (entities: {}{more})",
+        shown.join(", ")
+    )
+}
+
 /// Units, scale and resolution from the Global section.
 struct Global {
     param: u8,
@@ -114,29 +169,54 @@ struct Global {
     resolution: Option<f64>,
 }
 
+impl Default for Global {
+    /// The standard's defaults: `,` and `;`, model space scale 1, millimetres.
+    fn default() -> Self {
+        Self { param: b',', record: b';', scale: 1.0, units: "mm".into(), resolution: None }
+    }
+}
+
 /// Reads an IGES file.
 ///
 /// Coordinates are divided by the Global section's model space scale and
 /// stay in the file's unit (named in [`Model::units`]); [`Model::tolerance`]
 /// is the file's minimum resolution. Faces: 144 trimmed and 143 bounded
 /// surfaces, 510 faces of 514 shells and 186 solids, bounded 108 planes and
-/// surfaces no face uses; skipped faces and unsupported entities are listed
-/// in [`Model::warnings`].
+/// surfaces no face uses, read in place or where the 408 instances of a 308
+/// subfigure put them; skipped faces, unsupported entities and what was
+/// repaired are listed in [`Model::warnings`].
 ///
 /// # Errors
 /// [`Error::Iges`] for a malformed file (section, line and entity named),
 /// and when no face at all could be read (the first face's error).
 pub fn read_iges(bytes: &[u8]) -> Result<Model, Error> {
-    let sections = split_sections(bytes)?;
-    if sections.global.is_empty() {
-        return Err(iges_error(Section::Global, 0, 0, "no Global section (not an IGES file?)"));
-    }
-    let g = global(&sections.global)?;
+    let mut sections = split_sections(bytes)?;
     if sections.directory.is_empty() {
-        return Err(iges_error(Section::Directory, 0, 0, "no Directory entries: the file holds no entities"));
+        return Err(iges_error(
+            Section::Directory,
+            0,
+            0,
+            if sections.global.is_empty() {
+                "no Global section and no Directory entries (not an IGES file?)"
+            } else {
+                "no Directory entries: the file holds no entities"
+            },
+        ));
     }
-    let dir = Directory::parse(&sections.directory, &sections.parameter, g.param, g.record)?;
-    let mut warnings = Vec::new();
+    let mut warnings = core::mem::take(&mut sections.notes);
+    // Nothing the Global section holds is needed to read the entities: its
+    // defaults (delimiters `,` and `;`, scale 1, millimetres) stand in.
+    let g = if sections.global.is_empty() {
+        warnings.push("no Global section: the default delimiters, scale and unit are used".into());
+        Global::default()
+    } else {
+        global(&sections.global).unwrap_or_else(|e| {
+            warnings.push(alloc::format!("{e}; the default delimiters, scale and unit are used"));
+            Global::default()
+        })
+    };
+    let mut dir = Directory::parse(&sections.directory, &sections.parameter, g.param, g.record)?;
+    warnings.append(&mut dir.notes);
     if let Some(line) = sections.truncated {
         warnings.push(alloc::format!("line {line} is cut short (file truncated?): ignored"));
     }
@@ -145,19 +225,15 @@ pub fn read_iges(bytes: &[u8]) -> Result<Model, Error> {
         dir: &dir,
         world: DAffine3::from_scale(glam::DVec3::splat(1.0 / g.scale)),
         resolution: g.resolution.map(|r| r / g.scale),
+        notes: core::cell::RefCell::default(),
     };
-    let (faces, bodies, first_error) = faces::read_faces(&ctx, &mut warnings);
+    let mut skipped = Vec::new();
+    let (faces, bodies, first_error) = faces::read_faces(&ctx, &mut warnings, &mut skipped);
+    warnings.extend(ctx.notes.borrow().warnings());
     if faces.is_empty() {
-        return Err(first_error.unwrap_or_else(|| {
-            iges_error(
-                Section::Directory,
-                0,
-                0,
-                "no surfaces or faces in the file (only curves, points or annotations?)",
-            )
-        }));
+        return Err(first_error.unwrap_or_else(|| iges_error(Section::Directory, 0, 0, no_faces(&dir))));
     }
-    Ok(Model { units: g.units, faces, warnings, tolerance: ctx.resolution, bodies })
+    Ok(Model { units: g.units, faces, warnings, tolerance: ctx.resolution, bodies, tessellated: Vec::new(), skipped })
 }
 
 /// The Global section: delimiters (fields 1–2), model space scale (13),

@@ -22,7 +22,7 @@ use crate::model::FaceSurface;
 use crate::nurbs::analytic::{bilinear, circle_arc, extrude, revolve, ruled, ArcParam};
 use crate::nurbs::join::join;
 use crate::nurbs::reparam::{reparametrized, segment};
-use crate::nurbs::seam::rotate_seam;
+use crate::nurbs::seam::{rotate_seam, unroll};
 use crate::nurbs::{project_to_surface, NurbsCurve, NurbsSurface, ProjectionOptions, Surface, MAX_DEGREE};
 use crate::Error;
 
@@ -161,6 +161,21 @@ impl SurfDef {
         }
     }
 
+    /// The closed B-spline surface unrolled along u (`along_u`) or v over
+    /// native range `[a, b]`, which may exceed its period (see [`unroll`]).
+    pub fn unroll(&self, along_u: bool, a: f64, b: f64) -> Option<Self> {
+        match self {
+            Self::Nurbs { surface, periods, .. } => {
+                let s = unroll(surface, along_u, a, b)?;
+                Some(Self::Nurbs { surface: s, periods: *periods, natural: None })
+            }
+            Self::Offset { base, distance } => {
+                Some(Self::Offset { base: Box::new(base.unroll(along_u, a, b)?), distance: *distance })
+            }
+            _ => None,
+        }
+    }
+
     /// Native coordinates of the surface point closest to `p` (`hint`: the
     /// coordinates of a nearby point, to stay on the same branch). `retry`
     /// allows a global search when Newton from the hint ends far off, and
@@ -245,7 +260,10 @@ impl Revolution {
         let (x, y) = self.frame();
         let r = radial.length();
         let scale = self.origin.length() + w.length() + 1e-300;
-        let on_axis = r <= 1e-10 * scale;
+        // A vertex meant to lie on the axis (a sphere's pole, a cone's apex)
+        // is written a few digits short of it: within 1e-7 of its distance
+        // from the origin its angle is noise, not a direction.
+        let on_axis = r <= 1e-10 * scale + 1e-7 * w.length();
         let mut theta = if on_axis { hint.map_or(0.0, |q| q.y) } else { libm::atan2(radial.dot(y), radial.dot(x)) };
         let t = match &self.profile {
             Profile::Line { p0, d } => {
@@ -257,14 +275,32 @@ impl Revolution {
                 };
                 let (t, e) = foot(DVec2::new(r, h));
                 let (t2, e2) = foot(DVec2::new(-r, h));
-                if e2 < e && !on_axis {
+                if on_axis && d.x != 0.0 {
+                    // On the axis means at the apex, exactly: the loop's
+                    // corner is then the pole, not a hair beside it.
+                    -p0.x / d.x
+                } else if e2 < e && !on_axis {
                     theta += if theta > 0.0 { -core::f64::consts::PI } else { core::f64::consts::PI };
                     t2
                 } else {
                     t
                 }
             }
-            Profile::Circle { c, .. } => libm::atan2(h - c.y, r - c.x),
+            Profile::Circle { c, rho, .. } => {
+                let t = libm::atan2(h - c.y, r - c.x);
+                // On the axis: exactly where the circle crosses it (a sphere's pole).
+                let cross = -c.x / rho.max(1e-300);
+                if on_axis && cross.abs() <= 1.0 {
+                    let pole = libm::acos(cross);
+                    if t < 0.0 {
+                        -pole
+                    } else {
+                        pole
+                    }
+                } else {
+                    t
+                }
+            }
             Profile::Curve(curve) => {
                 let q = self.origin + self.axis * h + x * r;
                 curve.project(q).0

@@ -29,6 +29,9 @@ pub(super) fn own_transform(dir: &Directory, de: usize) -> Result<DAffine3, Erro
             .get(at)
             .filter(|m| m.kind == 124)
             .ok_or_else(|| e.error(alloc::format!("transformation pointer {at} does not name a 124 matrix entity")))?;
+        if let Some(err) = &m.damage {
+            return Err(err.clone());
+        }
         let r = |i: usize| m.real(i);
         let mat = DMat3::from_cols(
             DVec3::new(r(1)?, r(5)?, r(9)?),

@@ -82,7 +82,7 @@ pub(super) const SHAPES: [&str; 12] = [
 ];
 
 fn is_shape(e: Ent<'_>) -> bool {
-    SHAPES.iter().any(|n| e.has(n)) || super::surfaces::is_bspline_surface(e)
+    SHAPES.iter().any(|n| e.has(n)) || super::surfaces::is_bspline_surface(e) || super::tessellated::is_tessellated(e)
 }
 
 /// The `(name, items, context)` of a representation, if `e` is one.

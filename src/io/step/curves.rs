@@ -10,7 +10,7 @@ use glam::{DAffine3, DMat3, DVec3};
 
 use super::graph::{Ent, Graph};
 use super::{MAX_CONTROL_POINTS, MAX_DEPTH};
-use crate::nurbs::analytic::{ellipse_arc, line};
+use crate::nurbs::analytic::{ellipse_arc, hyperbola_arc, line, parabola_arc};
 use crate::nurbs::join::join;
 use crate::nurbs::reparam::{reversed, segment, with_end_points, RawCurve};
 use crate::nurbs::{NurbsCurve, MAX_DEGREE};
@@ -51,6 +51,10 @@ pub(super) enum Curve3 {
     Line { p: DVec3, d: DVec3 },
     /// `c + cos t·x + sin t·y` (`x`, `y` orthogonal, lengths the semi-axes), `t` in radians.
     Conic { c: DVec3, x: DVec3, y: DVec3 },
+    /// `c + cosh t·x + sinh t·y` (`x`, `y` orthogonal, lengths the semi-axes).
+    Hyperbola { c: DVec3, x: DVec3, y: DVec3 },
+    /// `c + t²·x + t·y` (`x` the focal distance along the axis, `y` twice it across).
+    Parabola { c: DVec3, x: DVec3, y: DVec3 },
     /// A B-spline; `closed` when it ends where it starts.
     Nurbs { c: NurbsCurve, closed: bool },
 }
@@ -224,6 +228,24 @@ impl Geo<'_> {
             }
             return basis(Curve3::Conic { c: f.o, x: f.x * r1, y: f.y * r2 });
         }
+        if e.has("HYPERBOLA") {
+            let a = e.chain(&[("REPRESENTATION_ITEM", 1), ("CONIC", 1), ("HYPERBOLA", 2)])?;
+            let f = self.placement(a.ent(1)?)?;
+            let (r1, r2) = (a.real(2)?, a.real(3)?);
+            if !(r1 > 0.0 && r2 > 0.0 && r1.is_finite() && r2.is_finite()) {
+                return Err(e.error("hyperbola with a semi-axis that is not positive"));
+            }
+            return basis(Curve3::Hyperbola { c: f.o, x: f.x * r1, y: f.y * r2 });
+        }
+        if e.has("PARABOLA") {
+            let a = e.chain(&[("REPRESENTATION_ITEM", 1), ("CONIC", 1), ("PARABOLA", 1)])?;
+            let f = self.placement(a.ent(1)?)?;
+            let focal = a.real(2)?;
+            if !(focal.is_finite() && focal != 0.0) {
+                return Err(e.error("parabola with a zero focal distance"));
+            }
+            return basis(Curve3::Parabola { c: f.o, x: f.x * focal, y: f.y * (2.0 * focal) });
+        }
         if is_bspline_curve(e) {
             let c = self.bspline_curve(e)?;
             let (a, b) = c.domain();
@@ -254,8 +276,10 @@ impl Geo<'_> {
             let prefer_param = a.enumeration(5).map(|m| m == "PARAMETER").unwrap_or(false);
             let t1 = self.trim_value(e, &inner.curve, &a, 2, prefer_param)?;
             let t2 = self.trim_value(e, &inner.curve, &a, 3, prefer_param)?;
+            // The trimmed curve runs from trim_1 to trim_2, along its basis
+            // when `sense` and against it otherwise (ISO 10303-42).
             let range = match (t1, t2) {
-                (Some(t1), Some(t2)) => Some(if sense { (t1, t2) } else { (t2, t1) }),
+                (Some(t1), Some(t2)) => Some((t1, t2)),
                 _ => None,
             };
             return Ok(CurveDef { curve: inner.curve, range, reversed: !sense ^ inner.reversed });
@@ -487,6 +511,8 @@ pub(super) fn param_of(c: &Curve3, p: DVec3) -> f64 {
             let w = p - *c;
             libm::atan2(w.dot(*y) / y.length_squared().max(1e-300), w.dot(*x) / x.length_squared().max(1e-300))
         }
+        Curve3::Hyperbola { c, y, .. } => libm::asinh((p - *c).dot(*y) / y.length_squared().max(1e-300)),
+        Curve3::Parabola { c, y, .. } => (p - *c).dot(*y) / y.length_squared().max(1e-300),
         Curve3::Nurbs { c, .. } => c.project(p).0,
     }
 }
@@ -494,7 +520,7 @@ pub(super) fn param_of(c: &Curve3, p: DVec3) -> f64 {
 /// Period of the curve's parameter, if it closes.
 pub(super) fn period(c: &Curve3) -> Option<f64> {
     match c {
-        Curve3::Line { .. } => None,
+        Curve3::Line { .. } | Curve3::Hyperbola { .. } | Curve3::Parabola { .. } => None,
         Curve3::Conic { .. } => Some(TAU),
         Curve3::Nurbs { c, closed } => closed.then(|| {
             let (a, b) = c.domain();
@@ -513,6 +539,8 @@ pub(super) fn pieces_between(c: &Curve3, t0: f64, t1: f64) -> Result<Vec<NurbsCu
     match c {
         Curve3::Line { p, d } => Ok(alloc::vec![line(*p + *d * t0, *p + *d * t1, 0.0, 1.0).map_err(err)?]),
         Curve3::Conic { c, x, y } => Ok(alloc::vec![ellipse_arc(*c, *x, *y, t0, t1).map_err(err)?]),
+        Curve3::Hyperbola { c, x, y } => Ok(alloc::vec![hyperbola_arc(*c, *x, *y, t0, t1).map_err(err)?]),
+        Curve3::Parabola { c, x, y } => Ok(alloc::vec![parabola_arc(*c, *x, *y, t0, t1).map_err(err)?]),
         Curve3::Nurbs { c, closed } => {
             let (a, b) = c.domain();
             let per = b - a;
@@ -524,15 +552,21 @@ pub(super) fn pieces_between(c: &Curve3, t0: f64, t1: f64) -> Result<Vec<NurbsCu
                 }
                 return Ok(alloc::vec![seg(c, s0, s1)?]);
             }
-            // Wraps past the end: two pieces (parameters brought into the domain).
-            let wrap = |t: f64| a + (t - a) - per * libm::floor((t - a) / per);
-            let (s0, s1) = (wrap(t0), wrap(t1));
-            let mut out = Vec::new();
-            if b - s0 > tiny {
-                out.push(seg(c, s0, b)?);
+            // Wraps past the end: the start brought into the domain (a start
+            // at the domain's end is its beginning), then one piece or two.
+            let mut s0 = a + (t0 - a) - per * libm::floor((t0 - a) / per);
+            if b - s0 <= tiny {
+                s0 = a;
             }
-            if s1 - a > tiny {
-                out.push(seg(c, a, s1)?);
+            let s1 = s0 + (t1 - t0).min(per);
+            let mut out = Vec::new();
+            if s1 <= b + tiny {
+                out.push(seg(c, s0, s1.min(b))?);
+            } else {
+                out.push(seg(c, s0, b)?);
+                if s1 - per - a > tiny {
+                    out.push(seg(c, a, s1 - per)?);
+                }
             }
             if out.is_empty() {
                 return Err("empty closed-curve range".into());
@@ -550,6 +584,9 @@ pub(super) fn bounded_pieces(def: &CurveDef) -> Result<Vec<NurbsCurve>, String> 
         (None, Curve3::Nurbs { c, .. }) => c.domain(),
         (None, Curve3::Conic { .. }) => (0.0, TAU),
         (None, Curve3::Line { .. }) => return Err("an unbounded line in a composite curve".into()),
+        (None, Curve3::Hyperbola { .. } | Curve3::Parabola { .. }) => {
+            return Err("an unbounded hyperbola or parabola in a composite curve".into())
+        }
     };
     // The range runs from the start to the end of the trimmed curve; along
     // the basis parameter that is increasing unless `reversed`.
@@ -563,4 +600,51 @@ pub(super) fn bounded_pieces(def: &CurveDef) -> Result<Vec<NurbsCurve>, String> 
         rev_all(&mut out)?;
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// A full circle as one B-spline over [0, 2] that starts and ends at (5, 0, 0).
+    fn closed_circle() -> Curve3 {
+        let x = DVec3::X * 5.0;
+        let y = DVec3::Y * 5.0;
+        let c = ellipse_arc(DVec3::ZERO, x, y, 0.0, core::f64::consts::TAU).unwrap();
+        Curve3::Nurbs { c: crate::nurbs::reparam::reparametrized(&c, 0.0, 2.0).unwrap(), closed: true }
+    }
+
+    fn span_of(pieces: &[NurbsCurve]) -> f64 {
+        pieces
+            .iter()
+            .map(|c| {
+                let (a, b) = c.domain();
+                (0..64)
+                    .map(|k| {
+                        c.point(a + (b - a) * k as f64 / 64.0).distance(c.point(a + (b - a) * (k + 1) as f64 / 64.0))
+                    })
+                    .sum::<f64>()
+            })
+            .sum()
+    }
+
+    /// An edge from the curve's closing point to its middle: where the start
+    /// is found at the end of the domain, the range wraps to the half after
+    /// it, not the whole turn and that half again.
+    #[test]
+    fn a_range_starting_at_the_domain_end_wraps_to_its_beginning() {
+        let c = closed_circle();
+        let half = core::f64::consts::PI * 5.0;
+        for (t0, t1) in [(2.0, 3.0), (0.0, 1.0), (1.5, 2.5), (2.0 - 1e-12, 3.0)] {
+            let pieces = pieces_between(&c, t0, t1).unwrap();
+            let len = span_of(&pieces);
+            assert!((len - half).abs() < 1e-3 * half, "{t0}..{t1}: length {len}, expected {half}");
+        }
+        let Curve3::Nurbs { c: n, .. } = &c else { unreachable!() };
+        let first = pieces_between(&c, 2.0, 3.0).unwrap();
+        let (a, b) = first[0].domain();
+        assert!(first[0].point(a).distance(n.point(0.0)) < 1e-9, "starts at the closing point");
+        assert!(first.last().unwrap().point(b.max(a)).distance(DVec3::new(-5.0, 0.0, 0.0)) < 1e-9);
+    }
 }

@@ -31,6 +31,19 @@ pub(super) struct Edges {
     /// the first edge read): such a writer puts one vertex where the loop
     /// has two corners, so no edge's curve is cut or moved to them.
     reused: Option<crate::collections::HashSet<u64>>,
+    /// Where each edge is used in the file's loops, built at the first edge
+    /// whose vertex is missing.
+    uses: Option<LoopUses>,
+}
+
+/// For each `EDGE_CURVE`, its uses in `EDGE_LOOP`s: the loop, the position
+/// in it and the orientation, so a missing vertex can be taken from the
+/// neighbouring edge that shares it.
+#[derive(Default)]
+struct LoopUses {
+    by_edge: HashMap<u64, Vec<(u64, usize)>>,
+    /// Each loop's edges with their orientations, in order.
+    loops: HashMap<u64, Vec<(u64, bool)>>,
 }
 
 impl Edges {
@@ -42,7 +55,7 @@ impl Edges {
             return r.clone();
         }
         let reused = self.reused.get_or_insert_with(|| reused_vertices(geo));
-        let r = read_edge(geo, e, alone, reused);
+        let r = read_edge(geo, e, alone, reused, &mut self.uses);
         self.done.insert((e.id(), alone), r.clone());
         r
     }
@@ -57,20 +70,105 @@ pub(super) fn vertex(geo: &Geo<'_>, e: Ent<'_>) -> Result<DVec3, Error> {
     geo.point(a.ent(1)?)
 }
 
-fn read_edge(geo: &Geo<'_>, e: Ent<'_>, alone: bool, reused: &crate::collections::HashSet<u64>) -> Result<Edge, Error> {
+fn read_edge(
+    geo: &Geo<'_>,
+    e: Ent<'_>,
+    alone: bool,
+    reused: &crate::collections::HashSet<u64>,
+    uses: &mut Option<LoopUses>,
+) -> Result<Edge, Error> {
     if !e.has("EDGE_CURVE") {
         return Err(e.error("expected an EDGE_CURVE"));
     }
     let a = e.chain(&[("REPRESENTATION_ITEM", 1), ("EDGE", 2), ("EDGE_CURVE", 2)])?;
     let (vs, ve) = (a.refr(1)?, a.refr(2)?);
-    let ps = vertex(geo, a.ent(1)?)?;
-    let pe = if ve == vs { ps } else { vertex(geo, a.ent(2)?)? };
+    // A vertex the file does not define (a dangling reference) is where the
+    // neighbouring edge of one of the edge's loops ends.
+    let mut found = None;
+    let mut end_point = |end: bool, v: u64| -> Result<DVec3, Error> {
+        let missing = match geo.g.get(v, e.id()) {
+            Ok(x) => return vertex(geo, x),
+            Err(err) => err,
+        };
+        let uses = uses.get_or_insert_with(|| LoopUses::of(geo));
+        let (p, lp) = uses.neighbour_vertex(geo, e.id(), end).ok_or(missing)?;
+        let which = if end { "end" } else { "start" };
+        found = Some(format!(
+            "its {which} vertex #{v} is not defined; the point its neighbour in loop #{lp} gives is used"
+        ));
+        Ok(p)
+    };
+    let ps = end_point(false, vs)?;
+    let pe = if ve == vs { ps } else { end_point(true, ve)? };
     let def = geo.curve(a.ent(3)?, 0)?;
     let same_sense = a.boolean(4, true)?;
     let ends = Ends { ps, pe, trust: [!reused.contains(&vs), !reused.contains(&ve)] };
     let (pieces, repaired) =
         cut(&def, &ends, same_sense, vs == ve || alone, geo.uncertainty).map_err(|m| e.error(m))?;
+    let repaired = match (found, repaired) {
+        (Some(f), Some(r)) => Some(format!("{f}; {r}")),
+        (f, r) => f.or(r),
+    };
     Ok(Edge { pieces, repaired })
+}
+
+impl LoopUses {
+    /// One pass over the file's `EDGE_LOOP`s.
+    fn of(geo: &Geo<'_>) -> Self {
+        let mut out = Self::default();
+        for lp in geo.g.all().filter(|x| x.has("EDGE_LOOP")) {
+            let Some(refs) = lp.part("EDGE_LOOP").and_then(|p| {
+                // A simple instance lists its name first.
+                let at = usize::from(!lp.is_complex());
+                p.refs(at).ok()
+            }) else {
+                continue;
+            };
+            let mut list = Vec::with_capacity(refs.len());
+            for r in refs {
+                let Some(oe) = geo.g.find(r) else { continue };
+                let (edge, orientation) = if oe.has("ORIENTED_EDGE") {
+                    let oa = oe.attrs();
+                    match (oa.refr(3), oa.boolean(4, true)) {
+                        (Ok(x), Ok(o)) => (x, o),
+                        _ => continue,
+                    }
+                } else {
+                    (r, true)
+                };
+                out.by_edge.entry(edge).or_default().push((lp.id(), list.len()));
+                list.push((edge, orientation));
+            }
+            out.loops.insert(lp.id(), list);
+        }
+        out
+    }
+
+    /// The point of edge `edge`'s start (`end` false) or end vertex as the
+    /// edge next to it in one of its loops gives it, and that loop's `#id`.
+    fn neighbour_vertex(&self, geo: &Geo<'_>, edge: u64, end: bool) -> Option<(DVec3, u64)> {
+        for &(lp, i) in self.by_edge.get(&edge)? {
+            let list = self.loops.get(&lp)?;
+            let n = list.len();
+            let &(_, o) = list.get(i)?;
+            if n < 2 {
+                continue;
+            }
+            // Along the loop, the edge runs start to end when `o`: its end
+            // meets the next edge's first vertex, its start the previous edge's last.
+            let forward = end == o;
+            let (other, oo) = if forward { list[(i + 1) % n] } else { list[(i + n - 1) % n] };
+            // The neighbour's vertex there: its first along the loop if it comes next.
+            let first_of_other = forward == oo;
+            let Some(x) = geo.g.find(other) else { continue };
+            let Ok(xa) = x.chain(&[("REPRESENTATION_ITEM", 1), ("EDGE", 2)]) else { continue };
+            let Ok(v) = xa.ent(if first_of_other { 1 } else { 2 }) else { continue };
+            if let Ok(p) = vertex(geo, v) {
+                return Some((p, lp));
+            }
+        }
+        None
+    }
 }
 
 /// An edge's two vertex points, and whether each can be trusted to lie at
@@ -250,7 +348,9 @@ fn cut(
 fn curve_scale(c: &Curve3) -> f64 {
     match c {
         Curve3::Line { d, .. } => d.length(),
-        Curve3::Conic { x, y, .. } => x.length().max(y.length()),
+        Curve3::Conic { x, y, .. } | Curve3::Hyperbola { x, y, .. } | Curve3::Parabola { x, y, .. } => {
+            x.length().max(y.length())
+        }
         Curve3::Nurbs { c, .. } => c.bbox().diagonal(),
     }
 }

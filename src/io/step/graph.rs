@@ -76,6 +76,37 @@ pub(super) struct Graph {
     index: Option<HashMap<u64, u32>>,
     /// Header entities (`FILE_NAME`, `FILE_SCHEMA`, …), as parts.
     pub header: Vec<Part>,
+    /// What the parser forgave (duplicate numbers, bad escapes, a damaged header).
+    pub forgiven: Forgiven,
+}
+
+/// What a tolerant parser let pass, one entry per kind: the first
+/// occurrence's message (naming its line and instance) and how many more of
+/// that kind followed, so a file with many of one flaw gets one warning.
+#[derive(Debug, Default)]
+pub(super) struct Forgiven {
+    kinds: Vec<(&'static str, String, usize)>,
+}
+
+impl Forgiven {
+    /// Notes one occurrence of `kind`; `message` is made only for the first.
+    pub fn note(&mut self, kind: &'static str, message: impl FnOnce() -> String) {
+        match self.kinds.iter_mut().find(|k| k.0 == kind) {
+            Some(k) => k.2 += 1,
+            None => self.kinds.push((kind, message(), 0)),
+        }
+    }
+
+    /// One warning per kind, in the order the kinds were first met.
+    pub fn warnings(&self) -> Vec<String> {
+        self.kinds
+            .iter()
+            .map(|(_, m, more)| match more {
+                0 => m.clone(),
+                n => format!("{m} (and {n} more like it)"),
+            })
+            .collect()
+    }
 }
 
 impl Graph {
@@ -102,8 +133,11 @@ impl Graph {
             self.index = Some(m);
         }
         if let Some(m) = &mut self.index {
-            if m.insert(inst.id, self.instances.len() as u32).is_some() {
-                return false;
+            match m.entry(inst.id) {
+                hashbrown::hash_map::Entry::Occupied(_) => return false,
+                hashbrown::hash_map::Entry::Vacant(v) => {
+                    v.insert(self.instances.len() as u32);
+                }
             }
         }
         self.instances.push(inst);
@@ -474,6 +508,18 @@ impl Graph {
             Value::List { start, len } => Some(self.slice(start, len)),
             Value::Typed { at, .. } => match self.values.get(at as usize)? {
                 Value::List { start, len } => Some(self.slice(*start, *len)),
+                _ => None,
+            },
+            _ => None,
+        }
+    }
+
+    /// The text of a string value (also inside a typed value, `IDENTIFIER('…')`).
+    pub fn text(&self, v: Value) -> Option<&str> {
+        match v {
+            Value::Str { start, len } => Some(self.str_of(start, len)),
+            Value::Typed { at, .. } => match self.values.get(at as usize)? {
+                Value::Str { start, len } => Some(self.str_of(*start, *len)),
                 _ => None,
             },
             _ => None,

@@ -9,14 +9,23 @@
 //! `\X4\…\X0\`; raw bytes above 127 are taken as UTF-8 (ISO 8859-1 when
 //! they are not valid UTF-8); line breaks inside strings are dropped,
 //! comments `/* … */` are skipped anywhere between tokens.
+//!
+//! What real writers get wrong and a reader can still make sense of is
+//! forgiven with one warning per kind ([`Graph::forgiven`]): a repeated
+//! instance number (the first definition is kept), a malformed escape (its
+//! raw text is kept), an apostrophe not doubled inside a string (a string
+//! ends only at a quote followed by `,` or `)`), a damaged HEADER section
+//! ([`header`]). Anything else malformed is an error naming its line.
 
 use alloc::format;
-use alloc::string::String;
+use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 
 use super::graph::{Graph, Instance, Part, Value};
 use super::step_error;
 use crate::Error;
+
+mod header;
 
 /// Deepest nesting of lists and typed values inside one instance.
 pub(super) const MAX_DEPTH: usize = 32;
@@ -233,13 +242,23 @@ impl<'a> Lexer<'a> {
                     if self.b.get(self.pos) == Some(&b'\'') {
                         self.pos += 1;
                         out.push(b'\'');
-                    } else {
+                    } else if self.ends_string() {
                         break;
+                    } else {
+                        // A string is a parameter: what follows its closing quote is a
+                        // separator. A quote before anything else is one its writer did
+                        // not double; it stays in the text.
+                        let line = self.line;
+                        g.forgiven.note("apostrophe", || {
+                            let m = "a lone apostrophe inside a string (not doubled); kept in the text";
+                            step_error(id, line, m).to_string()
+                        });
+                        out.push(b'\'');
                     }
                 }
                 b'\n' => self.line += 1,
                 b'\r' => {}
-                b'\\' => self.directive(&mut out, id)?,
+                b'\\' => self.directive(&mut out, g, id),
                 _ => out.push(c),
             }
         }
@@ -256,13 +275,35 @@ impl<'a> Lexer<'a> {
         Ok(Tok::Str(start as u32, text.len() as u32))
     }
 
+    /// After a quote in a string: whether the string ends there, that is
+    /// whether a `,` or `)` (or a comment, or the end of the file) follows
+    /// past any blanks.
+    fn ends_string(&self) -> bool {
+        let mut i = self.pos;
+        while self.b.get(i).is_some_and(|c| c.is_ascii_whitespace()) {
+            i += 1;
+        }
+        match self.b.get(i) {
+            None | Some(b',' | b')') => true,
+            Some(b'/') => self.b.get(i + 1) == Some(&b'*'),
+            Some(_) => false,
+        }
+    }
+
     /// After a backslash in a string: `\\`, `\S\c`, `\P?\`, `\X\hh`,
     /// `\X2\…\X0\`, `\X4\…\X0\`, `\N\`; anything else is kept literally.
-    fn directive(&mut self, out: &mut Vec<u8>, id: u64) -> Result<(), Error> {
+    /// A malformed escape (a bad hex digit, a `\X2\` run the string ends
+    /// inside) keeps what decoded and leaves the rest as raw text, with a
+    /// note naming the line and instance.
+    fn directive(&mut self, out: &mut Vec<u8>, g: &mut Graph, id: u64) {
         let rest = &self.b[self.pos..];
         let push = |out: &mut Vec<u8>, ch: char| {
             let mut buf = [0u8; 4];
             out.extend_from_slice(ch.encode_utf8(&mut buf).as_bytes());
+        };
+        let line = self.line;
+        let mut note = |kind: &'static str, message: &str| {
+            g.forgiven.note(kind, || format!("{}; kept as raw text", step_error(id, line, message)));
         };
         match rest {
             [b'\\', ..] => {
@@ -275,13 +316,18 @@ impl<'a> Lexer<'a> {
             }
             [b'P', _, b'\\', ..] => self.pos += 3,
             [b'N', b'\\', ..] => self.pos += 2,
-            [b'X', b'\\', h, l, ..] => {
-                let v = hex(*h).zip(hex(*l)).ok_or_else(|| self.error(id, "bad \\X\\ escape in a string"))?;
+            [b'X', b'\\', h, l, ..] if hex(*h).is_some() && hex(*l).is_some() => {
+                let v = hex(*h).unwrap_or(0) * 16 + hex(*l).unwrap_or(0);
                 self.pos += 4;
-                push(out, char::from(v.0 * 16 + v.1));
+                push(out, char::from(v));
+            }
+            [b'X', b'\\', ..] => {
+                note("escape-x", "bad hex digit in a \\X\\ escape");
+                out.push(b'\\');
             }
             [b'X', w @ (b'2' | b'4'), b'\\', ..] => {
                 let width = if *w == b'2' { 4 } else { 8 };
+                let start = self.pos;
                 self.pos += 3;
                 let mut units: Vec<u32> = Vec::new();
                 loop {
@@ -289,16 +335,26 @@ impl<'a> Lexer<'a> {
                         self.pos += 4;
                         break;
                     }
-                    let Some(chunk) = self.b.get(self.pos..self.pos + width) else {
-                        return Err(self.error(id, "\\X2\\ or \\X4\\ escape not closed by \\X0\\"));
-                    };
-                    let mut v = 0u32;
-                    for &h in chunk {
-                        let d = hex(h).ok_or_else(|| self.error(id, "bad hex digit in a \\X2\\ or \\X4\\ escape"))?;
-                        v = (v << 4) | u32::from(d);
+                    let chunk = self.b.get(self.pos..(self.pos + width).min(self.b.len())).unwrap_or(&[]);
+                    match chunk.iter().find(|&&h| hex(h).is_none()) {
+                        None if chunk.len() == width => {
+                            units.push(chunk.iter().fold(0u32, |v, &h| (v << 4) | u32::from(hex(h).unwrap_or(0))));
+                            self.pos += width;
+                            continue;
+                        }
+                        // The string (or the file) ends, or another directive starts, inside the run.
+                        None | Some(b'\'' | b'\\') => {
+                            note("escape-open", "\\X2\\ or \\X4\\ escape not closed by \\X0\\");
+                        }
+                        Some(_) => note("escape-hex", "bad hex digit in a \\X2\\ or \\X4\\ escape"),
                     }
-                    units.push(v);
-                    self.pos += width;
+                    if units.is_empty() {
+                        // Nothing decoded: the escape itself stays as it was written.
+                        self.pos = start;
+                        out.push(b'\\');
+                        return;
+                    }
+                    break;
                 }
                 if width == 4 {
                     let u16s: Vec<u16> = units.iter().map(|&u| u as u16).collect();
@@ -313,7 +369,6 @@ impl<'a> Lexer<'a> {
             }
             _ => out.push(b'\\'),
         }
-        Ok(())
     }
 }
 
@@ -342,7 +397,7 @@ fn ascii_upper(b: &[u8]) -> String {
 ///
 /// # Errors
 /// A malformed file (the line and, inside the DATA section, the instance
-/// named), a duplicate instance number, or a size limit.
+/// named) or a size limit.
 pub(super) fn parse(bytes: &[u8]) -> Result<Graph, Error> {
     let mut g = Graph::default();
     let mut lx = Lexer { b: bytes, pos: 0, line: 1 };
@@ -355,12 +410,14 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Graph, Error> {
     presize(&mut g, bytes);
     let mut scratch: Vec<Value> = Vec::new();
     let mut seen_data = false;
+    let mut seen_header = false;
     loop {
         let line = lx.line;
         match lx.next(&mut g, 0)? {
             Tok::Keyword(k) if k == "HEADER" => {
                 expect(&mut lx, &mut g, 0, &Tok::Semicolon, "';' after HEADER")?;
-                header(&mut lx, &mut g, &mut scratch)?;
+                header::header(&mut lx, &mut g, &mut scratch);
+                seen_header = true;
             }
             Tok::Keyword(k) if k == "DATA" => {
                 // Edition 3: DATA(name, (schemas));
@@ -393,6 +450,10 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Graph, Error> {
     }
     if !seen_data {
         return Err(step_error(0, lx.line, "no DATA section"));
+    }
+    if !seen_header {
+        g.forgiven
+            .note("header", || step_error(0, 0, "no HEADER section; the DATA section is read anyway").to_string());
     }
     g.shrink();
     Ok(g)
@@ -434,24 +495,6 @@ fn skip_section(lx: &mut Lexer<'_>, g: &mut Graph) -> Result<(), Error> {
             Tok::Keyword(k) if k == "ENDSEC" => return expect(lx, g, 0, &Tok::Semicolon, "';' after ENDSEC"),
             Tok::End => return Err(lx.error(0, "section not closed by ENDSEC")),
             _ => {}
-        }
-    }
-}
-
-fn header(lx: &mut Lexer<'_>, g: &mut Graph, scratch: &mut Vec<Value>) -> Result<(), Error> {
-    loop {
-        match lx.next(g, 0)? {
-            Tok::Keyword(k) if k == "ENDSEC" => return expect(lx, g, 0, &Tok::Semicolon, "';' after ENDSEC"),
-            Tok::Keyword(k) => {
-                let name = g.intern(&k);
-                expect(lx, g, 0, &Tok::Open, "'(' after a header entity name")?;
-                let (start, len) = parse_params(lx, g, scratch, 0)?;
-                g.header.push(Part { name, start, len });
-                expect(lx, g, 0, &Tok::Semicolon, "';' after a header entity")?;
-            }
-            other => {
-                return Err(lx.error(0, format!("in the HEADER section: expected an entity or ENDSEC, found {other:?}")))
-            }
         }
     }
 }
@@ -511,7 +554,14 @@ fn instance(lx: &mut Lexer<'_>, g: &mut Graph, scratch: &mut Vec<Value>, id: u64
     }
     expect(lx, g, id, &Tok::Semicolon, "';' at the end of the instance")?;
     if !g.add_instance(Instance { id, first, count, line: u32::try_from(line).unwrap_or(u32::MAX) }) {
-        return Err(step_error(id, line, "instance number defined twice"));
+        // The first definition is kept: references read before this one
+        // already meant it, and writers that repeat a number repeat the same entity.
+        g.parts.truncate(first as usize);
+        let before = g.line_of(id);
+        g.forgiven.note("duplicate", || {
+            let m = format!("instance number defined twice; the first definition (line {before}) is kept");
+            step_error(id, line, m).to_string()
+        });
     }
     Ok(())
 }
@@ -615,142 +665,4 @@ fn parse_params(lx: &mut Lexer<'_>, g: &mut Graph, scratch: &mut Vec<Value>, id:
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use alloc::string::ToString;
-
-    fn file(data: &str) -> String {
-        format!("ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('x'),'2;1');\nENDSEC;\nDATA;\n{data}\nENDSEC;\nEND-ISO-10303-21;\n")
-    }
-
-    fn message(bytes: &[u8]) -> String {
-        match parse(bytes) {
-            Ok(_) => String::from("parsed"),
-            Err(e) => e.to_string(),
-        }
-    }
-
-    #[test]
-    fn escapes_crlf_comments_and_raw_utf8() {
-        let g = parse(include_bytes!("../../../tests/data/step_escapes.stp")).unwrap();
-        let s = |id: u64, i: usize| g.get(id, 0).unwrap().attrs().string(i).unwrap().to_string();
-        assert_eq!(s(1, 0), "\u{c4}\u{d6}-part");
-        assert_eq!(s(1, 1), "M\u{fc}ller");
-        assert_eq!(s(1, 2), "it's \\ here");
-        assert_eq!(s(2, 0), "\u{1f600} \u{c4}");
-        assert_eq!(s(3, 0), "Gr\u{fc}\u{df}e \u{6f22}\u{5b57}");
-        assert_eq!(s(4, 0), "a string /* not a comment */ ends here");
-        assert_eq!(s(5, 0), "split across lines");
-        // CRLF line ends count as one line each: #5 starts on line 13.
-        assert_eq!(g.line_of(5), 13);
-        assert_eq!(g.get(4, 0).unwrap().attrs().refs(2).unwrap(), [2]);
-        assert_eq!(g.header.len(), 3);
-    }
-
-    #[test]
-    fn raw_latin1_bytes() {
-        let g = parse(include_bytes!("../../../tests/data/step_latin1.stp")).unwrap();
-        assert_eq!(g.get(1, 0).unwrap().attrs().string(0).unwrap(), "caf\u{e9}");
-    }
-
-    #[test]
-    fn complex_instances_typed_values_and_forward_references() {
-        let g = parse(include_bytes!("../../../tests/data/step_complex.stp")).unwrap();
-        let u = g.get(11, 0).unwrap();
-        assert!(u.is_complex() && u.has("SI_UNIT") && u.has("LENGTH_UNIT") && !u.has("PLANE_ANGLE_UNIT"));
-        assert_eq!(u.part("SI_UNIT").unwrap().enumeration(0).unwrap(), "MILLI");
-        assert_eq!(u.part("NAMED_UNIT").unwrap().value(0).unwrap(), Value::Derived);
-        let inch = g.get(12, 0).unwrap();
-        assert_eq!(inch.part("CONVERSION_BASED_UNIT").unwrap().string(0).unwrap(), "INCH");
-        let m = g.get(13, 0).unwrap().attrs();
-        assert_eq!(m.real(0).unwrap(), 25.4);
-        assert_eq!(m.ent(1).unwrap().id(), 11);
-        assert_eq!(g.get(15, 0).unwrap().attrs().real(0).unwrap(), 1e-7);
-        let n = g.get(16, 0).unwrap().attrs();
-        assert_eq!(n.string(0).unwrap(), "n");
-        // (((( ((1,2),(3)), ((4)) )))): three single-item lists around a pair.
-        let mut l = n.list(1).unwrap();
-        for _ in 0..3 {
-            assert_eq!(l.len(), 1);
-            l = g.list(l[0]).unwrap();
-        }
-        assert_eq!(l.len(), 2);
-        assert_eq!(g.list(g.list(l[0]).unwrap()[0]).unwrap(), [Value::Int(1), Value::Int(2)]);
-        assert_eq!(n.opt_ref(2).unwrap(), None);
-        assert_eq!(n.value(3).unwrap(), Value::Derived);
-        assert!(n.boolean(4, false).unwrap());
-        assert_eq!(n.value(5).unwrap(), Value::Binary);
-        assert_eq!(n.real(6).unwrap(), -150.0);
-        assert_eq!(n.int(7).unwrap(), 7);
-        // #17 refers to #18, defined after it.
-        let c = g.get(17, 0).unwrap().attrs();
-        let pts = c.refs(2).unwrap();
-        assert_eq!(pts, [10, 18]);
-        assert_eq!(g.get(18, 17).unwrap().attrs().reals(1).unwrap(), [1.0, 2.0, 3.0]);
-    }
-
-    #[test]
-    fn malformed_files_name_instance_and_line() {
-        let m = message(include_bytes!("../../../tests/data/step_unclosed_string.stp"));
-        assert_eq!(m, "STEP line 10, #7: string not closed by a quote");
-        assert!(m.contains("#7") && m.contains("line 10") && m.contains("string not closed"), "{m}");
-        let m = message(include_bytes!("../../../tests/data/step_duplicate_id.stp"));
-        assert!(m.contains("#2") && m.contains("line 10") && m.contains("defined twice"), "{m}");
-        let m = message(include_bytes!("../../../tests/data/step_unclosed_comment.stp"));
-        assert!(m.contains("line 10") && m.contains("comment not closed"), "{m}");
-        let m = message(include_bytes!("../../../tests/data/step_bad_token.stp"));
-        assert!(m.contains("#4") && m.contains("line 10") && m.contains("'@'"), "{m}");
-        let m = message(include_bytes!("../../../tests/data/step_huge_id.stp"));
-        assert!(m.contains("line 10") && m.contains("instance number too large"), "{m}");
-        let m = message(b"HEADER;\nENDSEC;\n");
-        assert!(m.contains("ISO-10303-21"), "{m}");
-        let m = message(b"ISO-10303-21;\nHEADER;\nENDSEC;\nEND-ISO-10303-21;\n");
-        assert!(m.contains("no DATA section"), "{m}");
-        let m = message(file("#1 = A(1);\n#4 = A(1,,2);").as_bytes());
-        assert!(m.contains("#4") && m.contains("value is missing"), "{m}");
-        let m = message(file("#4 = A(1").as_bytes());
-        assert!(m.contains("#4"), "{m}");
-    }
-
-    #[test]
-    fn instances_numbered_out_of_order_are_found_and_duplicates_refused() {
-        let g = parse(file("#5 = A(#9);\n#7 = A(2);\n#2 = A(#5);\n#9 = A(3);").as_bytes()).unwrap();
-        for id in [2, 5, 7, 9] {
-            assert_eq!(g.get(id, 0).unwrap().id(), id);
-        }
-        assert!(g.find(3).is_none() && g.find(10).is_none());
-        assert_eq!(g.get(2, 0).unwrap().attrs().ent(0).unwrap().attrs().ent(0).unwrap().id(), 9);
-        let m = message(file("#5 = A(1);\n#2 = A(1);\n#5 = A(2);").as_bytes());
-        assert!(m.contains("#5") && m.contains("defined twice"), "{m}");
-        let m = message(file("#1 = A(1);\n#2 = A(1);\n#3 = A(1);\n#2 = A(2);").as_bytes());
-        assert!(m.contains("#2") && m.contains("defined twice"), "{m}");
-    }
-
-    #[test]
-    fn deep_nesting_is_refused_without_recursion() {
-        let m = message(include_bytes!("../../../tests/data/step_deep_nesting.stp"));
-        assert!(m.contains("#5") && m.contains("nested deeper than"), "{m}");
-        let ok = format!("#1 = A({}1{});", "(".repeat(MAX_DEPTH - 2), ")".repeat(MAX_DEPTH - 2));
-        assert!(parse(file(&ok).as_bytes()).is_ok());
-    }
-
-    #[test]
-    fn a_missing_reference_is_named_where_it_is_followed() {
-        let g = parse(file("#5 = A(#9);").as_bytes()).unwrap();
-        let m = g.get(5, 0).unwrap().attrs().ent(0).err().unwrap().to_string();
-        assert!(m.contains("#5") && m.contains("#9") && m.contains("not defined"), "{m}");
-    }
-
-    #[test]
-    fn every_prefix_of_a_file_parses_or_fails_cleanly() {
-        // Truncation anywhere: an error or a graph, never a panic.
-        let bytes = include_bytes!("../../../tests/data/step_complex.stp");
-        for n in 0..bytes.len() {
-            let _ = parse(&bytes[..n]);
-        }
-        let bytes = include_bytes!("../../../tests/data/step_escapes.stp");
-        for n in 0..bytes.len() {
-            let _ = parse(&bytes[..n]);
-        }
-    }
-}
+mod tests;

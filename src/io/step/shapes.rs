@@ -10,6 +10,8 @@
 //! `same_sense` says is outside. A face that cannot be read is skipped with
 //! a warning naming its `#id`; the others go on.
 
+mod skipped;
+
 use crate::collections::{HashMap, HashSet};
 use alloc::boxed::Box;
 use alloc::format;
@@ -40,6 +42,8 @@ struct ItemFaces {
     ids: Vec<u64>,
     /// `(#id, closed, faces, faces listed)` per shell.
     shells: Vec<(u64, bool, core::ops::Range<usize>, usize)>,
+    /// Faces skipped: the index their shell gets in `shells`, and their border.
+    skipped: Vec<(usize, Vec<NurbsCurve>)>,
 }
 
 /// Reading state shared by all items.
@@ -63,6 +67,8 @@ pub(super) struct Shapes {
     /// Each face's colour: its own style's, else its shell's, else its solid's or set's.
     pub colours: Vec<Option<Rgb>>,
     pub shells: Vec<StepShell>,
+    /// Faces skipped, placed: the index of their shell in `shells`, and their border.
+    pub skipped: Vec<(usize, Vec<NurbsCurve>)>,
     pub first_error: Option<Error>,
 }
 
@@ -81,8 +87,14 @@ pub(super) fn read_shapes(g: &Graph, plan: &Plan, warnings: &mut Vec<String>) ->
     };
     let mut cache: HashMap<(u64, u64, u64), ItemFaces> = HashMap::default();
     let styles = colours(g);
-    let mut out =
-        Shapes { faces: Vec::new(), placement: Vec::new(), colours: Vec::new(), shells: Vec::new(), first_error: None };
+    let mut out = Shapes {
+        faces: Vec::new(),
+        placement: Vec::new(),
+        colours: Vec::new(),
+        shells: Vec::new(),
+        skipped: Vec::new(),
+        first_error: None,
+    };
     let key_of = |p: &Placed| (p.item, p.angle.to_bits(), p.uncertainty.to_bits());
     // How many placements of each item are still ahead: the last one takes
     // the item's faces instead of copying them, so that a part placed once
@@ -136,6 +148,10 @@ pub(super) fn read_shapes(g: &Graph, plan: &Plan, warnings: &mut Vec<String>) ->
             }
         }
         let placed = out.faces.len() - base;
+        let shell_base = out.shells.len();
+        for (k, border) in &item.skipped {
+            out.skipped.push((shell_base + k, skipped::place_border(border, &p.m)));
+        }
         for (id, closed, range, listed) in &item.shells {
             // Faces that could not be placed shorten the ranges (rarely: a non-finite transform).
             let s = (base + range.start).min(base + placed);
@@ -245,7 +261,11 @@ impl Reader<'_, '_> {
                 out.faces.push(f);
                 out.ids.push(s.id());
             }
-            Err(err) => self.skip(s, err),
+            Err(err) => {
+                self.skip(s, err);
+                let border = self.skipped_border(geo, s);
+                out.skipped.push((out.shells.len(), border));
+            }
         }
     }
 
@@ -275,7 +295,11 @@ impl Reader<'_, '_> {
                     out.faces.push(face);
                     out.ids.push(fe.id());
                 }
-                Err(err) => self.skip(fe, err),
+                Err(err) => {
+                    self.skip(fe, err);
+                    let border = self.skipped_border(geo, fe);
+                    out.skipped.push((out.shells.len(), border));
+                }
             }
         }
         // A closed shell uses each of its edges twice; one whose faces leave
