@@ -94,7 +94,7 @@ function build() {
   const args = ['build', '--profile', profile, '--bin', 'surfmesh', '--example', 'measure', '--example', 'curvo_mesh'];
   if (sh('cargo', args, { stdio: 'inherit' }).status !== 0) throw new Error('cargo build failed');
   const wasm = join(root, 'pkg', 'node', 'surfmesh_bg.wasm');
-  if (WASM && !existsSync(wasm) || statSync(wasm).mtimeMs < newestSource()) {
+  if (WASM && (!existsSync(wasm) || statSync(wasm).mtimeMs < newestSource())) {
     say('npm package out of date: node scripts/build-wasm.mjs');
     if (sh('node', ['scripts/build-wasm.mjs'], { stdio: 'inherit' }).status !== 0) throw new Error('wasm build failed');
   }
@@ -340,7 +340,7 @@ function compare(row, peer) {
   const sm = row.surfmesh_wasm.measure;
   const c = { peer: peer.key };
   c.triangles = eq ? sm.triangles / eq.triangles : null;
-  if (!eq) c.note = `${peer.key} did not reach surfmesh's deviation ${sm.max_deviation.toPrecision(3)}`;
+  if (!eq) c.note = `${peer.key} did not reach surfmesh's deviation ${sm.max_deviation?.toPrecision(3) ?? '(none measured)'}`;
   c.time = totalMs(ours.run) / totalMs(p.run);
   c.memory = memKb(ours.run, peer.js) / memKb(p.run, peer.js);
   const pm = p.measure;
