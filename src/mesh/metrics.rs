@@ -185,7 +185,7 @@ pub(crate) fn edge_census(
             None => gaps.push(Gap { faces, width }),
         }
     }
-    gaps.sort_by(|a, b| a.faces.cmp(&b.faces));
+    gaps.sort_by_key(|g| g.faces);
     (out, gaps)
 }
 
@@ -231,7 +231,7 @@ fn find_cracks(
     sew: f64,
     body: &dyn Fn(u32) -> u32,
     skipped: &[SkippedFace],
-) -> (Vec<((u32, u32), f64)>, usize) {
+) -> (Vec<Crack>, usize) {
     let mut cracks = Vec::new();
     if free.is_empty() || !(sew > 0.0 && sew.is_finite()) {
         return (cracks, 0);
@@ -320,6 +320,9 @@ impl<'a> Holes<'a> {
         })
     }
 }
+
+/// A crack between two faces: the faces (lower first) and its width.
+type Crack = ((u32, u32), f64);
 
 /// Distance from `p` to the segment `ab`.
 fn to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {

@@ -79,7 +79,7 @@ pub(super) fn slide_nodes(
                 let reach = SNAP_SHARE * shorter;
                 // A node on its neighbour (a pole's) has nowhere to slide:
                 // that neighbour stays within sewing distance of it.
-                if !(reach > 0.0) {
+                if reach.is_nan() || reach <= 0.0 {
                     continue;
                 }
                 let r = DVec3::splat(reach);
