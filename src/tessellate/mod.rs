@@ -272,7 +272,12 @@ pub fn mesh_model_with_progress(
         Some(s) => (s, auto_tight.min(s)),
         None => (0.4 * tol, auto_tight),
     };
-    let ids = unify_outlines(&mut chosen, &model.bodies, &facets, sew_tol, tight, aim + sew_tol);
+    // Closed as built (a sphere, a torus, a ring's closed quarter): its
+    // seams and poles meet to a rounding. A side that shrinks to a small
+    // circle within the sewing distance is a border that another face can
+    // close, not a pole.
+    let body_ids = own_bodies(model, &mine, 1e-9 * diag.max(tol));
+    let ids = unify_outlines(&mut chosen, &body_ids, &facets, sew_tol, tight, aim + sew_tol);
     // Every face's first mesh (grid and trim band) on those nodes; each
     // outline is freed once its mesh is built (only whether it is pinched
     // is asked later).
@@ -316,7 +321,7 @@ pub fn mesh_model_with_progress(
         return Err(e);
     }
     // Borders along tessellated faces take their vertices before refinement.
-    tessellated::snap_borders(&mut works, &facets, &model.bodies, sew_tol);
+    tessellated::snap_borders(&mut works, &facets, &body_ids, sew_tol);
     // Refinement keeps shared borders shared: a split of a shared edge is
     // made on every side; then every node takes one position.
     let budget_hit = sew::refine_all(&mut works, ids, sew_tol, options.max_triangles, progress)?;
@@ -369,7 +374,7 @@ pub fn mesh_model_with_progress(
         w.mesh.rest();
     }
     // The tessellated faces take the exact borders' nodes along theirs.
-    tessellated::split_rims(&mut works, &mut facets, &model.bodies, sew_tol);
+    tessellated::split_rims(&mut works, &mut facets, &body_ids, sew_tol);
     let (mut dev_sum, mut dev_count) = (0.0, 0u64);
     for (index, (w, fit_error)) in works.iter_mut().zip(&fit_errors).enumerate() {
         let out = w.mesh.outcome(w.surface, &w.crit);
@@ -459,7 +464,7 @@ pub fn mesh_model_with_progress(
     report.mean_deviation = if dev_count > 0 { dev_sum / dev_count as f64 } else { 0.0 };
     report.triangles = mesh.triangle_count();
     report.vertices = mesh.positions.len();
-    let (edges, gaps) = edge_census(&mesh, &model.bodies, &model.skipped, (tol * 1e-3).min(tight * 0.5), tol);
+    let (edges, gaps) = edge_census(&mesh, &body_ids, &model.skipped, (tol * 1e-3).min(tight * 0.5), tol);
     holes_warning(&model.skipped, edges.hole_edges, &mut report.warnings);
     // A crack wider than sewing reaches is the file's own gap: say where.
     for g in gaps.iter().filter(|g| g.width > sew_tol) {
@@ -682,6 +687,24 @@ impl<'a> Chosen<'a> {
         #[cfg(not(feature = "std"))]
         face::initial_face(index, self.face, &self.lim, budget)
     }
+}
+
+/// Each face's body for sewing and for the edge counts: the file's
+/// ([`Model::bodies`]), except that a face closed on itself
+/// ([`face::closed_on_itself`] within `reach`) is a body of its own: it has
+/// no border to sew, and where it touches another face (closed quarters of a
+/// ring meeting at their end caps) the two are solids side by side, not one
+/// surface with non-manifold edges.
+fn own_bodies(model: &Model, mine: &[bool], reach: f64) -> Vec<u32> {
+    let mut ids: Vec<u32> = (0..model.face_count()).map(|f| crate::model::body_of(&model.bodies, f)).collect();
+    let mut next = ids.iter().copied().max().map_or(0, |m| m + 1);
+    for (index, face) in model.faces.iter().enumerate() {
+        if mine.get(index).copied().unwrap_or(false) && face::closed_on_itself(face, reach) {
+            ids[index] = next;
+            next += 1;
+        }
+    }
+    ids
 }
 
 /// Sews the outlines of the faces to be meshed (see [`sew::unify`]), after

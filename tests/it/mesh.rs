@@ -123,6 +123,21 @@ fn mesh_torus_exact_and_closed() {
     counts_follow_tolerance("torus", &counts);
 }
 
+/// A face closed on itself has no border to share: it is a body of its
+/// own. Two copies of one torus (as closed quarters of a ring meet at their
+/// end caps) are two solids in one place, each closed, not one surface whose
+/// every edge is non-manifold.
+#[test]
+fn mesh_closed_faces_that_touch_are_bodies_of_their_own() {
+    let mut model = shapes::torus(shapes::TORUS_MAJOR, shapes::TORUS_MINOR);
+    model.faces.push(model.faces[0].clone());
+    let r = mesh(&model, 1e-2);
+    let e = (r.report.nonmanifold_edges, r.report.boundary_edges, r.report.free_edges);
+    assert_eq!(e, (0, 0, 0), "two tori in one place: non-manifold, boundary, free edges");
+    let counts: Vec<u32> = r.mesh.face_ranges.iter().map(|f| f.count).collect();
+    assert!(counts[0] > 0 && counts[0] == counts[1], "both copies meshed alike: {counts:?}");
+}
+
 #[test]
 fn mesh_cylinder_exact() {
     let model = shapes::cylinder();
