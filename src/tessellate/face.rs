@@ -217,7 +217,13 @@ pub(crate) fn mesh_face<'a>(
             tight + lim.tol,
         );
         let mut wm = initial_from_outline(index, &face.surface, &o, budget)?;
-        wm.refine(&face.surface, &o.loops.curves, crit, budget);
+        let outcome = wm.refine(&face.surface, &o.loops.curves, crit, budget);
+        if wm.tris.len() >= budget {
+            // Out of its budget: it loses to any mesh within it, whatever
+            // its shapes; mending them (seconds on a folded face) would
+            // change nothing the comparison reads.
+            return Ok(FaceResult { mesh: wm, outcome, outline: Some(unsewn) });
+        }
         // Flipped as the model's faces are, so that the shapes compared are
         // those the model's mesh would have.
         let flipped = wm.improve_angles(&face.surface, crit, &mut crate::collections::HashSet::default());
