@@ -3,8 +3,6 @@
 #[cfg(feature = "std")]
 mod band;
 #[cfg(feature = "std")]
-mod cancel;
-#[cfg(feature = "std")]
 mod cdt;
 mod collapse;
 mod face;
@@ -372,10 +370,6 @@ pub fn mesh_model_with_progress(
     // Three faces' corners that sewing left apart: a sliver between them.
     #[cfg(feature = "std")]
     fill::close_slivers(&mut works, tol);
-    // Triangles folded onto each other back to back bound nothing: they go
-    // (points one point as in the edge counts below).
-    #[cfg(feature = "std")]
-    cancel::drop_opposite_pairs(&mut works, &body_ids, (tol * 1e-3).min(tight * 0.5), &mut report.warnings);
     for w in works.iter_mut() {
         w.mesh.rest();
     }
