@@ -17,10 +17,19 @@
 // mesher allows. Memory: peak resident set of a process that runs one mesher
 // on one file (Node: above a bare Node's).
 //
-// npm run bench [-- --runs 5 --tols 1e-2,1e-3 --only NAME --no-corpus --no-plates --no-build --out DIR --profile debug]
+// npm run bench [-- --runs 5 --tols 1e-2,1e-3 --only NAME[,NAME...] --dir DIR --no-corpus --no-plates
+//                   --no-build --no-wasm --no-equal --out DIR --profile debug]
 // Writes DIR/latest.json and DIR/latest.md (DIR: bench/results). Builds what it
 // needs first: the CLI and the two example runners (cargo, release unless
 // --profile debug), and the npm package when it is older than the sources.
+//   --only: files whose names contain any of the comma-separated parts.
+//   --dir: the CAD files of DIR instead of ../shared/corpus (e.g.
+//     ../shared/corpus-wide, with --only to pick some of them).
+//   --no-wasm: surfmesh's native build only (no npm package needed); its
+//     mesh stands for surfmesh in the comparisons and times are native
+//     against OCCT's wasm.
+//   --no-equal: OCCT at surfmesh's deflection only (no rescaled runs): enough
+//     for the edge counts, which the report lists per file beside surfmesh's.
 
 import { spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, mkdtempSync, readdirSync, readFileSync, rmSync, statSync, writeFileSync } from 'node:fs';
@@ -37,7 +46,10 @@ const opt = (name, fallback) => {
 };
 const RUNS = Math.max(1, Number(opt('--runs', 5)));
 const TOLS = opt('--tols', '1e-2,1e-3').split(',').map(Number);
-const ONLY = opt('--only');
+const ONLY = opt('--only')?.split(',').filter(Boolean);
+const CORPUS = opt('--dir', join(root, '..', 'shared', 'corpus'));
+const WASM = !argv.includes('--no-wasm');
+const EQUAL = !argv.includes('--no-equal');
 const ANGLE = 0.5; // surfmesh's default angle; OCCT's angular deflection
 const CHILD_TIMEOUT_MS = Number(opt('--timeout', 120)) * 1000;
 /** The first native run of each file: longer than this and the file is skipped. */
@@ -82,7 +94,7 @@ function build() {
   const args = ['build', '--profile', profile, '--bin', 'surfmesh', '--example', 'measure', '--example', 'curvo_mesh'];
   if (sh('cargo', args, { stdio: 'inherit' }).status !== 0) throw new Error('cargo build failed');
   const wasm = join(root, 'pkg', 'node', 'surfmesh_bg.wasm');
-  if (!existsSync(wasm) || statSync(wasm).mtimeMs < newestSource()) {
+  if (WASM && (!existsSync(wasm) || statSync(wasm).mtimeMs < newestSource())) {
     say('npm package out of date: node scripts/build-wasm.mjs');
     if (sh('node', ['scripts/build-wasm.mjs'], { stdio: 'inherit' }).status !== 0) throw new Error('wasm build failed');
   }
@@ -168,13 +180,21 @@ function runSurfmeshNative(file, rel) {
   return { run: { ...times, rss_kb: rss }, mesh: out };
 }
 
+/** Without the npm package: the native build's mesh (an OBJ with a group per face) stands for surfmesh. */
+function nativeAsOurs(sn) {
+  const report = JSON.parse(readFileSync(join(tmp, 'surfmesh-native-report.json'), 'utf8'));
+  const { warnings, ...rest } = report;
+  const run = { ...sn.run, report: rest, warnings: warnings.slice(0, 5), native: true };
+  return { run, mesh: sn.mesh, tolerance: report.tolerance };
+}
+
 function runOcct(file, tol, unit, target) {
   const same = join(tmp, 'occt.json');
   const run = node(['occt', file, '--tol', String(tol), '--angle', String(ANGLE), '--unit', unit, '--runs', String(RUNS), '--out', same], 'occt');
   if (run.error) return { run };
   const m = measure(file, same, tol);
   const result = { run, deflection: tol, measure: m };
-  if (m.error || !(target > 0)) return result;
+  if (m.error || !(target > 0) || !EQUAL) return result;
   // Equal verified deviation: rescale the deflection (a few single runs).
   const tried = [{ deflection: tol, triangles: m.triangles, max_deviation: m.max_deviation }];
   let best = m.max_deviation <= target ? { deflection: tol, measure: m } : null;
@@ -234,7 +254,7 @@ function inputs() {
     if (!f.endsWith('.json') || f.startsWith('bad_')) continue;
     list.push({ path: join(data, f), name: f, kind: 'json' });
   }
-  const corpus = join(root, '..', 'shared', 'corpus');
+  const corpus = CORPUS;
   if (existsSync(corpus) && !argv.includes('--no-corpus')) {
     for (const f of readdirSync(corpus).sort()) {
       const ext = extname(f).slice(1).toLowerCase();
@@ -253,7 +273,7 @@ function inputs() {
       list.push({ path, name, kind: 'cad' });
     }
   }
-  return { list: list.filter((x) => !ONLY || x.name.includes(ONLY)), skipped, formats };
+  return { list: list.filter((x) => !ONLY || ONLY.some((part) => x.name.includes(part))), skipped, formats };
 }
 
 // ---- one file at one tolerance ------------------------------------------------------------
@@ -267,8 +287,8 @@ function benchOne(input, rel, info) {
     row.surfmesh_wasm = { run: { error: sn.run.error } };
     return row;
   }
-  say(`${input.name} @ ${rel}: surfmesh (wasm)`);
-  const sw = runSurfmeshWasm(input.path, rel);
+  say(`${input.name} @ ${rel}: surfmesh (${WASM ? 'wasm' : 'native, measured'})`);
+  const sw = WASM ? runSurfmeshWasm(input.path, rel) : nativeAsOurs(sn);
   row.surfmesh_wasm = { run: sw.run };
   if (sw.run.error) return row;
   row.tolerance = sw.tolerance;
@@ -320,7 +340,7 @@ function compare(row, peer) {
   const sm = row.surfmesh_wasm.measure;
   const c = { peer: peer.key };
   c.triangles = eq ? sm.triangles / eq.triangles : null;
-  if (!eq) c.note = `${peer.key} did not reach surfmesh's deviation ${sm.max_deviation.toPrecision(3)}`;
+  if (!eq) c.note = `${peer.key} did not reach surfmesh's deviation ${sm.max_deviation?.toPrecision(3) ?? '(none measured)'}`;
   c.time = totalMs(ours.run) / totalMs(p.run);
   c.memory = memKb(ours.run, peer.js) / memKb(p.run, peer.js);
   const pm = p.measure;
@@ -384,6 +404,22 @@ function markdown(rows, meta) {
     }
   }
   out.push('');
+  out.push('## Edges per file (the yardstick\'s counts; OCCT at surfmesh\'s deflection)');
+  out.push('');
+  out.push('surfmesh\'s own report beside them: its weld distance and bodies can differ from the yardstick\'s.');
+  out.push('');
+  out.push('| file | rel. tol | surfmesh non-manifold | OCCT non-manifold | surfmesh cracks | OCCT cracks | surfmesh boundary | OCCT boundary | surfmesh report: free / non-manifold / inverted |');
+  out.push('|---|---|---:|---:|---:|---:|---:|---:|---|');
+  for (const r of rows) {
+    const sm = r.surfmesh_wasm?.measure;
+    const om = r.occt?.measure;
+    if (!sm && !om) continue;
+    const rep = r.surfmesh_wasm?.run?.report;
+    const own = rep ? `${rep.free_edges} / ${rep.nonmanifold_edges} / ${rep.inverted_triangles}` : '–';
+    const cell = (m, k) => (m && m[k] != null ? m[k] : r.occt?.run?.error && m === om ? 'failed' : '–');
+    out.push(`| ${r.file} | ${r.rel} | ${cell(sm, 'nonmanifold_edges')} | ${cell(om, 'nonmanifold_edges')} | ${cell(sm, 'free_edges')} | ${cell(om, 'free_edges')} | ${cell(sm, 'boundary_edges')} | ${cell(om, 'boundary_edges')} | ${own} |`);
+  }
+  out.push('');
   out.push('## Per file');
   out.push('');
   out.push('| file | rel. tol | peer | triangles | cracks (s / peer) | time | memory |');
@@ -414,7 +450,7 @@ function markdown(rows, meta) {
     out.push('');
     out.push('| mesher | setting | triangles | max dev | mean dev | coverage | boundary | cracks | non-manifold | angles | parse ms | mesh ms | total ms | first run ms | memory MB | wasm memory MB |');
     out.push('|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|');
-    out.push(meshRow('surfmesh wasm', `rel ${r.rel}`, r.surfmesh_wasm?.measure, r.surfmesh_wasm?.run, true));
+    out.push(meshRow(WASM ? 'surfmesh wasm' : 'surfmesh native (measured)', `rel ${r.rel}`, r.surfmesh_wasm?.measure, r.surfmesh_wasm?.run, true));
     if (r.surfmesh_native) out.push(meshRow('surfmesh native', `rel ${r.rel}`, r.surfmesh_native.measure, r.surfmesh_native.run, false));
     if (r.surfmesh_native?.note) out.push(`| | ${r.surfmesh_native.note} |||||||||||||||`);
     if (r.occt) {

@@ -15,7 +15,7 @@ pub(crate) type HashSet<K> = hashbrown::HashSet<K, foldhash::fast::FixedState>;
 /// twice the memory (welding a whole model's vertices set the wasm peak).
 pub(crate) struct CellGrid<T> {
     inv: f64,
-    cells: HashMap<(i64, i64, i64), (u32, u32)>,
+    cells: HashMap<Key, (u32, u32)>,
     items: alloc::vec::Vec<(T, u32)>,
 }
 
@@ -66,13 +66,72 @@ impl<T> CellGrid<T> {
     }
 
     /// The items of every cube that meets the box `[lo, hi]`, in the order of [`CellGrid::near`].
+    /// A box of more cubes than the grid holds takes the held cubes inside
+    /// it, sorted, instead of looking up each of its cubes (a box a hundred
+    /// cubes wide is a million look-ups).
     #[cfg(feature = "std")]
     pub fn in_box(&self, lo: glam::DVec3, hi: glam::DVec3) -> impl Iterator<Item = &T> + '_ {
         let (a, b) = (self.key(lo), self.key(hi));
-        (a.0..=b.0)
-            .flat_map(move |x| (a.1..=b.1).flat_map(move |y| (a.2..=b.2).map(move |z| (x, y, z))))
-            .flat_map(|c| self.cube(c))
+        let walk = cubes_between(a, b) <= self.cells.len() as u128;
+        let every = walk
+            .then(|| (a.0..=b.0).flat_map(move |x| (a.1..=b.1).flat_map(move |y| (a.2..=b.2).map(move |z| (x, y, z)))));
+        let held = (!walk).then(|| {
+            let inside =
+                |c: &Key| (a.0..=b.0).contains(&c.0) && (a.1..=b.1).contains(&c.1) && (a.2..=b.2).contains(&c.2);
+            let mut keys: alloc::vec::Vec<Key> = self.cells.keys().copied().filter(inside).collect();
+            keys.sort_unstable();
+            keys
+        });
+        every.into_iter().flatten().chain(held.into_iter().flatten()).flat_map(|c| self.cube(c))
     }
+
+    /// The items of the cubes that come within `r` of the segment `a`-`b`
+    /// (and of a few more beside them), in the order of
+    /// [`CellGrid::in_box`] over the segment's box grown by `r`: the items of
+    /// that box within `r` of the segment, without visiting the rest of a
+    /// long slanted segment's box.
+    #[cfg(feature = "std")]
+    pub fn near_segment(&self, a: glam::DVec3, b: glam::DVec3, r: f64) -> impl Iterator<Item = &T> + '_ {
+        let (lo, hi) = (a.min(b) - glam::DVec3::splat(r), a.max(b) + glam::DVec3::splat(r));
+        let cell = 1.0 / self.inv;
+        // Samples at most a cube apart: a point within `r` of the segment
+        // is within `r` + half a cube of one of them.
+        let steps = a.distance(b) * self.inv;
+        let short = !(steps.is_finite() && r.is_finite())
+            || steps <= 4.0
+            || steps > self.cells.len() as f64
+            || r * self.inv > 4.0
+            || cubes_between(self.key(lo), self.key(hi)) <= 64;
+        let whole = short.then(|| self.in_box(lo, hi));
+        let along = (!short).then(|| {
+            let n = crate::math::ceil(steps) as usize;
+            let reach = glam::DVec3::splat(r + 0.5 * cell);
+            let mut keys: alloc::vec::Vec<Key> = alloc::vec::Vec::new();
+            for k in 0..=n {
+                let s = a.lerp(b, k as f64 / n as f64);
+                let (p, q) = (self.key(s - reach), self.key(s + reach));
+                for x in p.0..=q.0 {
+                    for y in p.1..=q.1 {
+                        keys.extend((p.2..=q.2).map(|z| (x, y, z)).filter(|c| self.cells.contains_key(c)));
+                    }
+                }
+            }
+            keys.sort_unstable();
+            keys.dedup();
+            keys.into_iter().flat_map(|c| self.cube(c))
+        });
+        whole.into_iter().flatten().chain(along.into_iter().flatten())
+    }
+}
+
+/// A cube's key on a [`CellGrid`].
+type Key = (i64, i64, i64);
+
+/// How many cubes the keys `a` to `b` span (0 when `b` lies below `a` on an axis).
+#[cfg(feature = "std")]
+fn cubes_between(a: Key, b: Key) -> u128 {
+    let span = |x: i64, y: i64| (i128::from(y) - i128::from(x) + 1).max(0) as u128;
+    span(a.0, b.0).saturating_mul(span(a.1, b.1)).saturating_mul(span(a.2, b.2))
 }
 
 /// A map from pairs of `u32` (never both `u32::MAX`) to small values, for
@@ -289,5 +348,52 @@ mod tests {
         assert_eq!(near, [2, 1, 3, 5, 0, 4]);
         assert_eq!(g.near(at(5.5, 5.5, 5.5)).copied().collect::<Vec<_>>(), [6]);
         assert!(g.near(at(50.0, 0.0, 0.0)).next().is_none());
+    }
+
+    /// Items on a slanted line and scattered round it: a box of more cubes
+    /// than the grid holds, and the cubes along a long segment, give the
+    /// items the cube by cube walk of the box gives (all of them, or those
+    /// near the segment), in its order.
+    #[test]
+    fn boxes_and_segments_keep_the_walks_order() {
+        let mut g: CellGrid<u32> = CellGrid::new(1.0);
+        let at = |t: f64, k: u32| {
+            let off = [(0.0, 0.0), (0.3, -0.2), (2.5, 0.0), (-3.0, 1.0)][k as usize % 4];
+            glam::DVec3::new(t, 0.5 * t + off.0, 0.25 * t + off.1)
+        };
+        let mut pts = Vec::new();
+        for i in 0..400u32 {
+            let p = at(i as f64 * 0.17, i);
+            g.insert(p, i);
+            pts.push(p);
+        }
+        let walk = |lo: glam::DVec3, hi: glam::DVec3| -> Vec<u32> {
+            let (a, b) = (g.key(lo), g.key(hi));
+            let mut out = Vec::new();
+            for x in a.0..=b.0 {
+                for y in a.1..=b.1 {
+                    for z in a.2..=b.2 {
+                        out.extend(g.cube((x, y, z)).copied());
+                    }
+                }
+            }
+            out
+        };
+        let (lo, hi) = (glam::DVec3::new(-5.0, -8.0, -6.0), glam::DVec3::new(80.0, 45.0, 25.0));
+        assert!(cubes_between(g.key(lo), g.key(hi)) > g.cells.len() as u128);
+        let all: Vec<u32> = g.in_box(lo, hi).copied().collect();
+        assert_eq!(all, walk(lo, hi));
+        assert_eq!(all.len(), 400);
+        let (a, b, r) = (at(3.0, 0), at(60.0, 0), 0.6);
+        let near = |p: glam::DVec3| {
+            let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+            p.distance(a.lerp(b, t)) <= r
+        };
+        let box_walk = walk(a.min(b) - glam::DVec3::splat(r), a.max(b) + glam::DVec3::splat(r));
+        let seg: Vec<u32> = g.near_segment(a, b, r).copied().collect();
+        assert!(seg.len() < box_walk.len(), "{} of {}", seg.len(), box_walk.len());
+        let keep = |v: &[u32]| v.iter().copied().filter(|&i| near(pts[i as usize])).collect::<Vec<_>>();
+        assert_eq!(keep(&seg), keep(&box_walk));
+        assert!(keep(&seg).len() > 50);
     }
 }

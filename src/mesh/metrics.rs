@@ -52,6 +52,28 @@ pub fn edge_counts_around_skipped(
     weld_tol: f64,
     sew_tol: f64,
 ) -> EdgeCounts {
+    edge_census(mesh, bodies, skipped, weld_tol, sew_tol).0
+}
+
+/// Where two faces' borders run side by side unjoined (see [`edge_census`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Gap {
+    /// The two faces, the lower index first.
+    pub faces: (u32, u32),
+    /// The widest distance, over their cracks, from a crack edge to the
+    /// nearest border point of the other face beside it.
+    pub width: f64,
+}
+
+/// As [`edge_counts_around_skipped`], with the gaps of the cracks: per pair
+/// of faces whose borders crack apart, how far apart they lie.
+pub(crate) fn edge_census(
+    mesh: &Mesh,
+    bodies: &[u32],
+    skipped: &[SkippedFace],
+    weld_tol: f64,
+    sew_tol: f64,
+) -> (EdgeCounts, Vec<Gap>) {
     let (mut map, mut nverts) = weld_positions(&mesh.positions, weld_tol);
     let face_of = face_lookup(mesh);
     let body_of_face = |f: u32| crate::model::body_of(bodies, f as usize);
@@ -153,10 +175,18 @@ pub fn edge_counts_around_skipped(
     }
     drop((at, start, around));
     out.boundary_edges = free.len();
-    let (cracks, holes) = count_cracks(&free, &pos, sew_tol, &body_of_face, skipped);
-    out.free_edges = cracks;
+    let (cracks, holes) = find_cracks(&free, &pos, sew_tol, &body_of_face, skipped);
+    out.free_edges = cracks.len() + holes;
     out.hole_edges = holes;
-    out
+    let mut gaps: Vec<Gap> = Vec::new();
+    for (faces, width) in cracks {
+        match gaps.iter_mut().find(|g| g.faces == faces) {
+            Some(g) => g.width = g.width.max(width),
+            None => gaps.push(Gap { faces, width }),
+        }
+    }
+    gaps.sort_by_key(|g| g.faces);
+    (out, gaps)
 }
 
 /// The report's line about faces the reader skipped, if any: how many, and
@@ -186,18 +216,25 @@ fn face_lookup(mesh: &Mesh) -> impl Fn(usize) -> u32 + '_ {
 
 /// A free edge is a crack when a vertex or midpoint of a free edge of another
 /// face of its body lies within `sew` (and within a fifth of the edge's
-/// length) of its quarter, half or three-quarter point, or when it runs
-/// along the border of a skipped face of its body ([`Holes::along`]).
-/// Returns the cracks and, of them, those along skipped faces.
-fn count_cracks(
+/// length) of its quarter, half or three-quarter point. A vertex on the
+/// edge's own face's border too is not: the two faces are joined there, and
+/// the edge passes it where its own face is narrower than `sew` (a strip
+/// whose far side comes near a corner it shares with a neighbour). A free
+/// edge that runs along the border of a skipped face of its body
+/// ([`Holes::along`]) is a crack too, the missing face's hole.
+/// Returns, per crack between two faces, the faces (lower first) and the
+/// distance from the edge to the nearest border point of the other face
+/// beside it; and how many cracks run along skipped faces.
+fn find_cracks(
     free: &[(u32, u32, u32)],
     pos: &dyn Fn(u32) -> DVec3,
     sew: f64,
     body: &dyn Fn(u32) -> u32,
     skipped: &[SkippedFace],
-) -> (usize, usize) {
+) -> (Vec<Crack>, usize) {
+    let mut cracks = Vec::new();
     if free.is_empty() || !(sew > 0.0 && sew.is_finite()) {
-        return (0, 0);
+        return (cracks, 0);
     }
     // Points of interest: free-edge vertices (tag = vertex id) and midpoints (tag = edge index).
     #[derive(Clone, Copy)]
@@ -218,27 +255,32 @@ fn count_cracks(
         grid.insert(m, (m, Tag::Mid, f));
     }
     let holes = Holes::new(skipped, 2.0 * sew);
-    let (mut cracks, mut along) = (0, 0);
+    let mut along = 0;
     for &(a, b, face) in free {
         let (pa, pb) = (pos(a), pos(b));
         // Relative to the edge too: an open border's own neighbours sit half an edge away.
         let reach = sew.min(0.2 * pa.distance(pb));
-        let hit = [0.25, 0.5, 0.75].iter().any(|&f| {
-            let q = pa.lerp(pb, f);
-            grid.near(q).any(|&(p, tag, f)| {
+        // The nearest other face's border point beside the edge, and that face.
+        let mut hit: Option<(f64, u32)> = None;
+        for q in [0.25, 0.5, 0.75].map(|f| pa.lerp(pb, f)) {
+            for &(p, tag, f) in grid.near(q) {
                 let other = f != face
                     && body(f) == body(face)
                     && match tag {
-                        Tag::Vertex(v) => v != a && v != b,
+                        Tag::Vertex(v) => v != a && v != b && !seen.contains(&(v, face)),
                         Tag::Mid => true,
                     };
-                other && p.distance(q) < reach
-            })
-        });
-        if hit {
-            cracks += 1;
+                if other && p.distance(q) < reach {
+                    let width = to_segment(p, pa, pb);
+                    if hit.is_none_or(|h| width < h.0) {
+                        hit = Some((width, f));
+                    }
+                }
+            }
+        }
+        if let Some((width, f)) = hit {
+            cracks.push(((face.min(f), face.max(f)), width));
         } else if holes.along(pa, pb, body(face)) {
-            cracks += 1;
             along += 1;
         }
     }
@@ -279,6 +321,17 @@ impl<'a> Holes<'a> {
     }
 }
 
+/// A crack between two faces: the faces (lower first) and its width.
+type Crack = ((u32, u32), f64);
+
+/// Distance from `p` to the segment `ab`.
+fn to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let l2 = ab.length_squared();
+    let t = if l2 > 0.0 { ((p - a).dot(ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    p.distance(a + ab * t)
+}
+
 /// Triangle angle distribution.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct AngleStats {
@@ -314,4 +367,54 @@ pub(crate) fn min_angle(t: [DVec3; 3]) -> f64 {
         m = m.min(ang);
     }
     m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::FaceRange;
+
+    /// Two faces on the plane z = 0: `a`'s triangles, then `b`'s.
+    fn two_faces(pts: &[(f64, f64)], a: &[[u32; 3]], b: &[[u32; 3]]) -> Mesh {
+        let indices: Vec<u32> = a.iter().chain(b).flatten().copied().collect();
+        Mesh {
+            positions: pts.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect(),
+            normals: Vec::new(),
+            indices,
+            face_ranges: alloc::vec![
+                FaceRange { first: 0, count: a.len() as u32 },
+                FaceRange { first: a.len() as u32, count: b.len() as u32 }
+            ],
+        }
+    }
+
+    /// A T-junction: face b's border has a node in the middle of face a's
+    /// edge, which a lacks. That edge is a crack.
+    #[test]
+    fn a_node_of_another_face_along_a_free_edge_is_a_crack() {
+        let pts = [(0.0, 0.0), (4.0, 0.0), (2.0, -2.0), (2.0, 0.0), (1.0, 2.0), (3.0, 2.0)];
+        let m = two_faces(&pts, &[[0, 2, 1]], &[[0, 3, 4], [3, 1, 5], [3, 5, 4]]);
+        assert_eq!(edge_counts(&m, 1e-9, 1.0).free_edges, 1);
+        // The node lies on the edge: a gap of nothing between faces 0 and 1.
+        assert_eq!(edge_census(&m, &[], &[], 1e-9, 1.0).1, [Gap { faces: (0, 1), width: 0.0 }]);
+        // Lifted 0.3 off it, the nearest of face 1's border points (the
+        // midpoints of its edges to that node) lie 0.15 off.
+        let mut lifted = m.clone();
+        lifted.positions[3].z = 0.3;
+        let gaps = edge_census(&lifted, &[], &[], 1e-9, 1.0).1;
+        assert!(gaps.len() == 1 && (gaps[0].width - 0.15).abs() < 1e-12, "{gaps:?}");
+    }
+
+    /// A strip 0.5 wide (face a, its top border through node 4) that face b
+    /// touches at node 4 alone: the strip's bottom edge passes node 4 at
+    /// half a unit, within the sewing distance, yet the two faces are
+    /// joined there, and nothing is missing.
+    #[test]
+    fn a_corner_both_faces_have_is_no_crack_of_a_narrow_face() {
+        let pts = [(0.0, 0.0), (10.0, 0.0), (10.0, 0.5), (0.0, 0.5), (5.0, 0.5), (4.0, 3.0), (6.0, 3.0)];
+        let m = two_faces(&pts, &[[0, 1, 4], [1, 2, 4], [0, 4, 3]], &[[4, 6, 5]]);
+        let c = edge_counts(&m, 1e-9, 1.0);
+        assert_eq!(c.boundary_edges, 8);
+        assert_eq!(c.free_edges, 0);
+    }
 }

@@ -137,6 +137,31 @@ impl KnotVector {
         lo
     }
 
+    /// The span whose polynomial piece evaluates the B-spline at `t`: the
+    /// [`KnotVector::span`] holding `t`, unless that span is a sliver no
+    /// wider than the rounding of its knots ([`SLIVER`]), a knot written twice
+    /// a few units in the last place apart (a surface split next to its own
+    /// knot). Its derivatives are the rounding of its control points over
+    /// that width (any size, any direction: normals turned at random, and a
+    /// grid split down to its cap), so `t` is evaluated as if the sliver's
+    /// two ends were one knot: on the next span, or at the domain's end on
+    /// the last span before the sliver.
+    pub(crate) fn eval_span(&self, t: f64) -> usize {
+        let span = self.span(t);
+        let u = &self.knots;
+        let (a, b) = self.domain();
+        let sliver = SLIVER * a.abs().max(b.abs()).max(b - a);
+        if u[span + 1] - u[span] > sliver {
+            return span;
+        }
+        let last = self.control_count() - 1;
+        // The next span wider than a sliver, else the one before.
+        (span + 1..=last)
+            .find(|&i| u[i + 1] - u[i] > sliver)
+            .or_else(|| (self.degree..span).rev().find(|&i| u[i + 1] - u[i] > sliver))
+            .unwrap_or(span)
+    }
+
     /// Non-zero basis functions and their derivatives up to order `nd` at `t`.
     ///
     /// Writes `ders[k][j]` = k-th derivative of `N_{span-p+j}` for `k <= nd`,
@@ -151,7 +176,7 @@ impl KnotVector {
     /// low degrees, so hot paths pick a small `N`.
     pub(crate) fn basis_into<const N: usize>(&self, t: f64, nd: usize, ders: &mut [[f64; N]; MAX_DERIV + 1]) -> usize {
         let t = self.clamp(t);
-        let span = self.span(t);
+        let span = self.eval_span(t);
         self.basis_in_span(span, t, nd, ders);
         span
     }
@@ -373,6 +398,12 @@ impl KnotVector {
     }
 }
 
+/// Widest knot span, as a share of the larger of the knot vector's end
+/// magnitudes and its domain length, that [`KnotVector::eval_span`] treats
+/// as a rounding of one knot written twice: about 450 units in the last
+/// place, where a parameter written with 15 significant digits is off by 5.
+pub(crate) const SLIVER: f64 = 1e-13;
+
 /// Highest derivative order computed by [`KnotVector::basis_ders`].
 pub const MAX_DERIV: usize = 2;
 
@@ -497,5 +528,41 @@ mod tests {
             }
         }
         assert!(checked > 1000, "{checked} cases");
+    }
+
+    /// A quarter circle whose knot vector starts with a sliver (0.25 written
+    /// once rounded and once exactly, with three control points rounding the
+    /// same point): at the domain's start the tangent is the circle's, as
+    /// without the sliver; evaluated in the sliver it pointed anywhere.
+    #[test]
+    fn a_sliver_span_evaluates_as_one_knot() {
+        use crate::nurbs::NurbsCurve;
+        use glam::DVec3;
+        let a = 0.25 - 5e-16;
+        let h = core::f64::consts::FRAC_1_SQRT_2;
+        let knots = alloc::vec![a, a, a, 0.25, 0.25, 0.5, 0.5, 0.5];
+        let corner = DVec3::new(1.0, 1.0, 0.0);
+        let pts = alloc::vec![
+            DVec3::X,
+            DVec3::new(1.0 + 4.4e-16, 1e-16, 0.0),
+            DVec3::new(1.0, -1e-16, 0.0),
+            corner,
+            DVec3::Y
+        ];
+        let c = NurbsCurve::try_new(2, knots, pts, Some(alloc::vec![1.0, 1.0, 1.0, h, 1.0])).unwrap();
+        let kv = KnotVector::try_new(2, alloc::vec![a, a, a, 0.25, 0.25, 0.5, 0.5, 0.5]).unwrap();
+        assert_eq!(kv.span(a), 2, "the sliver holds the domain's start");
+        assert_eq!(kv.eval_span(a), 4, "evaluated on the span after it");
+        for t in [a, 0.25 - 2e-16, 0.25] {
+            let d = c.derivs(t);
+            assert!(d.point.distance(DVec3::X) < 1e-12, "{t}: {:?}", d.point);
+            let along = d.d1.normalize();
+            assert!(along.distance(DVec3::Y) < 1e-9, "{t}: tangent {along:?}");
+        }
+        // Clean vectors and zero-width spans (multiple knots) are left alone.
+        let clean = KnotVector::try_new(2, alloc::vec![0.0, 0.0, 0.0, 0.5, 0.5, 1.0, 1.0, 1.0]).unwrap();
+        for t in [0.0, 0.25, 0.5, 0.75, 1.0] {
+            assert_eq!(clean.eval_span(t), clean.span(t));
+        }
     }
 }

@@ -217,7 +217,13 @@ pub(crate) fn mesh_face<'a>(
             tight + lim.tol,
         );
         let mut wm = initial_from_outline(index, &face.surface, &o, budget)?;
-        wm.refine(&face.surface, &o.loops.curves, crit, budget);
+        let outcome = wm.refine(&face.surface, &o.loops.curves, crit, budget);
+        if wm.tris.len() >= budget {
+            // Out of its budget: it loses to any mesh within it, whatever
+            // its shapes; mending them (seconds on a folded face) would
+            // change nothing the comparison reads.
+            return Ok(FaceResult { mesh: wm, outcome, outline: Some(unsewn) });
+        }
         // Flipped as the model's faces are, so that the shapes compared are
         // those the model's mesh would have.
         let flipped = wm.improve_angles(&face.surface, crit, &mut crate::collections::HashSet::default());
@@ -446,6 +452,39 @@ pub(crate) fn domain_loops(face: &Face) -> Vec<crate::TrimLoop> {
     } else {
         Vec::new()
     }
+}
+
+/// Whether an untrimmed face closes on itself: each side of its domain
+/// either collapses to a point (a pole) or runs along the opposite side (a
+/// seam), at 33 points within `reach`. Such a face (a sphere, a torus, a
+/// closed B-spline tube) has no border to share: it is a body of its own.
+pub(crate) fn closed_on_itself(face: &Face, reach: f64) -> bool {
+    if !face.loops.is_empty() || reach.is_nan() || reach <= 0.0 {
+        return false;
+    }
+    let [lo, hi] = face.surface.domain();
+    if !(hi.x > lo.x && hi.y > lo.y) {
+        return false;
+    }
+    const N: usize = 33;
+    let at = |along_u: bool, side: f64, k: usize| {
+        let t = k as f64 / (N - 1) as f64;
+        let uv = if along_u {
+            DVec2::new(lo.x + t * (hi.x - lo.x), side)
+        } else {
+            DVec2::new(side, lo.y + t * (hi.y - lo.y))
+        };
+        face.surface.point(uv)
+    };
+    let pole = |along_u: bool, side: f64| {
+        let first = at(along_u, side, 0);
+        (1..N).all(|k| at(along_u, side, k).distance(first) <= reach)
+    };
+    let seam = |along_u: bool, a: f64, b: f64| (0..N).all(|k| at(along_u, a, k).distance(at(along_u, b, k)) <= reach);
+    // The sides v = lo.y, hi.y run along u; u = lo.x, hi.x along v.
+    let v_closed = seam(true, lo.y, hi.y) || (pole(true, lo.y) && pole(true, hi.y));
+    let u_closed = seam(false, lo.x, hi.x) || (pole(false, lo.x) && pole(false, hi.x));
+    v_closed && u_closed
 }
 
 /// The loop around a surface's whole parameter domain, a straight (u,v)

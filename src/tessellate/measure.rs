@@ -107,11 +107,22 @@ pub(crate) fn distance_from_hint(surface: &dyn Surface, q: DVec3, hint: DVec2, o
             break;
         }
         let next = (uv + step).clamp(lo, hi);
+        // A step that gets no closer where the Gauss-Newton model still
+        // promises a gain: the model does not hold (a pole's fan, where the
+        // hint's interpolated (u,v) lies far round from the foot point, or a
+        // step clamped at the domain's edge); the general projection takes over.
+        let stuck = |best: f64| {
+            if settled(r, d.su, d.sv, best, floor) {
+                best
+            } else {
+                best.min(project_to_surface(surface, q, Some(uv), opts).distance)
+            }
+        };
         if iteration == 0 {
             let (p, su, sv) = surface.tangents(next);
             let dist = p.distance(q);
             if dist >= best {
-                break;
+                return stuck(best);
             }
             let gain = best - dist;
             uv = next;
@@ -123,7 +134,7 @@ pub(crate) fn distance_from_hint(surface: &dyn Surface, q: DVec3, hint: DVec2, o
         }
         let dist = surface.point(next).distance(q);
         if dist >= best {
-            break;
+            return stuck(best);
         }
         let gain = best - dist;
         uv = next;
@@ -302,5 +313,29 @@ mod tests {
             assert!((m.max - h).abs() < 1e-12);
             assert!((m.sum / h - f64::from(sample_count(steps))).abs() < 1e-9, "steps {steps}: {}", m.sum / h);
         }
+    }
+
+    /// A flat cap about a pole (the end of a tube of rectangular section,
+    /// its rows from the centre out to the rectangle): a triangle with a
+    /// corner at the pole lies on the cap, but its samples' interpolated
+    /// (u,v) lie far round the fan from their foot points, where Newton's
+    /// first step got no closer and the hint's distance (up to 0.1 of the
+    /// rectangle, far over any tolerance) stood as the deviation.
+    #[test]
+    fn samples_round_a_pole_are_found_on_the_surface() {
+        use crate::nurbs::NurbsSurface;
+        let rect = [(-0.45, 18.0), (-0.45, -18.0), (0.45, -18.0), (0.45, 18.0), (-0.45, 18.0)];
+        let ring: Vec<DVec3> = rect.iter().map(|&(x, z)| DVec3::new(x, 0.0, z)).collect();
+        let pts = alloc::vec![alloc::vec![DVec3::ZERO; 5], ring.clone(), ring];
+        let kv = alloc::vec![0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0];
+        let s = NurbsSurface::try_new([2, 1], alloc::vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0], kv, &pts, None).unwrap();
+        let a = 0.015;
+        let uv = [DVec2::new(a, 0.75), DVec2::new(0.0, 0.75), DVec2::new(a, 0.5)];
+        let p = uv.map(|x| s.point(x));
+        let m = measure_triangle(&s, &p, &uv, 4, &measure_projection());
+        assert!(m.max < 1e-9, "{}", m.max);
+        // The hints are far off: the search had work to do.
+        let hint = uv[1] * 0.25 + uv[2] * 0.75;
+        assert!(s.point(hint).distance(p[1] * 0.25 + p[2] * 0.75) > 0.1);
     }
 }

@@ -26,7 +26,7 @@ use alloc::format;
 use alloc::vec::Vec;
 use glam::DVec2;
 
-use crate::mesh::{angle_stats, edge_counts_around_skipped, holes_warning, FaceRange};
+use crate::mesh::{angle_stats, edge_census, holes_warning, FaceRange};
 use crate::nurbs::{Aabb, Surface};
 use crate::reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
 use crate::{Error, Mesh, Model, Report};
@@ -248,6 +248,13 @@ pub fn mesh_model_with_progress(
                 if let Some(m) = c.mended() {
                     report.warnings.push(format!("face {index}: {m}"));
                 }
+                if let Some(along) = c.capped_grid() {
+                    report.warnings.push(format!(
+                        "face {index}: the grid along {along} stopped at its cap of {} lines (the surface's \
+                         normals or sag never settle there); refinement still holds the tolerance",
+                        params::MAX_PARAMS
+                    ));
+                }
                 chosen.push(Some(c));
             }
             // One face that cannot be meshed does not sink the others; a
@@ -270,7 +277,12 @@ pub fn mesh_model_with_progress(
         Some(s) => (s, auto_tight.min(s)),
         None => (0.4 * tol, auto_tight),
     };
-    let ids = unify_outlines(&mut chosen, &model.bodies, &facets, sew_tol, tight, aim + sew_tol);
+    // Closed as built (a sphere, a torus, a ring's closed quarter): its
+    // seams and poles meet to a rounding. A side that shrinks to a small
+    // circle within the sewing distance is a border that another face can
+    // close, not a pole.
+    let body_ids = own_bodies(model, &mine, 1e-9 * diag.max(tol));
+    let ids = unify_outlines(&mut chosen, &body_ids, &facets, sew_tol, tight, aim + sew_tol);
     // Every face's first mesh (grid and trim band) on those nodes; each
     // outline is freed once its mesh is built (only whether it is pinched
     // is asked later).
@@ -314,7 +326,7 @@ pub fn mesh_model_with_progress(
         return Err(e);
     }
     // Borders along tessellated faces take their vertices before refinement.
-    tessellated::snap_borders(&mut works, &facets, &model.bodies, sew_tol);
+    tessellated::snap_borders(&mut works, &facets, &body_ids, sew_tol);
     // Refinement keeps shared borders shared: a split of a shared edge is
     // made on every side; then every node takes one position.
     let budget_hit = sew::refine_all(&mut works, ids, sew_tol, options.max_triangles, progress)?;
@@ -367,7 +379,7 @@ pub fn mesh_model_with_progress(
         w.mesh.rest();
     }
     // The tessellated faces take the exact borders' nodes along theirs.
-    tessellated::split_rims(&mut works, &mut facets, &model.bodies, sew_tol);
+    tessellated::split_rims(&mut works, &mut facets, &body_ids, sew_tol);
     let (mut dev_sum, mut dev_count) = (0.0, 0u64);
     for (index, (w, fit_error)) in works.iter_mut().zip(&fit_errors).enumerate() {
         let out = w.mesh.outcome(w.surface, &w.crit);
@@ -457,8 +469,16 @@ pub fn mesh_model_with_progress(
     report.mean_deviation = if dev_count > 0 { dev_sum / dev_count as f64 } else { 0.0 };
     report.triangles = mesh.triangle_count();
     report.vertices = mesh.positions.len();
-    let edges = edge_counts_around_skipped(&mesh, &model.bodies, &model.skipped, (tol * 1e-3).min(tight * 0.5), tol);
+    let (edges, gaps) = edge_census(&mesh, &body_ids, &model.skipped, (tol * 1e-3).min(tight * 0.5), tol);
     holes_warning(&model.skipped, edges.hole_edges, &mut report.warnings);
+    // A crack wider than sewing reaches is the file's own gap: say where.
+    for g in gaps.iter().filter(|g| g.width > sew_tol) {
+        report.warnings.push(format!(
+            "faces {} and {}: their borders lie {:.3e} apart where they meet, farther than sewing closes \
+             ({sew_tol:.3e}); the crack between them is left open",
+            g.faces.0, g.faces.1, g.width
+        ));
+    }
     report.free_edges = edges.free_edges;
     report.boundary_edges = edges.boundary_edges;
     report.nonmanifold_edges = edges.nonmanifold_edges;
@@ -641,6 +661,23 @@ impl<'a> Chosen<'a> {
         None
     }
 
+    /// The direction (`"u"` or `"v"`) whose grid lines reached
+    /// [`params::MAX_PARAMS`], where the interval tests stopped splitting
+    /// before they passed.
+    fn capped_grid(&self) -> Option<&'static str> {
+        #[cfg(feature = "std")]
+        {
+            let capped = |p: &[f64]| p.len() >= params::MAX_PARAMS;
+            if capped(&self.outline.pu) {
+                return Some("u");
+            }
+            if capped(&self.outline.pv) {
+                return Some("v");
+            }
+        }
+        None
+    }
+
     /// Whether a loop of the sewn outline passes one node twice.
     fn pinched(&self) -> bool {
         #[cfg(feature = "std")]
@@ -667,6 +704,24 @@ impl<'a> Chosen<'a> {
         #[cfg(not(feature = "std"))]
         face::initial_face(index, self.face, &self.lim, budget)
     }
+}
+
+/// Each face's body for sewing and for the edge counts: the file's
+/// ([`Model::bodies`]), except that a face closed on itself
+/// ([`face::closed_on_itself`] within `reach`) is a body of its own: it has
+/// no border to sew, and where it touches another face (closed quarters of a
+/// ring meeting at their end caps) the two are solids side by side, not one
+/// surface with non-manifold edges.
+fn own_bodies(model: &Model, mine: &[bool], reach: f64) -> Vec<u32> {
+    let mut ids: Vec<u32> = (0..model.face_count()).map(|f| crate::model::body_of(&model.bodies, f)).collect();
+    let mut next = ids.iter().copied().max().map_or(0, |m| m + 1);
+    for (index, face) in model.faces.iter().enumerate() {
+        if mine.get(index).copied().unwrap_or(false) && face::closed_on_itself(face, reach) {
+            ids[index] = next;
+            next += 1;
+        }
+    }
+    ids
 }
 
 /// Sews the outlines of the faces to be meshed (see [`sew::unify`]), after

@@ -27,7 +27,9 @@ pub(super) const SHORTER_TRIES: usize = 6;
 /// limit starts at `first` times the longest edge and falls by √2 a try (about twice
 /// the triangles), for at most `tries` tries, until the mesh wins or takes
 /// more triangles than the original's; the limits of the winning mesh, if
-/// one does, and its unsewn outline.
+/// one does, and its unsewn outline. A mesh that loses on proof (more
+/// triangles left over the limits than the original's: out of budget, or
+/// at the shortest edge) is not tried: more triangles cannot win it back.
 pub(super) fn shorter_edges<'x>(
     index: usize,
     (face, loops): (&'x crate::Face, &'x [crate::TrimLoop]),
@@ -38,7 +40,7 @@ pub(super) fn shorter_edges<'x>(
     tight: f64,
 ) -> Option<(params::Limits, refine::Criteria, Option<face::Outline<'x>>)> {
     let (Ok(new), Ok(old)) = (rebuilt, original) else { return None };
-    if new.mesh.tris.is_empty() || new.mesh.tris.len() >= old.mesh.tris.len() {
+    if !loses_on_shape_alone(new, old) {
         return None;
     }
     let pos = |v: u32| new.mesh.pos.get(v as usize).copied().unwrap_or_default();
@@ -74,7 +76,8 @@ pub(super) fn shorter_edges<'x>(
 /// fanned onto tiny edges) spends the difference on Delaunay refinement of
 /// its triangles under the original's 1st-percentile angle + 1°
 /// (`refine/lift.rs`); the limits of the mesh if it then wins, and its
-/// unsewn outline.
+/// unsewn outline. As in [`shorter_edges`], only a mesh that loses on
+/// shape alone is lifted.
 pub(super) fn lift_needles<'x>(
     index: usize,
     (face, loops): (&'x crate::Face, &'x [crate::TrimLoop]),
@@ -85,13 +88,25 @@ pub(super) fn lift_needles<'x>(
 ) -> Option<(refine::Criteria, Option<face::Outline<'x>>)> {
     let (Ok(new), Ok(old)) = (rebuilt, original) else { return None };
     let most = old.mesh.tris.len();
-    if new.mesh.tris.len() >= most {
+    if !loses_on_shape_alone(new, old) {
         return None;
     }
     let goal = (p1(&old.mesh) + 1.0).to_radians();
     let c = refine::Criteria { lift: refine::Lift { goal, most }, ..*crit };
     let mut r = face::mesh_face(index, face, loops, lim, &c, budget, tight);
     rebuild_loses(&r, original).is_none().then(|| (c, outline_of(&mut r)))
+}
+
+/// Whether the mesh of a rebuilt face `new` has triangles to spend on
+/// shape: fewer than the original's `old`, and no more of them left over
+/// the limits. One that ran out of its trial budget (the original's count)
+/// or stopped at the shortest edge with more unproven triangles loses on
+/// proof, which shorter edges or lifted needles only make worse: on a
+/// folded face each such try refined up to the budget again (seconds a try).
+fn loses_on_shape_alone(new: &face::FaceResult<'_>, old: &face::FaceResult<'_>) -> bool {
+    !new.mesh.tris.is_empty()
+        && new.mesh.tris.len() < old.mesh.tris.len()
+        && new.outcome.unproven <= old.outcome.unproven
 }
 
 /// The 1st-percentile smallest angle of a trial mesh, degrees, as the
@@ -139,5 +154,32 @@ pub(super) fn rebuild_loses(
         ))
     } else {
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A trial result of `tris` triangles, `unproven` of them over the limits.
+    fn result(tris: usize, unproven: usize) -> face::FaceResult<'static> {
+        let mut mesh = refine::WorkMesh::default();
+        mesh.tris = alloc::vec![[0, 1, 2]; tris];
+        let outcome = refine::Outcome { unproven, ..Default::default() };
+        face::FaceResult { mesh, outcome, outline: None }
+    }
+
+    /// Shorter edges and lifted needles spend triangles on shape: a rebuild
+    /// that is lighter and as proven as the original may try them; one out
+    /// of its budget or with more triangles unproven (a folded face's
+    /// rebuild, each try refined to the budget again) may not.
+    #[test]
+    fn only_a_lighter_proven_rebuild_spends_triangles_on_shape() {
+        let old = result(100, 2);
+        assert!(loses_on_shape_alone(&result(60, 2), &old));
+        assert!(loses_on_shape_alone(&result(60, 0), &old));
+        assert!(!loses_on_shape_alone(&result(60, 3), &old), "more unproven");
+        assert!(!loses_on_shape_alone(&result(100, 0), &old), "as many triangles");
+        assert!(!loses_on_shape_alone(&result(0, 0), &old), "empty");
     }
 }

@@ -123,6 +123,21 @@ fn mesh_torus_exact_and_closed() {
     counts_follow_tolerance("torus", &counts);
 }
 
+/// A face closed on itself has no border to share: it is a body of its
+/// own. Two copies of one torus (as closed quarters of a ring meet at their
+/// end caps) are two solids in one place, each closed, not one surface whose
+/// every edge is non-manifold.
+#[test]
+fn mesh_closed_faces_that_touch_are_bodies_of_their_own() {
+    let mut model = shapes::torus(shapes::TORUS_MAJOR, shapes::TORUS_MINOR);
+    model.faces.push(model.faces[0].clone());
+    let r = mesh(&model, 1e-2);
+    let e = (r.report.nonmanifold_edges, r.report.boundary_edges, r.report.free_edges);
+    assert_eq!(e, (0, 0, 0), "two tori in one place: non-manifold, boundary, free edges");
+    let counts: Vec<u32> = r.mesh.face_ranges.iter().map(|f| f.count).collect();
+    assert!(counts[0] > 0 && counts[0] == counts[1], "both copies meshed alike: {counts:?}");
+}
+
 #[test]
 fn mesh_cylinder_exact() {
     let model = shapes::cylinder();
@@ -564,6 +579,24 @@ fn mesh_sews_one_gapped_border_in_a_model_that_otherwise_meets_exactly() {
     assert!(open(1.5 * tol) > r.report.boundary_edges, "a gap of 1.5 tolerances was sewn");
 }
 
+/// A gap wider than the sewing distance (0.4 of the tolerance) but within
+/// the tolerance is a crack the file has, not one the mesher left: the
+/// report names the two faces and the measured width.
+#[test]
+fn mesh_names_a_gap_wider_than_sewing_and_its_width() {
+    let tol = 1.0;
+    let r = mesh_model(&row_with_one_gap(0.7 * tol), &MeshOptions::default().with_tolerance(tol)).expect("meshes");
+    assert!(r.report.free_edges > 0, "the gap is a crack");
+    let gaps: Vec<&String> = r.report.warnings.iter().filter(|w| w.contains("apart where they meet")).collect();
+    assert_eq!(gaps.len(), 1, "{:?}", r.report.warnings);
+    assert!(gaps[0].starts_with("faces 29 and 30: their borders lie "), "{}", gaps[0]);
+    let width: f64 = gaps[0]["faces 29 and 30: their borders lie ".len()..].split(' ').next().unwrap().parse().unwrap();
+    assert!(width >= 0.7 * tol - 1e-9 && width < tol, "{width}");
+    // Sewn gaps leave no such warning.
+    let sewn = mesh_model(&row_with_one_gap(0.3 * tol), &MeshOptions::default().with_tolerance(tol)).expect("meshes");
+    assert!(sewn.report.warnings.iter().all(|w| !w.contains("apart where they meet")), "{:?}", sewn.report.warnings);
+}
+
 /// Three flat faces round a corner that misses: the right face's corner
 /// stops `miss` short of the others', leaving a sliver between its top
 /// border and the face above.
@@ -681,4 +714,82 @@ fn mesh_folded_strip_keeps_its_panels_flat_and_few() {
         // Four flat panels: two triangles each would do; eight each is slack.
         assert!(r.report.triangles <= 32, "rel {rel}: {} triangles for four flat panels", r.report.triangles);
     }
+}
+
+/// A quarter cylinder, its arc along v: clean, or with the arc's knot
+/// vector starting on a sliver (0.25 written once rounded and once exactly,
+/// three control points rounding the arc's first point, the rounding
+/// opposite at the two ends), as a surface split next to its own knot comes
+/// out of a reader.
+fn quarter_cylinder(sliver: bool) -> Model {
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    let a = 0.25 - 5e-16;
+    let corner = DVec3::new(1.0, 1.0, 0.0);
+    let (kv, w) = if sliver {
+        (vec![a, a, a, 0.25, 0.25, 0.5, 0.5, 0.5], vec![1.0, 1.0, 1.0, h, 1.0])
+    } else {
+        (vec![0.25, 0.25, 0.25, 0.5, 0.5, 0.5], vec![1.0, h, 1.0])
+    };
+    let rows: Vec<Vec<DVec3>> = [(0.0, 1.0), (3.0, -1.0)]
+        .iter()
+        .map(|&(z, sign)| {
+            let arc = if sliver {
+                vec![DVec3::X, DVec3::new(1.0 + sign * 4.4e-16, sign * 1e-16, 0.0), DVec3::X, corner, DVec3::Y]
+            } else {
+                vec![DVec3::X, corner, DVec3::Y]
+            };
+            arc.iter().map(|p| *p + DVec3::Z * z).collect()
+        })
+        .collect();
+    let weights = vec![w.clone(), w];
+    let s = NurbsSurface::try_new([1, 2], vec![0.0, 0.0, 1.0, 1.0], kv, &rows, Some(&weights)).expect("surface");
+    Model { faces: vec![Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] }], ..Default::default() }
+}
+
+/// A sliver knot span is evaluated as the one knot it stands for: its
+/// derivatives were the rounding of its control points over 5e-16, the
+/// normals along the face's first line turned over where that rounding
+/// changes sign, and the grid split the straight direction down to its cap
+/// of 20 000 lines.
+#[test]
+fn mesh_sliver_knot_span_meshes_like_its_clean_twin() {
+    for rel in [1e-2, 1e-3] {
+        let clean = check_common("clean quarter cylinder", &mesh(&quarter_cylinder(false), rel), rel);
+        let r = mesh(&quarter_cylinder(true), rel);
+        let rep = &r.report;
+        assert!(rep.max_deviation <= rep.tolerance, "{rel}: deviation {} over {}", rep.max_deviation, rep.tolerance);
+        assert_eq!(rep.inverted_triangles, 0, "{rel}");
+        assert!(
+            rep.triangles <= clean + clean / 4,
+            "{rel}: {} triangles against {clean} without the sliver",
+            rep.triangles
+        );
+    }
+}
+
+/// A grid direction that reaches its cap of lines says so: a strip whose
+/// edge limit asks for five times the cap along its length gets a warning
+/// naming the face and the direction. (The budget then skips the strip, so
+/// that the test does not refine its 40 000 triangles; a speck of a face
+/// first keeps the model meshable.)
+#[test]
+fn mesh_warns_when_a_grid_direction_reaches_its_cap() {
+    let square = |o: DVec3, w: f64, h: f64| {
+        let pts =
+            vec![vec![o, o + DVec3::new(0.0, h, 0.0)], vec![o + DVec3::new(w, 0.0, 0.0), o + DVec3::new(w, h, 0.0)]];
+        let s = NurbsSurface::try_new([1, 1], vec![0.0, 0.0, 1.0, 1.0], vec![0.0, 0.0, 1.0, 1.0], &pts, None)
+            .expect("square");
+        Face { name: None, surface: FaceSurface::Nurbs(s), loops: vec![] }
+    };
+    let speck = square(DVec3::new(5.0, 0.0, 0.0), 5e-6, 5e-6);
+    let strip = square(DVec3::ZERO, 1.0, 1e-4);
+    let model = Model { faces: vec![speck, strip], ..Default::default() };
+    // A tolerance far below the edge limit: sewing then looks at a few of
+    // the border's 40 000 nodes at a time, not at thousands.
+    let opts = MeshOptions::default().with_relative_tolerance(1e-6).with_max_edge(Some(1e-5)).with_max_triangles(1000);
+    let r = mesh_model(&model, &opts).expect("meshes");
+    let capped: Vec<&String> = r.report.warnings.iter().filter(|w| w.contains("stopped at its cap")).collect();
+    assert_eq!(capped.len(), 1, "{:?}", r.report.warnings);
+    assert!(capped[0].starts_with("face 1: the grid along u"), "{}", capped[0]);
+    assert_eq!(r.report.faces_skipped, 1, "{:?}", r.report.warnings);
 }

@@ -224,7 +224,8 @@ fn insertions(
                 let (curve, ta, tb) = poly.seg[i];
                 let Some(c) = o.loops.curves.get(curve as usize) else { continue };
                 let on_curve = |s: f64| surface.point(c.point(ta + (tb - ta) * s).truncate());
-                for &qn in grid.in_box(pa.min(pb) - DVec3::splat(reach), pa.max(pb) + DVec3::splat(reach)) {
+                // Only nodes within `reach` of the segment pass the tests below.
+                for &qn in grid.near_segment(pa, pb, reach) {
                     let (g, kk, jj) = (qn.0 as usize, qn.1 as usize, qn.2 as usize);
                     if qn == na || qn == nb || body(g) != body(fi) {
                         continue;

@@ -39,15 +39,19 @@ pub(super) fn slide_nodes(
     }
     let body = |f: usize| crate::model::body_of(bodies, f);
     let is_moved = |f: usize| moved.get(f).is_some_and(|&m| m > 0.0);
-    let longest = pos
+    // Nodes hashed on a grid about one loop segment long: a cube as long as
+    // the longest segment held most of a model's nodes, and every node
+    // looked at all of them.
+    let (total, count) = pos
         .iter()
         .flatten()
         .flat_map(|p| (0..p.len()).map(move |i| p[i].distance(p[(i + 1) % p.len()])))
-        .fold(0.0f64, f64::max);
-    if !(longest > 0.0 && longest.is_finite()) {
+        .fold((0.0, 0usize), |(t, c), l| (t + l, c + 1));
+    let mean = total / count.max(1) as f64;
+    if !(mean > 0.0 && mean.is_finite()) {
         return pos;
     }
-    let mut grid = CellGrid::new(1.0 / longest);
+    let mut grid = CellGrid::new(1.0 / mean);
     for (fi, f) in pos.iter().enumerate() {
         for (k, p) in f.iter().enumerate() {
             for (i, &q) in p.iter().enumerate() {
@@ -73,6 +77,11 @@ pub(super) fn slide_nodes(
                 let here = pos[fi][k][i];
                 let shorter = here.distance(pos[fi][k][h]).min(here.distance(pos[fi][k][(i + 1) % n]));
                 let reach = SNAP_SHARE * shorter;
+                // A node on its neighbour (a pole's) has nowhere to slide:
+                // that neighbour stays within sewing distance of it.
+                if reach.is_nan() || reach <= 0.0 {
+                    continue;
+                }
                 let r = DVec3::splat(reach);
                 let Some((_, q)) = grid
                     .in_box(here - r, here + r)
@@ -114,6 +123,9 @@ pub(super) fn slide_nodes(
                 poly.seg[h].2 = t;
                 poly.seg[i].1 = t;
                 pos[fi][k][i] = p;
+                // Found where it is now by the nodes after it (its entry at
+                // the old place no longer passes their distance tests).
+                grid.insert(p, (fi as u32, k as u32, i as u32));
             }
         }
     }
