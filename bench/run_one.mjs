@@ -84,7 +84,7 @@ function runSurfmesh() {
   const wasmBase = surfmesh.memoryBytes?.() ?? null;
   let wasmPeak = null;
   const t = timed(() => {
-    const m = surfmesh.mesh(bytes, format, { toleranceRel: rel });
+    const m = surfmesh.mesh(bytes, format, { toleranceRel: rel, flatten: true });
     wasmPeak ??= surfmesh.memoryBytes?.() ?? null;
     return { parse: m.report.parse_ms, mesh: m.report.time_ms, result: m };
   });
