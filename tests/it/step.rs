@@ -525,6 +525,20 @@ fn fuzz_timeout_folded_sheet_meshes_without_exploding() {
     );
 }
 
+/// Found by fuzzing (a timeout under the sanitizer on a loaded machine): a
+/// mutated file whose one face meshes into 6424 triangles on 482 vertices,
+/// many stacked on one another, which the edge census then sorts round each
+/// vertex. It reads and meshes within its tolerance and the fuzz budget.
+#[test]
+fn fuzz_timeout_stacked_triangles_mesh_within_budget() {
+    let model = read_step(&data("step_fuzz_timeout_census.stp")).unwrap();
+    let options = MeshOptions::default().with_relative_tolerance(0.05).with_max_triangles(5_000);
+    let r = mesh_model(&model, &options).expect("meshes");
+    let rep = &r.report;
+    assert!(rep.triangles > 0 && rep.triangles < 20_000, "{} triangles", rep.triangles);
+    assert!(rep.max_deviation <= rep.tolerance, "deviation {} > {}", rep.max_deviation, rep.tolerance);
+}
+
 /// Two shares of a two-body assembly mesh one body each, and together they
 /// are the whole model's mesh face by face (bodies share no border); with
 /// more shares than bodies the extra share is empty, not an error.
