@@ -14,6 +14,7 @@
 // Usage: node scripts/build-wasm.mjs [--build viewer|full ...] [--target web|bundler|nodejs ...] [--no-opt]
 
 import { spawnSync } from 'node:child_process';
+import { createHash } from 'node:crypto';
 import { copyFileSync, existsSync, mkdirSync, readFileSync, rmSync, statSync, writeFileSync } from 'node:fs';
 import { dirname, join, relative } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -191,6 +192,9 @@ function main() {
   const sizes = [];
   const built = [];
   const tops = [];
+  // wasm-bindgen writes the same module for every target of a build: wasm-opt
+  // (a minute or more each) runs once per distinct module, the others are copies.
+  const optimized = new Map();
   for (const buildName of buildNames) {
     const build = config.builds[buildName];
     const features = build.features.join(',');
@@ -214,7 +218,15 @@ function main() {
         tops.push({ build: buildName, top: twiggyTop(named) });
         rmSync(named, { force: true });
       }
-      if (optimize) run(wasmOpt, [...optArgs, wasm, '-o', wasm]);
+      if (optimize) {
+        const key = createHash('sha256').update(readFileSync(wasm)).digest('hex');
+        const done = optimized.get(key);
+        if (done) copyFileSync(done, wasm);
+        else {
+          run(wasmOpt, [...optArgs, wasm, '-o', wasm]);
+          optimized.set(key, wasm);
+        }
+      }
       writeFileSync(join(out, 'package.json'), `${JSON.stringify(targetManifest(name, cargo, config.outName), null, 2)}\n`);
       const bytes = readFileSync(wasm);
       const brotli = brotliCompressSync(bytes, { params: { [zlib.BROTLI_PARAM_QUALITY]: 11, [zlib.BROTLI_PARAM_SIZE_HINT]: bytes.length } }).length;

@@ -183,6 +183,48 @@ test('an assembly meshed in shares of its parts merges into the whole mesh', asy
   assert.throws(() => surfmesh.mesh(bytes, 'step', { share: [0, 2], mode: 'quality' }), /option share: meshes fast mode only/);
 });
 
+test('the page draws placed parts as instances that match the flattened mesh vertex for vertex', async () => {
+  const { flattened } = await import(join(root, 'www', 'js', 'instanced.js'));
+  const bytes = readFileSync(join(root, 'tests', 'data', 'step_assembly.stp'));
+  const whole = surfmesh.mesh(bytes, 'step', { toleranceRel: 1e-3, flatten: true });
+  const page = flattened(surfmesh.mesh(bytes, 'step', { toleranceRel: 1e-3 }));
+  // One block placed twice: one part mesh, two instances.
+  assert.equal(page.instanced.meshes.length, 1);
+  assert.equal(page.instanced.instances.length, 2);
+  assert.equal(page.faceRanges.length, whole.faceRanges.length);
+  assert.equal(page.indices.length, whole.indices.length);
+  // The page's faces go instance after instance; the binding's in the file's
+  // order, faceParts naming each face's instance. Face j of instance k is the
+  // j-th face of k in the file's order.
+  const starts = [0];
+  for (const inst of page.instanced.instances) starts.push(starts.at(-1) + page.instanced.meshes[inst.part].faceRanges.length / 2);
+  const seen = new Array(page.instanced.instances.length).fill(0);
+  const corners = (r, f) => {
+    const out = [];
+    for (let k = 3 * r.faceRanges[2 * f]; k < 3 * (r.faceRanges[2 * f] + r.faceRanges[2 * f + 1]); k++) {
+      const v = r.indices[k];
+      out.push([r.positions[3 * v], r.positions[3 * v + 1], r.positions[3 * v + 2]]);
+    }
+    return out;
+  };
+  const size = Math.max(...whole.positions.map(Math.abs));
+  for (let f = 0; f < whole.faceRanges.length / 2; f++) {
+    const k = whole.faceParts[f];
+    const g = starts[k] + seen[k]++;
+    assert.equal(page.faceParts[g], k);
+    const [a, b] = [corners(whole, f), corners(page, g)];
+    assert.equal(a.length, b.length, `face ${f}`);
+    // The same triangles, each corner the same point to float precision (the
+    // binding moves f64 points, the page the f32 ones).
+    a.forEach((p, i) => p.forEach((x, c) => assert.ok(Math.abs(x - b[i][c]) <= 1e-6 * size, `face ${f} corner ${i}: ${x} vs ${b[i][c]}`)));
+  }
+  // A one-instance model is its part's mesh, no copy made and nothing to instance.
+  const single = surfmesh.mesh(freeform, 'json', {});
+  const flat = flattened(single);
+  assert.equal(flat.instanced, null);
+  assert.equal(flat.positions, single.meshes[0].positions);
+});
+
 test('the viewer build meshes; repair, fit and quality mode are the full build\'s, at surfmesh/full', () => {
   assert.equal(surfmesh.repair, undefined);
   assert.equal(surfmesh.fit, undefined);

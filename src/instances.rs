@@ -263,7 +263,7 @@ impl Plan {
 /// that every worker computes the same split.
 fn share_parts(parts: &[PartPlan], index: u32, count: u32) -> Vec<bool> {
     let mut order: Vec<usize> = (0..parts.len()).collect();
-    order.sort_by(|&a, &b| parts[b].faces.len().cmp(&parts[a].faces.len()).then(a.cmp(&b)));
+    crate::sort::by_u64(&mut order, |&a| u64::MAX - parts[a].faces.len() as u64);
     let count = count.max(1) as usize;
     let mut load = alloc::vec![0usize; count];
     let mut owner = alloc::vec![0usize; parts.len()];

@@ -29,6 +29,7 @@ mod quality;
 #[cfg(feature = "repair")]
 mod repair;
 mod reparam;
+mod sort;
 mod tessellate;
 #[cfg(test)]
 mod testing;

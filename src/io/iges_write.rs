@@ -81,7 +81,7 @@ fn write_face(face: &Face, surface: &NurbsSurface, out: &mut Vec<Entity>) {
     // Outer loop first: the largest (u,v) area.
     let mut order: Vec<(f64, usize)> =
         face.loops.iter().enumerate().map(|(i, lp)| (loop_area(&lp.curves).abs(), i)).collect();
-    order.sort_by(|a, b| b.0.total_cmp(&a.0));
+    crate::sort::by_f64_desc(&mut order, |o| o.0);
     let mut boundaries = Vec::with_capacity(order.len());
     for &(_, li) in &order {
         let Some(lp) = face.loops.get(li) else { continue };

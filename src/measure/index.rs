@@ -121,7 +121,7 @@ impl<'a> SurfaceIndex<'a> {
         // Lower bound of the centroid's distance to each face; project the centroid in that order.
         let mut order: Vec<(f64, u32)> =
             touched.iter().map(|&f| (self.nearest[f as usize].0 - self.radius[f as usize], f)).collect();
-        order.sort_by(|a, b| a.0.total_cmp(&b.0));
+        crate::sort::by_f64(&mut order, |o| o.0);
         self.candidates.clear();
         let mut best = f64::INFINITY;
         let mut dist_c: Vec<f64> = Vec::with_capacity(order.len());

@@ -145,7 +145,7 @@ pub(crate) fn sample_face(face: &Face, plan: &FacePlan, spacing: f64, min_lines:
                 }
             }
         }
-        crossings.sort_by(f64::total_cmp);
+        crate::sort::f64s(&mut crossings);
         for i in 0..=nu {
             let uv = uv_at(i, j);
             // Even-odd: inside when an odd number of loop crossings lie left of u.

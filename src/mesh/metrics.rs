@@ -349,7 +349,7 @@ pub fn angle_stats(mesh: &Mesh) -> AngleStats {
         return AngleStats::default();
     }
     let mut mins: Vec<f64> = (0..n).map(|t| min_angle(mesh.triangle(t))).collect();
-    mins.sort_by(|a, b| a.total_cmp(b));
+    crate::sort::f64s(&mut mins);
     let p1 = mins[(n - 1) / 100];
     AngleStats { min_deg: mins[0].to_degrees(), p1_deg: p1.to_degrees() }
 }

@@ -424,7 +424,7 @@ fn coarse_search(surface: &dyn Surface, target: DVec3, n: usize) -> Starts {
             }
         }
     }
-    minima.sort_by(|a, b| a.0.total_cmp(&b.0));
+    crate::sort::by_f64(&mut minima, |m| m.0);
     let mut starts = Starts::one(lo);
     starts.len = 0;
     let mut on_edge = false;

@@ -414,7 +414,7 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Resu
     // can stall where the original's parameter speed jumps). A point whose
     // start is no farther than the worst found so far cannot raise it, so
     // the far starts go first and the rest are not projected.
-    checks.sort_by(|a, b| b.0.total_cmp(&a.0));
+    crate::sort::by_f64_desc(&mut checks, |c| c.0);
     let mut worst = [0.0f64; 3];
     for &(near, key) in &checks {
         let dir = key as usize % 3;

@@ -203,7 +203,7 @@ fn close_triangles(faces: &mut [FaceWork<'_>], open: &[Side], at_node: &HashMap<
             }
             // Into the face along whose border it lies longest, else the next.
             let mut order = [(len[0], s1, p[2], n3), (len[1], s2, p[0], n1), (len[2], s3, p[1], n2)];
-            order.sort_by(|x, y| y.0.total_cmp(&x.0));
+            crate::sort::by_f64_desc(&mut order, |o| o.0);
             for (_, s, q, g) in order {
                 let f = &mut faces[s.face as usize];
                 if f.mesh.close_beside(f.surface, &f.crit, s.a, s.b, q, g) {
@@ -260,7 +260,7 @@ fn close_polygons(faces: &mut [FaceWork<'_>], open: &[Side], at_node: &HashMap<u
         let p: Vec<DVec3> = (0..n).map(|m| pos_of(faces, &open[sides[m]], nodes[m])).collect();
         // Longest side first; where its face refuses the ear, the next.
         let mut by_length: Vec<usize> = (0..n).collect();
-        by_length.sort_by(|&x, &y| p[y].distance(p[(y + 1) % n]).total_cmp(&p[x].distance(p[(x + 1) % n])));
+        crate::sort::by_f64_desc(&mut by_length, |&x| p[x].distance(p[(x + 1) % n]));
         for m in by_length {
             let Some(far) = ear(&p, m, width) else { continue };
             let s = open[sides[m]];

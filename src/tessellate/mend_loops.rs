@@ -171,7 +171,7 @@ pub(crate) fn mend(loops: &mut Loops<'_>, file_ccw: &[bool]) -> Option<Mended> {
             })
             .collect();
         fs.push((1.0, seg.b));
-        fs.sort_by(|x, y| x.0.total_cmp(&y.0));
+        crate::sort::by_f64(&mut fs, |x| x.0);
         let mut prev = (seg.a, 0.0);
         for &(f, at) in &fs {
             if at == prev.0 {
@@ -190,7 +190,7 @@ pub(crate) fn mend(loops: &mut Loops<'_>, file_ccw: &[bool]) -> Option<Mended> {
         .filter(|(n, _)| *n != 0)
         .map(|(n, p)| (n.abs(), if (n > 0) == (p.a < p.b) { p } else { p.reversed() }))
         .collect();
-    net.sort_by_key(|(_, p)| (p.a, p.b));
+    crate::sort::by_u64(&mut net, |(_, p)| crate::sort::pair(p.a, p.b));
     let kept = boundary(&net, &pts);
     let out = link(&kept, &pts);
     let before = loops.polys.len();
@@ -209,7 +209,7 @@ pub(crate) fn mend(loops: &mut Loops<'_>, file_ccw: &[bool]) -> Option<Mended> {
     if polys.is_empty() {
         return None;
     }
-    polys.sort_by(|a, b| signed_area(&b.uv).abs().total_cmp(&signed_area(&a.uv).abs()));
+    crate::sort::by_f64_desc(&mut polys, |p| signed_area(&p.uv).abs());
     loops.polys = polys;
     Some(Mended { crossings, loops_before: before, loops_after: loops.polys.len(), dropped, rejoined: true, flat: 0 })
 }

@@ -84,7 +84,7 @@ pub fn share_of_faces(bodies: &[u32], faces: usize, index: u32, count: u32) -> V
         *sizes.entry(body(f)).or_insert(0) += 1;
     }
     let mut order: Vec<(u32, usize)> = sizes.into_iter().collect();
-    order.sort_unstable_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    crate::sort::by_u64(&mut order, |o| crate::sort::pair(u32::MAX - o.1.min(u32::MAX as usize) as u32, o.0));
     let count = count.max(1) as usize;
     let mut load = alloc::vec![0usize; count];
     let mut owner: crate::collections::HashMap<u32, usize> = crate::collections::HashMap::default();

@@ -438,7 +438,7 @@ impl Places {
     /// Sorts by node, keeping face order (the sort is stable), and drops a
     /// node's repeated places.
     fn index(&mut self) {
-        self.0.sort_by_key(|&(g, _)| g);
+        crate::sort::by_u64(&mut self.0, |&(g, _)| u64::from(g));
         let mut kept: Vec<(u32, DVec3)> = Vec::with_capacity(self.0.len());
         let mut start = 0;
         for &(g, p) in &self.0 {

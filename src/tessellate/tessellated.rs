@@ -152,7 +152,8 @@ impl<'a> Facets<'a> {
             }
         }
         let mut edges: Vec<RimEdge> = uses.into_values().filter(|u| u.0 == 1).map(|u| u.1).collect();
-        edges.sort_unstable_by_key(|e| (e.2, e.3, e.0, e.1));
+        crate::sort::by_u64(&mut edges, |e| crate::sort::pair(e.0, e.1));
+        crate::sort::by_u64(&mut edges, |e| crate::sort::pair(e.2, e.3));
         // Only the border's points are kept, renumbered.
         let mut keep = alloc::vec![NONE; places.len()];
         let mut points = Vec::new();
@@ -369,7 +370,7 @@ mod pin {
                     out.uv.push(poly.uv[i]);
                     out.at.push(poly.at[i]);
                     let mut from = ta;
-                    adds[i].sort_by(|x, y| x.0.total_cmp(&y.0));
+                    crate::sort::by_f64(&mut adds[i], |x| x.0);
                     let Some(c) = o.loops.curves.get(curve as usize) else {
                         out.seg.push((curve, from, tb));
                         continue;
@@ -468,7 +469,7 @@ pub(crate) fn snap_borders(works: &mut [FaceWork<'_>], facets: &Facets<'_>, bodi
                     (s > 0.0 && s < 1.0 && d <= reach).then_some((s, q))
                 })
                 .collect();
-            on.sort_by(|x, y| x.0.total_cmp(&y.0));
+            crate::sort::by_f64(&mut on, |x| x.0);
             // Split from the far end back, so the edge from `a` keeps its name.
             let mut end = b;
             let mut changed = Vec::new();
@@ -514,7 +515,10 @@ fn snap(works: &mut [FaceWork<'_>], rims: &[Rim], bodies: &[u32], reach: f64) ->
             }
         }
     }
-    pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2, x.3).cmp(&(y.1, y.2, y.3))));
+    // Stable passes, last key first: by (distance, rim, point, vertex).
+    crate::sort::by_u64(&mut pairs, |x| u64::from(x.3));
+    crate::sort::by_u64(&mut pairs, |x| crate::sort::pair(x.1, x.2));
+    crate::sort::by_f64(&mut pairs, |x| x.0);
     // A node is its id where it has one (all its faces' vertices), else its vertex.
     let node = |v: u32| {
         let (_, _, f, x, g) = verts[v as usize];
@@ -618,7 +622,7 @@ pub(crate) fn split_rims(works: &mut [FaceWork<'_>], facets: &mut Facets<'_>, bo
             }
             let Some(mut pts) = pts.filter(|p| !p.is_empty()) else { continue };
             let ab = pb - pa;
-            pts.sort_by(|x, y| (*x - pa).dot(ab).total_cmp(&(*y - pa).dot(ab)));
+            crate::sort::by_f64(&mut pts, |x| (*x - pa).dot(ab));
             pts.dedup_by(|x, y| bits(*x) == bits(*y));
             let (pos, _, tris) = facets.parts(f as usize);
             let Some(tri) = tris.get(t as usize) else { continue };
@@ -630,7 +634,7 @@ pub(crate) fn split_rims(works: &mut [FaceWork<'_>], facets: &mut Facets<'_>, bo
         }
     }
     let mut cuts: Cuts = cuts.into_iter().collect();
-    cuts.sort_by_key(|c| c.0);
+    crate::sort::by_u64(&mut cuts, |c| crate::sort::pair(c.0 .0, c.0 .1));
     for ((f, t), pts) in cuts {
         if let Some(m) = facets.cut_mesh(f as usize) {
             m.cut(t as usize, &pts);

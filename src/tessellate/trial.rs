@@ -124,7 +124,7 @@ pub(super) fn p1(m: &refine::WorkMesh) -> f64 {
         .iter()
         .map(|t| crate::mesh::min_angle(t.map(|v| m.pos.get(v as usize).copied().unwrap_or_default())))
         .collect();
-    a.sort_by(f64::total_cmp);
+    crate::sort::f64s(&mut a);
     a.get(a.len().saturating_sub(1) / 100).map_or(0.0, |x| x.to_degrees())
 }
 

@@ -92,7 +92,7 @@ impl Loops<'_> {
                     xs.push(a.x + (y - a.y) / (b.y - a.y) * (b.x - a.x));
                 }
             }
-            xs.sort_by(|p, q| p.total_cmp(q));
+            crate::sort::f64s(&mut xs);
             // Node x is inside when an odd number of crossings lie to its right.
             let mut k = 0;
             for (i, &x) in pu.iter().enumerate() {
@@ -115,7 +115,7 @@ impl Loops<'_> {
                 xs.push(a.x + (s - a.y) / (b.y - a.y) * (b.x - a.x));
             }
         }
-        xs.sort_by(|p, q| p.total_cmp(q));
+        crate::sort::f64s(&mut xs);
         xs.chunks_exact(2).map(|c| (c[0], c[1])).collect()
     }
 

@@ -1,6 +1,7 @@
 // The page in headless Chromium, driven as a user would and judged by what it
 // shows: the default sample's mesh and its numbers, a finer tolerance, a
-// broken file, a good file, the exports, cancel, the display toggles, quality mode, and the
+// broken file, a good file, a STEP assembly drawn by instances, the exports,
+// cancel, the display toggles, quality mode, repair (the full build) and the
 // time from navigation to the first mesh on screen. Screenshots go to
 // tests/browser/screenshots/.
 //
@@ -210,6 +211,8 @@ test('a STEP assembly meshes, and a picked face names its part', async () => {
   assert.equal(state, 'ready', await page.textContent('#error-message'));
   assert.equal(await stat('stat-faces'), 12);
   assert.equal(await stat('stat-open-edges'), 0, 'two closed blocks');
+  // One block placed twice: meshed once, drawn by one InstancedMesh with two copies.
+  assert.equal(await page.getAttribute('body', 'data-instanced'), '1/2');
   const box = await page.locator('#canvas').boundingBox();
   let text = '';
   let at = null;
@@ -230,6 +233,7 @@ test('a STEP assembly meshes, and a picked face names its part', async () => {
   });
   assert.equal(again, 'ready', await page.textContent('#error-message'));
   assert.match(await page.textContent('#stat-time'), /· [2-4] workers$/);
+  assert.equal(await page.getAttribute('body', 'data-instanced'), '1/2', 'the shares merged into one part, placed twice');
   assert.equal(await stat('stat-faces'), 12);
   assert.equal(await stat('stat-open-edges'), 0, 'still two closed blocks');
   assert.ok((await stat('stat-triangles')) >= before);
@@ -400,5 +404,30 @@ test('quality mode meshes near-equilateral triangles of the chosen size; the can
   await settle(() => page.click('.segmented label:has-text("Fast")'));
   assert.equal(await stat('stat-triangles'), fast, 'fast mode gives its mesh back');
   assert.equal(await page.textContent('#stat-good-angles'), '—');
+  assert.deepEqual(page.errors, []);
+});
+
+test('repair runs in the full build: the can mesh comes back closed and without self-intersections', async () => {
+  // A model other than the can first, so that choosing the can re-meshes.
+  await settle(() => page.selectOption('#sample', 'plate.json'));
+  assert.ok(await page.isDisabled('#repair') === false, 'repair is offered once a mesh is shown');
+  await settle(() => page.selectOption('#sample', 'can.json'));
+  const meshed = await stat('stat-triangles');
+  const state = await settle(() => page.click('#repair'));
+  assert.equal(state, 'ready', await page.textContent('#error-message'));
+  assert.equal(await page.textContent('#quality'), 'repaired');
+  // The status names the build that repaired it: the full one, loaded for this.
+  assert.match(await page.textContent('#status'), /^Repaired \(full [\w.+-]+\): [\d,]+ triangles, closed, 0 self-intersections/);
+  const repaired = await stat('stat-triangles');
+  assert.ok(repaired > meshed / 2 && repaired < 2 * meshed, `${repaired} triangles after repair, ${meshed} before`);
+  assert.equal(await stat('stat-free-edges'), 0);
+  assert.equal(await stat('stat-nonmanifold'), 0);
+  await shot(page, '12-repaired');
+  // Any option change shows the model's own mesh again.
+  await settle(async () => {
+    await page.fill('#tol-value', '0.002');
+    await page.press('#tol-value', 'Enter');
+  });
+  assert.equal(await page.textContent('#quality'), 'final');
   assert.deepEqual(page.errors, []);
 });

@@ -137,20 +137,45 @@ function showStats(report, quality) {
   badge.hidden = false;
   badge.textContent = quality === 'final' ? 'final' : 'coarse preview';
   badge.className = `badge ${quality}`;
+  showWarnings(report.warnings);
+}
+
+function showWarnings(warnings) {
   const list = $('warnings');
   list.replaceChildren();
-  for (const w of report.warnings) {
+  for (const w of warnings) {
     const li = document.createElement('li');
     li.textContent = w;
     list.append(li);
   }
-  if (report.warnings.length === 0) {
+  if (warnings.length === 0) {
     const li = document.createElement('li');
     li.className = 'muted';
     li.textContent = 'none';
     list.append(li);
   }
-  $('warning-count').textContent = report.warnings.length ? String(report.warnings.length) : '';
+  $('warning-count').textContent = warnings.length ? String(warnings.length) : '';
+}
+
+/** The numbers of a repaired mesh: its edge census after repair; what only a mesh from a model has is "—". */
+function showRepairStats(report) {
+  setStat('stat-faces', '1 (repaired mesh)');
+  setStat('stat-triangles', count(report.triangles_out));
+  setStat('stat-vertices', count(report.vertices_out));
+  for (const id of ['tolerance', 'max-deviation', 'mean-deviation', 'min-angle', 'reparam', 'good-angles', 'edge-band']) {
+    setStat(`stat-${id}`, '—');
+  }
+  $('stat-units').textContent = '';
+  const census = report.census_out;
+  setStat('stat-free-edges', count(census.free_edges), census.free_edges === 0 ? 'ok' : 'bad');
+  setStat('stat-open-edges', count(census.free_edges));
+  setStat('stat-nonmanifold', count(census.nonmanifold_edges), census.nonmanifold_edges === 0 ? '' : 'bad');
+  setStat('stat-time', `${report.parse_ms.toFixed(1)} / ${report.time_ms.total.toFixed(1)} ms`);
+  const badge = $('quality');
+  badge.hidden = false;
+  badge.textContent = 'repaired';
+  badge.className = 'badge final';
+  showWarnings(report.warnings);
 }
 
 /** Which faces the ratio test flagged and which of them were rebuilt (paper 001). */
@@ -359,7 +384,11 @@ function display(result, lines, quality, { fit }) {
     });
   };
   viewer.show(result, lines, { fit, overlays: quality !== 'coarse' });
-  showStats(result.report, quality);
+  // How the model is drawn: InstancedMesh objects / copies they place (a plain mesh: 1/1).
+  const drawn = viewer.instancing();
+  body.dataset.instanced = `${drawn.meshes}/${drawn.copies}`;
+  if (quality === 'repaired') showRepairStats(result.report);
+  else showStats(result.report, quality);
   setExport(true);
 }
 
@@ -378,7 +407,7 @@ function cancel() {
 // ---------------------------------------------------------------- export
 
 function setExport(enabled) {
-  for (const id of ['export-stl', 'export-obj', 'export-glb']) $(id).disabled = !enabled;
+  for (const id of ['export-stl', 'export-obj', 'export-glb', 'repair']) $(id).disabled = !enabled;
 }
 
 function download(blob, filename) {
@@ -399,10 +428,50 @@ $('export-stl').onclick = () => state.shown && download(toStl(state.shown.result
 $('export-obj').onclick = () => state.shown && download(toObj(state.shown.result, `surfmesh ${stem()}`), `${stem()}.obj`);
 $('export-glb').onclick = () => state.shown && download(toGlb(state.shown.result, PALETTE), `${stem()}.glb`);
 
+// ---------------------------------------------------------------- repair
+
+/**
+ * Repairs the shown mesh in a worker with the full build (loaded on the
+ * first use): the mesh goes as binary STL, the repaired one is shown with
+ * its edge census. A re-mesh (any option change) shows the model's mesh again.
+ */
+async function repairShown() {
+  if (!state.shown) return;
+  const bytes = await toStl(state.shown.result, `surfmesh ${stem()}`).arrayBuffer();
+  pool.cancelAll();
+  const run = ++state.run;
+  hideError();
+  setState('meshing');
+  showProgress(0, 0);
+  status(`Repairing the mesh of ${state.model?.name ?? 'the model'} (full build)…`);
+  pool.mesh(bytes, 'stl', { repair: { verify: true } }).promise.then(
+    ({ result, lines }) => {
+      if (run !== state.run) return;
+      display(result, lines, 'repaired', { fit: false });
+      hideProgress();
+      setState('ready');
+      const r = result.report;
+      const closed = r.census_out.free_edges === 0 && r.census_out.nonmanifold_edges === 0;
+      status(
+        `Repaired (${r.build}): ${count(r.triangles_out)} triangles, ` +
+          `${closed ? 'closed' : `${count(r.census_out.free_edges)} free edges`}, ` +
+          `${r.self_intersections_out ?? '?'} self-intersections · ${r.time_ms.total.toFixed(0)} ms`,
+      );
+    },
+    (error) => {
+      if (run !== state.run) return;
+      hideProgress();
+      setState('error');
+      showError('Could not repair the mesh', error.message);
+    },
+  );
+}
+
 // ---------------------------------------------------------------- controls
 
 $('angle').value = DEFAULT_ANGLE_DEG;
 $('cancel').onclick = cancel;
+$('repair').onclick = repairShown;
 $('error-close').onclick = hideError;
 $('fit').onclick = () => viewer.fit();
 viewer.canvas.addEventListener('dblclick', () => viewer.fit());

@@ -244,49 +244,7 @@ export class MeshPool {
 export function mergeShares(parts) {
   const results = parts.map((p) => p.result);
   const first = results[0];
-  const faces = first.faceRanges.length / 2;
-  let triangles = 0;
-  let vertices = 0;
-  const blocks = []; // per face: [share, first triangle, count, lowest vertex, highest vertex]
-  for (let f = 0; f < faces; f++) {
-    const s = results.findIndex((r) => r.faceRanges[2 * f + 1] > 0);
-    if (s < 0) {
-      blocks.push(null);
-      continue;
-    }
-    const r = results[s];
-    const [t0, n] = [r.faceRanges[2 * f], r.faceRanges[2 * f + 1]];
-    let lo = Infinity;
-    let hi = -1;
-    for (let k = 3 * t0; k < 3 * (t0 + n); k++) {
-      lo = Math.min(lo, r.indices[k]);
-      hi = Math.max(hi, r.indices[k]);
-    }
-    blocks.push([s, t0, n, lo, hi]);
-    triangles += n;
-    vertices += hi - lo + 1;
-  }
-  const positions = new Float32Array(3 * vertices);
-  const normals = new Float32Array(3 * vertices);
-  const indices = new Uint32Array(3 * triangles);
-  const faceRanges = new Uint32Array(2 * faces);
-  const remap = results.map((r) => new Int32Array(r.positions.length / 3).fill(-1));
-  let v = 0;
-  let t = 0;
-  for (let f = 0; f < faces; f++) {
-    faceRanges[2 * f] = t;
-    const b = blocks[f];
-    if (!b) continue;
-    const [s, t0, n, lo, hi] = b;
-    const r = results[s];
-    positions.set(r.positions.subarray(3 * lo, 3 * (hi + 1)), 3 * v);
-    normals.set(r.normals.subarray(3 * lo, 3 * (hi + 1)), 3 * v);
-    for (let x = lo; x <= hi; x++) remap[s][x] = v + x - lo;
-    for (let k = 3 * t0; k < 3 * (t0 + n); k++) indices[3 * t + k - 3 * t0] = remap[s][r.indices[k]];
-    faceRanges[2 * f + 1] = n;
-    v += hi - lo + 1;
-    t += n;
-  }
+  const { positions, normals, indices, faceRanges, remap, triangles, vertices } = mergeFaces(results);
   const wire = [];
   parts.forEach((p, s) => {
     const w = p.lines.wire;
@@ -330,8 +288,69 @@ export function mergeShares(parts) {
     reparameterized: reps.flatMap((r) => r.reparameterized ?? []),
     shares: reps.length,
   };
+  // The part meshes of an instanced result: each part's faces from the shares that meshed them.
+  let instanced = first.instanced;
+  if (instanced) {
+    const meshes = instanced.meshes.map((m, p) => {
+      const { positions: ps, normals: ns, indices: is, faceRanges: fr } = mergeFaces(results.map((r) => r.instanced.meshes[p]));
+      return { name: m.name, positions: ps, normals: ns, indices: is, faceRanges: fr };
+    });
+    instanced = { meshes, instances: instanced.instances };
+  }
   return {
-    result: { ...first, positions, normals, indices, faceRanges, report },
+    result: { ...first, positions, normals, indices, faceRanges, report, instanced },
     lines: { wire: new Uint32Array(wire), borders: join('borders'), open: join('open') },
   };
+}
+
+/**
+ * One mesh from several meshes of the same faces, each face taken from the
+ * first mesh that has triangles for it (a face is meshed by one share only);
+ * `remap[s][v]` is where vertex v of mesh s went (-1: not taken).
+ */
+function mergeFaces(results) {
+  const faces = results[0].faceRanges.length / 2;
+  let triangles = 0;
+  let vertices = 0;
+  const blocks = []; // per face: [share, first triangle, count, lowest vertex, highest vertex]
+  for (let f = 0; f < faces; f++) {
+    const s = results.findIndex((r) => r.faceRanges[2 * f + 1] > 0);
+    if (s < 0) {
+      blocks.push(null);
+      continue;
+    }
+    const r = results[s];
+    const [t0, n] = [r.faceRanges[2 * f], r.faceRanges[2 * f + 1]];
+    let lo = Infinity;
+    let hi = -1;
+    for (let k = 3 * t0; k < 3 * (t0 + n); k++) {
+      lo = Math.min(lo, r.indices[k]);
+      hi = Math.max(hi, r.indices[k]);
+    }
+    blocks.push([s, t0, n, lo, hi]);
+    triangles += n;
+    vertices += hi - lo + 1;
+  }
+  const positions = new Float32Array(3 * vertices);
+  const normals = new Float32Array(3 * vertices);
+  const indices = new Uint32Array(3 * triangles);
+  const faceRanges = new Uint32Array(2 * faces);
+  const remap = results.map((r) => new Int32Array(r.positions.length / 3).fill(-1));
+  let v = 0;
+  let t = 0;
+  for (let f = 0; f < faces; f++) {
+    faceRanges[2 * f] = t;
+    const b = blocks[f];
+    if (!b) continue;
+    const [s, t0, n, lo, hi] = b;
+    const r = results[s];
+    positions.set(r.positions.subarray(3 * lo, 3 * (hi + 1)), 3 * v);
+    normals.set(r.normals.subarray(3 * lo, 3 * (hi + 1)), 3 * v);
+    for (let x = lo; x <= hi; x++) remap[s][x] = v + x - lo;
+    for (let k = 3 * t0; k < 3 * (t0 + n); k++) indices[3 * t + k - 3 * t0] = remap[s][r.indices[k]];
+    faceRanges[2 * f + 1] = n;
+    v += hi - lo + 1;
+    t += n;
+  }
+  return { positions, normals, indices, faceRanges, remap, triangles, vertices };
 }

@@ -1,5 +1,6 @@
 // The three.js viewer: a shaded mesh with one colour per model face (groups
-// from surfmesh/three), a wireframe overlay, face borders and open edges as
+// from surfmesh/three; a model of placed parts as one InstancedMesh per
+// distinct part, the part's faces coloured alike in every copy), a wireframe overlay, face borders and open edges as
 // line sets, orbit controls and fit-to-view. Renders on demand (after a
 // change or a camera move), so an idle page costs nothing.
 
@@ -49,6 +50,8 @@ export class Viewer {
 
     // The palette, then the highlight of a picked face (last index).
     this.faceMaterials = [...PALETTE, HIGHLIGHT].map((color) => this.#shaded(color));
+    // A picked face of placed parts: its copy drawn over the instances (which sit a little behind).
+    this.pickMaterial = new THREE.MeshPhongMaterial({ color: HIGHLIGHT, side: THREE.DoubleSide });
     const plain = this.#shaded(NEUTRAL);
     this.plainMaterials = [...PALETTE.map(() => plain), this.faceMaterials[PALETTE.length]];
     this.wireMaterial = new THREE.LineBasicMaterial({ color: 0x12161c, transparent: true, opacity: 0.35 });
@@ -116,7 +119,7 @@ export class Viewer {
   show(result, lines, { fit = false, overlays = true } = {}) {
     this.clear();
     const geometry = toBufferGeometry(result, { materialCount: PALETTE.length });
-    const shaded = new THREE.Mesh(geometry, this.faceMaterials);
+    const shaded = result.instanced ? this.#instanced(result.instanced) : new THREE.Mesh(geometry, this.faceMaterials);
     // The wireframe: the worker's edge list over the same vertex buffer (one line per edge).
     const wireGeometry = new THREE.BufferGeometry();
     wireGeometry.setAttribute('position', geometry.getAttribute('position'));
@@ -125,11 +128,53 @@ export class Viewer {
     const borders = segments(lines.borders, this.borderMaterial);
     const open = segments(lines.open, this.openMaterial);
     open.renderOrder = 2;
-    this.parts = { geometry, shaded, wire, borders, open, overlays, faceRanges: result.faceRanges, picked: -1 };
-    this.group.add(shaded, wire, borders, open);
+    // Over placed parts, the picked face is drawn from the merged mesh (one group, or none).
+    const pickGeometry = new THREE.BufferGeometry();
+    pickGeometry.setAttribute('position', geometry.getAttribute('position'));
+    pickGeometry.setAttribute('normal', geometry.getAttribute('normal'));
+    pickGeometry.setIndex(geometry.getIndex());
+    const pickedMesh = new THREE.Mesh(pickGeometry, [this.pickMaterial]);
+    pickedMesh.visible = false;
+    const faceStart = instanceFaceStarts(result);
+    this.parts = { geometry, shaded, wire, borders, open, pickedMesh, faceStart, overlays, faceRanges: result.faceRanges, picked: -1 };
+    this.group.add(shaded, wire, borders, open, pickedMesh);
     this.apply();
     if (fit) this.fit();
     this.requestRender();
+  }
+
+  /**
+   * Placed parts as a group of InstancedMesh, one per distinct part: its
+   * geometry (a draw group per face) shared by every copy, each copy's matrix
+   * the instance's; `userData.instances` maps a copy to its instance.
+   */
+  #instanced({ meshes, instances }) {
+    const group = new THREE.Group();
+    const copies = meshes.map(() => []);
+    const which = meshes.map(() => []); // per part, the instance index of each copy
+    instances.forEach((inst, k) => {
+      copies[inst.part]?.push(new THREE.Matrix4().fromArray(inst.matrix));
+      which[inst.part]?.push(k);
+    });
+    meshes.forEach((part, p) => {
+      if (copies[p].length === 0) return;
+      const mesh = new THREE.InstancedMesh(toBufferGeometry(part, { materialCount: PALETTE.length }), this.faceMaterials, copies[p].length);
+      copies[p].forEach((m, i) => mesh.setMatrixAt(i, m));
+      mesh.instanceMatrix.needsUpdate = true;
+      mesh.computeBoundingBox();
+      mesh.computeBoundingSphere();
+      mesh.userData.part = p;
+      mesh.userData.instances = which[p];
+      group.add(mesh);
+    });
+    return group;
+  }
+
+  /** Draw calls of the shaded model: InstancedMesh objects and the copies they place (a plain mesh: 1 and 1). */
+  instancing() {
+    const shaded = this.parts?.shaded;
+    if (!shaded?.isGroup) return { meshes: shaded ? 1 : 0, copies: shaded ? 1 : 0 };
+    return { meshes: shaded.children.length, copies: shaded.children.reduce((n, m) => n + m.count, 0) };
   }
 
   /**
@@ -142,8 +187,17 @@ export class Viewer {
     const ndc = new THREE.Vector2(((x - rect.left) / rect.width) * 2 - 1, -((y - rect.top) / rect.height) * 2 + 1);
     const ray = new THREE.Raycaster();
     ray.setFromCamera(ndc, this.camera);
-    const hit = ray.intersectObject(this.parts.shaded, false)[0];
-    const face = hit ? faceOfTriangle(this.parts.faceRanges, hit.faceIndex) : -1;
+    const hit = ray.intersectObject(this.parts.shaded, true)[0];
+    let face = -1;
+    if (hit?.instanceId !== undefined) {
+      // A copy of a part: the part's face, counted from where that instance's faces start.
+      const part = hit.object.geometry.userData.faceRanges;
+      const j = faceOfTriangle(part, hit.faceIndex);
+      const k = hit.object.userData.instances[hit.instanceId];
+      if (j >= 0) face = this.parts.faceStart[k] + j;
+    } else if (hit) {
+      face = faceOfTriangle(this.parts.faceRanges, hit.faceIndex);
+    }
     if (highlight) this.highlight(face);
     return face;
   }
@@ -151,6 +205,16 @@ export class Viewer {
   /** Draws model face `face` in the highlight colour (-1: none). */
   highlight(face) {
     if (!this.parts) return;
+    if (this.parts.shaded.isGroup) {
+      const g = this.parts.pickedMesh.geometry;
+      g.clearGroups();
+      const r = this.parts.faceRanges;
+      if (face >= 0) g.addGroup(3 * r[2 * face], 3 * r[2 * face + 1], 0);
+      this.parts.pickedMesh.visible = face >= 0;
+      this.parts.picked = face;
+      this.requestRender();
+      return;
+    }
     const groups = this.parts.geometry.groups;
     const ranges = this.parts.faceRanges;
     for (const g of groups) {
@@ -164,9 +228,11 @@ export class Viewer {
   /** Removes the shown mesh and frees its GPU buffers. */
   clear() {
     if (!this.parts) return;
-    for (const part of [this.parts.shaded, this.parts.wire, this.parts.borders, this.parts.open]) {
+    for (const part of [this.parts.shaded, this.parts.wire, this.parts.borders, this.parts.open, this.parts.pickedMesh]) {
       this.group.remove(part);
     }
+    if (this.parts.shaded.isGroup) for (const m of this.parts.shaded.children) m.geometry.dispose();
+    this.parts.pickedMesh.geometry.dispose();
     this.parts.geometry.dispose();
     this.parts.wire.geometry.dispose();
     this.parts.borders.geometry.dispose();
@@ -185,7 +251,9 @@ export class Viewer {
   apply() {
     if (!this.parts) return;
     const o = this.options;
-    this.parts.shaded.material = o.faceColors ? this.faceMaterials : this.plainMaterials;
+    const materials = o.faceColors ? this.faceMaterials : this.plainMaterials;
+    if (this.parts.shaded.isGroup) for (const m of this.parts.shaded.children) m.material = materials;
+    else this.parts.shaded.material = materials;
     const overlays = this.parts.overlays;
     this.parts.wire.visible = overlays && o.wireframe;
     this.parts.borders.visible = overlays && o.borders;
@@ -248,6 +316,19 @@ export class Viewer {
       if (this.onRendered) this.onRendered();
     });
   }
+}
+
+/** Where each instance's faces start in the merged mesh (instance after instance); null without instances. */
+function instanceFaceStarts(result) {
+  if (!result.instanced) return null;
+  const { meshes, instances } = result.instanced;
+  const starts = new Uint32Array(instances.length);
+  let f = 0;
+  instances.forEach((inst, k) => {
+    starts[k] = f;
+    f += meshes[inst.part].faceRanges.length / 2;
+  });
+  return starts;
 }
 
 /** Whether the context is drawn by a software rasterizer (SwiftShader, llvmpipe, ...). */

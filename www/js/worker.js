@@ -13,19 +13,21 @@
 // meshes the default sample from its own fetch, so the first mesh never waits
 // for the page's thread (busy parsing three.js while this runs).
 //
-// The full build is imported on the first quality-mode request.
+// The full build is imported on the first quality-mode or repair request.
 //
 // Messages in:  { type: 'init', module } | { type: 'boot', wasm, sample?, id, options }
-//               then { type: 'mesh', id, bytes, format, options }
+//               then { type: 'mesh', id, bytes, format, options }; with options.repair
+//               (the repair options) the mesh in `bytes` (STL or OBJ) is repaired instead
 // Messages out: { type: 'module', module } | { type: 'module', error } (after boot) | { type: 'ready' } | { type: 'fatal', message }
 //               { type: 'progress', id, done, total }
 //               { type: 'result', id, result, lines: { wire, borders, open } }
 //               { type: 'error', id, message }
 
 import init, { meshWithProgress, version } from '../pkg/web/surfmesh.js';
+import { flattened } from './instanced.js';
 
 // The package's full build (surfmesh/full), loaded the first time a request
-// needs what only it has (quality mode); the viewer build does the rest.
+// needs what only it has (quality mode, repair); the viewer build does the rest.
 let full = null;
 function fullBuild() {
   full ??= import('../pkg/full/web/surfmesh.js').then(async (m) => {
@@ -97,21 +99,49 @@ async function run(id, bytes, format, options) {
   }
   let result;
   try {
-    // The page draws one merged mesh (flatten); quality mode is the full build's.
-    const build = options?.mode === 'quality' ? await fullBuild() : { meshWithProgress };
-    result = build.meshWithProgress(new Uint8Array(bytes), format, { ...options, flatten: true }, (done, total) => {
-      self.postMessage({ type: 'progress', id, done, total });
-    });
+    if (options?.repair) {
+      // Repair is the full build's: the mesh in `bytes` made closed and free of self-intersections.
+      const { repair, version: fullVersion } = await fullBuild();
+      result = repaired(repair(new Uint8Array(bytes), format, options.repair), fullVersion());
+    } else {
+      // Each distinct part meshed once, placed by its instances; quality mode is the full build's.
+      const build = options?.mode === 'quality' ? await fullBuild() : { meshWithProgress };
+      const out = build.meshWithProgress(new Uint8Array(bytes), format, { ...options, flatten: false }, (done, total) => {
+        self.postMessage({ type: 'progress', id, done, total });
+      });
+      result = flattened(out);
+    }
   } catch (e) {
     self.postMessage({ type: 'error', id, message: e instanceof Error ? e.message : String(e) });
     return;
   }
   const lines = edgeLines(result);
-  const buffers = [result.positions, result.normals, result.indices, result.faceRanges, lines.wire, lines.borders, lines.open];
-  self.postMessage(
-    { type: 'result', id, result, lines },
-    buffers.map((a) => a.buffer),
-  );
+  const arrays = [result.positions, result.normals, result.indices, result.faceRanges, lines.wire, lines.borders, lines.open];
+  for (const m of result.instanced?.meshes ?? []) arrays.push(m.positions, m.normals, m.indices, m.faceRanges);
+  // A buffer is listed once (a single instance's arrays are the part's own).
+  self.postMessage({ type: 'result', id, result, lines }, [...new Set(arrays.map((a) => a.buffer))]);
+}
+
+/**
+ * A repair result in the shape of a mesh result: one face, vertex normals
+ * (area-weighted means of the triangles'), and the repair report with the
+ * full build's version.
+ */
+function repaired({ positions, indices, report }, version) {
+  const normals = new Float32Array(positions.length);
+  for (let t = 0; t < indices.length; t += 3) {
+    const [a, b, c] = [3 * indices[t], 3 * indices[t + 1], 3 * indices[t + 2]];
+    const u = [positions[b] - positions[a], positions[b + 1] - positions[a + 1], positions[b + 2] - positions[a + 2]];
+    const v = [positions[c] - positions[a], positions[c + 1] - positions[a + 1], positions[c + 2] - positions[a + 2]];
+    const n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+    for (const i of [a, b, c]) for (let k = 0; k < 3; k++) normals[i + k] += n[k];
+  }
+  for (let i = 0; i < normals.length; i += 3) {
+    const len = Math.hypot(normals[i], normals[i + 1], normals[i + 2]) || 1;
+    for (let k = 0; k < 3; k++) normals[i + k] /= len;
+  }
+  const faceRanges = new Uint32Array([0, indices.length / 3]);
+  return { positions, normals, indices, faceRanges, report: { ...report, build: `full ${version}` } };
 }
 
 /** Wireframe index pairs, and face-border and open-edge segments (x, y, z pairs), of a mesh. */

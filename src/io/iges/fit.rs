@@ -174,7 +174,7 @@ impl Track {
         let breaks = curve.knots().breakpoints();
         if breaks.len() < MAX_SAMPLES / 4 {
             ts.extend(breaks.iter().copied().filter(|&k| k > a && k < b));
-            ts.sort_by(f64::total_cmp);
+            crate::sort::f64s(&mut ts);
             ts.dedup_by(|x, y| (*x - *y).abs() <= 1e-12 * (b - a));
         }
         let mut tr = Self { curve, model, ts, qs: Vec::new(), free_ends: [[false; 2]; 2], retry: true };

@@ -151,7 +151,7 @@ fn no_faces(dir: &Directory) -> String {
             None => kinds.push((e.kind, 1)),
         }
     }
-    kinds.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    crate::sort::by_u64(&mut kinds, |k| crate::sort::pair(u32::MAX - k.1.min(u32::MAX as usize) as u32, k.0));
     let shown: Vec<String> = kinds.iter().take(6).map(|(k, n)| alloc::format!("{n} of type {k}")).collect();
     let more = if kinds.len() > 6 { ", …" } else { "" };
     alloc::format!(

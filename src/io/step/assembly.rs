@@ -260,7 +260,7 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
         children.contains_key(&gi)
             || members.get(&gi).is_some_and(|ms| ms.iter().any(|&i| product_of_rep.contains_key(&reps[i].0)))
     };
-    roots.sort_by_key(|&r| !in_products(r));
+    crate::sort::by_u64(&mut roots, |&r| u64::from(!in_products(r)));
     // The output unit's view of a map between millimetre coordinates.
     let out_map = |m: DAffine3| scale_out * m * scale_out.inverse();
     /// A node to visit: its group, its map to the output (mm), its name, its

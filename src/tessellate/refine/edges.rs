@@ -56,7 +56,7 @@ impl<V: Copy> EdgeList<V> {
 
     /// The list of `items`, sorted (the last of a repeated key wins).
     pub fn from_unsorted(mut items: Vec<((u32, u32), V)>) -> Self {
-        items.sort_by_key(|e| e.0);
+        crate::sort::by_u64(&mut items, |e| crate::sort::pair(e.0 .0, e.0 .1));
         items.dedup_by(|later, earlier| {
             let same = later.0 == earlier.0;
             if same {

@@ -269,7 +269,7 @@ fn insertions(
     // The gaps the model has, and those of each pair of faces side by
     // side (counted at the nodes whose nearest other face is the other).
     let q90 = |gaps: &mut Vec<f64>| {
-        gaps.sort_by(f64::total_cmp);
+        crate::sort::f64s(gaps);
         gaps.get((gaps.len() * 9) / 10).copied().unwrap_or(0.0)
     };
     let mut gaps: Vec<f64> = nearest.iter().flatten().flatten().copied().filter(|d| !d.is_nan()).collect();
@@ -320,7 +320,7 @@ fn insertions(
     drop((nearest_face, pair_sew));
     let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
     let mut adds: Additions = per_node(pos, Vec::new());
-    cands.sort_by(|x, y| x.3.total_cmp(&y.3));
+    crate::sort::by_f64(&mut cands, |c| c.3);
     for &(seg, s, t, d, q) in &cands {
         let (fi, k, i) = (seg.0 as usize, seg.1 as usize, seg.2 as usize);
         let limit = if seg.0 == q.0 { tight.min(r_of(q)) } else { r_of(q) };
@@ -360,7 +360,7 @@ fn insertions(
         }
     }
     for list in adds.iter_mut().flatten().flatten() {
-        list.sort_by(|x, y| x.0.total_cmp(&y.0));
+        crate::sort::by_f64(list, |x| x.0);
     }
     (adds, radius, sew)
 }
@@ -564,7 +564,7 @@ fn name_nodes(
                 }
             }
         }
-        pairs.sort_by(|x, y| x.0.total_cmp(&y.0));
+        crate::sort::by_f64(&mut pairs, |x| x.0);
         for (_, a, b) in pairs {
             cl.union(a, b);
         }

@@ -167,7 +167,7 @@ mod tests {
         let p = &o.loops.polys[0];
         let mut v: Vec<(f64, u32)> =
             p.uv.iter().zip(&o.gids[0]).filter(|(q, _)| (q.x - 1.0).abs() < 1e-12).map(|(q, &g)| (q.y, g)).collect();
-        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        crate::sort::by_f64(&mut v, |x| x.0);
         v
     }
 
