@@ -15,7 +15,7 @@
 use alloc::vec::Vec;
 use glam::DVec2;
 
-use super::trim::{CurveRef, Loops, Polyline};
+use super::trim::{signed_area, CurveRef, Loops, Polyline};
 use crate::collections::HashMap;
 
 /// What mending changed, for the face's warning.
@@ -279,11 +279,6 @@ fn contains(p: &[DVec2], q: DVec2) -> bool {
         }
     }
     inside
-}
-
-fn signed_area(p: &[DVec2]) -> f64 {
-    let n = p.len();
-    0.5 * (0..n).map(|i| p[i].perp_dot(p[(i + 1) % n])).sum::<f64>()
 }
 
 /// Where each segment must be cut (fractions along it, strictly inside):

@@ -348,7 +348,8 @@ fn dedup_closed(p: &mut Polyline) {
     p.at = at;
 }
 
-fn signed_area(p: &[DVec2]) -> f64 {
+/// Signed area of a closed polygon: positive when it runs counter-clockwise.
+pub(super) fn signed_area(p: &[DVec2]) -> f64 {
     let n = p.len();
     let mut a = 0.0;
     for i in 0..n {
