@@ -418,7 +418,7 @@ pub fn mesh_model_with_progress(
         if out.creased > 0 {
             report.warnings.push(format!(
                 "face {index}: {} triangles turn more than the angle limit where the surface folds or creases; \
-                 not split below a tenth of the tolerance",
+                 not split below a tenth of the tolerance (below the tolerance where it turns past a right angle)",
                 out.creased
             ));
         }

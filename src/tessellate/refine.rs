@@ -326,7 +326,8 @@ impl WorkMesh {
             // line: a zig-zag strip's every fold) and none where the surface
             // collapses (a cone's apex): a triangle there turns by what it
             // sees from its side. Else every triangle on the other side of
-            // a crease was split down to a tenth of the tolerance.
+            // a crease was split down to the crease limit (see
+            // `Criteria::short_for_angle`).
             let centre = (uv[0] + uv[1] + uv[2]) / 3.0;
             let inside: [Option<DVec3>; 3] = core::array::from_fn(|k| {
                 [1e-6, 1e-4, 1e-2].iter().find_map(|f| regular_normal(&surface.derivs(uv[k] + (centre - uv[k]) * *f)))

@@ -3,6 +3,11 @@
 
 use super::TriMeasure;
 
+/// A normal turn past a right angle inside one triangle: the surface folds
+/// back there or is within the tolerance of a sharp edge (see
+/// [`Criteria::short_for_angle`]).
+const FOLD_TURN: f64 = core::f64::consts::FRAC_PI_2;
+
 /// Limits a triangle must meet.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Criteria {
@@ -44,9 +49,16 @@ impl Criteria {
     /// by up to 180° however small the triangle, and splitting down to
     /// `min_edge` there only breeds millions of triangles (a folded patch
     /// took 3.9M triangles and two minutes). Detail a tenth of the tolerance
-    /// wide cannot be seen within the tolerance anyway.
+    /// wide cannot be seen within the tolerance anyway. Where the normal
+    /// turns past a right angle within the tolerance, the surface folds back
+    /// on itself (a pleat) or bends tighter than a radius of 0.64× the
+    /// tolerance: within the tolerance of a sharp edge, so splitting stops
+    /// there at the tolerance's length.
     pub fn short_for_angle(&self, m: &TriMeasure, turn: f64, len: f64) -> bool {
-        m.max <= self.tol && len <= self.max_edge && turn > self.angle && len <= 0.1 * self.tol
+        m.max <= self.tol
+            && len <= self.max_edge
+            && turn > self.angle
+            && (len <= 0.1 * self.tol || (turn > FOLD_TURN && len <= self.tol))
     }
 }
 
@@ -105,5 +117,33 @@ impl Packed {
 
     pub(super) fn unpack(self) -> (TriMeasure, f64) {
         (TriMeasure { max: f64::from(self.max), sum: f64::from(self.sum) }, f64::from(self.turn))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn within(c: &Criteria) -> TriMeasure {
+        TriMeasure { max: 0.5 * c.tol, sum: 0.0 }
+    }
+
+    /// A triangle within the tolerance that fails only the angle limit is
+    /// split down to a tenth of the tolerance where the normal turns less
+    /// than a right angle (a tight fillet still gets its shading), but only
+    /// down to the tolerance where it turns past one (a fold or pleat, whose
+    /// turn no split lowers).
+    #[test]
+    fn folds_stop_at_the_tolerance_bends_at_a_tenth() {
+        let c = Criteria::PLANE_TEST;
+        let m = within(&c);
+        let (bend, fold) = (1.0, 2.5);
+        assert!(!c.short_for_angle(&m, bend, 0.5 * c.tol));
+        assert!(c.short_for_angle(&m, bend, 0.09 * c.tol));
+        assert!(c.short_for_angle(&m, fold, 0.5 * c.tol));
+        assert!(!c.short_for_angle(&m, fold, 1.5 * c.tol));
+        // Over the tolerance or within the angle limit: not a crease at all.
+        assert!(!c.short_for_angle(&TriMeasure { max: 2.0 * c.tol, sum: 0.0 }, fold, 0.5 * c.tol));
+        assert!(!c.short_for_angle(&m, 0.4, 0.05 * c.tol));
     }
 }
