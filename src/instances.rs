@@ -18,8 +18,8 @@ use glam::DAffine3;
 
 use crate::collections::HashMap;
 use crate::model::{body_of, SkippedFace};
-use crate::quality::ElementSize;
-use crate::tessellate::{MeshOptions, MeshResult, Tolerance};
+use crate::options::{ElementSize, MeshOptions, Tolerance};
+use crate::tessellate::MeshResult;
 use crate::units::{mesh_model_in_units, mm_per_unit, Units};
 use crate::{Assembly, Error, FaceRange, Mesh, Model, Report};
 

@@ -25,6 +25,7 @@ mod measure;
 mod mesh;
 mod model;
 mod nurbs;
+mod options;
 mod quality;
 #[cfg(feature = "repair")]
 mod repair;
@@ -60,29 +61,31 @@ pub use mesh::{
     EdgeCounts, FaceRange, Mesh, Report,
 };
 pub use model::{
-    Assembly, AssemblyNode, Face, FaceSurface, Model, PartInstance, SkippedFace, TessellatedFace, TrimLoop,
+    share_of_faces, Assembly, AssemblyNode, Face, FaceSurface, Model, PartInstance, SkippedFace, TessellatedFace,
+    TrimLoop,
 };
 pub use nurbs::{
     project_to_surface, Aabb, BasisDers, CurveDerivs, KnotVector, NurbsCurve, NurbsError, NurbsSurface, Projection,
     ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
 };
-pub use quality::{ElementSize, QualityMethod, QualityOptions, QualityReport, EDGE_BAND, GOOD_ANGLE_DEG};
+pub use options::{
+    ElementSize, MeshMode, MeshOptions, OptionsError, QualityMethod, QualityOptions, Reparam, Tolerance,
+};
+pub use quality::{QualityReport, EDGE_BAND, GOOD_ANGLE_DEG};
 #[cfg(feature = "repair")]
 pub use repair::{
     find_self_intersections, mesh_edge_census, mesh_volume, offset_mesh, repair_mesh, repair_mesh_timed, Bucketing,
     EdgeCensus, RepairOptions, RepairReport, RepairResult, StageTimes,
 };
 pub use reparam::{
-    rebuild_face, reparameterize_model, step_ratio, Rebuilt, Reparam, ReparamFace, ReparamModel, FIT_LIMIT, FIT_SHARE,
+    rebuild_face, reparameterize_model, step_ratio, Rebuilt, ReparamFace, ReparamModel, FIT_LIMIT, FIT_SHARE,
     RATIO_LIMIT,
 };
 /// The mesher's stages one at a time, for the criterion benches; not a stable API.
 #[cfg(feature = "std")]
 #[doc(hidden)]
 pub use tessellate::stages;
-pub use tessellate::{
-    mesh_model, mesh_model_with_progress, share_of_faces, MeshMode, MeshOptions, MeshResult, OptionsError, Tolerance,
-};
+pub use tessellate::{mesh_model, mesh_model_with_progress, MeshResult};
 pub use units::{mesh_model_in_units, mm_per_unit, Units};
 
 /// Reads `bytes` in `format` and meshes the model: the one call both doors use.

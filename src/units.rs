@@ -5,8 +5,8 @@
 use alloc::format;
 use alloc::string::ToString;
 
-use crate::quality::ElementSize;
-use crate::tessellate::{mesh_model_with_progress, MeshOptions, MeshResult, OptionsError, Tolerance};
+use crate::options::{ElementSize, MeshOptions, OptionsError, Tolerance};
+use crate::tessellate::{mesh_model_with_progress, MeshResult};
 use crate::{Error, Model};
 
 /// Millimetres per unit of the length unit `name`, as the readers name

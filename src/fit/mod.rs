@@ -34,7 +34,7 @@ pub use bezier::{Cubic, PatchPoint, TriPatch};
 pub use points::{read_points, PointFormat, MAX_FILE_POINTS};
 
 use crate::mesh::{edge_counts, Mesh};
-use crate::tessellate::{OptionsError, Tolerance};
+use crate::options::{OptionsError, Tolerance};
 use crate::Error;
 use kdtree::KdTree;
 use normals::Neighbours;

@@ -8,7 +8,9 @@ use glam::{DVec2, DVec3};
 use crate::nurbs::{Aabb, NurbsCurve, NurbsSurface, Surface, SurfaceDerivs};
 
 mod assembly;
+mod bodies;
 pub use assembly::{Assembly, AssemblyNode, PartInstance};
+pub use bodies::share_of_faces;
 
 /// Everything read from one input file.
 #[derive(Debug, Clone, Default)]

@@ -26,13 +26,11 @@ mod looping;
 mod mapping;
 #[cfg(feature = "quality")]
 mod mesher;
-mod options;
 
 use serde::Serialize;
 
 #[cfg(feature = "quality")]
 pub(crate) use mesher::mesh_quality;
-pub use options::{ElementSize, QualityMethod, QualityOptions};
 
 /// Triangles whose smallest angle reaches this count as good, degrees.
 pub const GOOD_ANGLE_DEG: f64 = 25.0;
@@ -68,10 +66,10 @@ pub struct QualityReport {
 #[cfg(not(feature = "quality"))]
 pub(crate) fn mesh_quality(
     _model: &crate::Model,
-    _options: &crate::tessellate::MeshOptions,
+    _options: &crate::options::MeshOptions,
     _progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<crate::tessellate::MeshResult, crate::Error> {
-    Err(crate::Error::Options(crate::tessellate::OptionsError {
+    Err(crate::Error::Options(crate::options::OptionsError {
         option: "mode",
         message: "quality mode is not in this build (the npm package has it in surfmesh/full)",
     }))

@@ -18,26 +18,10 @@ use serde::Serialize;
 
 use crate::model::{Face, FaceSurface, Model, TrimLoop};
 use crate::nurbs::{project_to_surface, NurbsCurve, Surface};
-use crate::tessellate::Tolerance;
+use crate::options::{Reparam, Tolerance};
 use crate::Error;
 
 pub(crate) use interp::{chord_params, interpolate_curve};
-
-/// When faces are re-parameterized before meshing.
-///
-/// Auto by default: a flagged face's rebuild is kept only where its mesh
-/// wins (no more triangles, better angles) and the original is meshed
-/// otherwise, so the default never meshes a face worse than `Off`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Reparam {
-    /// Faces the ratio test flags (the default).
-    #[default]
-    Auto,
-    /// Never.
-    Off,
-    /// Every face.
-    Force,
-}
 
 /// Paper 001's empirical limit `k`: a parameter step whose model-space length
 /// is more than `k` times, or less than `1/k` of, the iso-line's mean step is poor.

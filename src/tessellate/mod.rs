@@ -11,7 +11,6 @@ mod fill;
 pub(crate) mod measure;
 #[cfg(feature = "std")]
 mod mend_loops;
-mod options;
 mod params;
 mod refine;
 mod sew;
@@ -27,12 +26,12 @@ use alloc::vec::Vec;
 use glam::DVec2;
 
 use crate::mesh::{angle_stats, edge_census, holes_warning, FaceRange};
+use crate::model::share_of_faces;
 use crate::nurbs::{Aabb, Surface};
-use crate::reparam::{rebuild_face, step_ratio, Rebuilt, Reparam, ReparamFace, RATIO_LIMIT};
+use crate::options::{MeshMode, MeshOptions, Reparam, Tolerance};
+use crate::reparam::{rebuild_face, step_ratio, Rebuilt, ReparamFace, RATIO_LIMIT};
 use crate::{Error, Mesh, Model, Report};
 use trial::{lift_needles, outline_of, rebuild_loses, shorter_edges, tris_of, SHORTER_TRIES};
-
-pub use options::{share_of_faces, MeshMode, MeshOptions, OptionsError, Tolerance};
 
 /// A mesh and what was measured on it.
 #[derive(Debug, Clone, Default)]
