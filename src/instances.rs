@@ -283,7 +283,7 @@ fn absolute(model: &Model, options: &MeshOptions, k: f64) -> MeshOptions {
     if !matches!(o.tolerance, Tolerance::Relative(_)) && !relative_size {
         return o;
     }
-    let diag = crate::tessellate::trimmed_bbox(model).diagonal() * k;
+    let diag = crate::model::trimmed_bbox(model).diagonal() * k;
     // A model of no size keeps its relative tolerance: the mesher says why it cannot mesh.
     let usable = |x: f64| x > 0.0 && x.is_finite();
     if let Tolerance::Relative(r) = o.tolerance {

@@ -9,8 +9,10 @@ use crate::nurbs::{Aabb, NurbsCurve, NurbsSurface, Surface, SurfaceDerivs};
 
 mod assembly;
 mod bodies;
+mod extent;
 pub use assembly::{Assembly, AssemblyNode, PartInstance};
 pub use bodies::share_of_faces;
+pub(crate) use extent::trimmed_bbox;
 
 /// Everything read from one input file.
 #[derive(Debug, Clone, Default)]

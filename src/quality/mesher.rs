@@ -63,7 +63,7 @@ pub(crate) fn mesh_quality(
     if model.faces.is_empty() {
         return Err(Error::Model { location: "model".into(), message: "has no faces".into() });
     }
-    let diag = crate::tessellate::trimmed_bbox(model).diagonal();
+    let diag = crate::model::trimmed_bbox(model).diagonal();
     let size = match q.size {
         ElementSize::Absolute(h) => h,
         ElementSize::Relative(r) => r * diag,

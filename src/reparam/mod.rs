@@ -135,7 +135,7 @@ pub struct ReparamModel {
 pub fn reparameterize_model(model: &Model, mode: Reparam, tolerance: Tolerance) -> Result<ReparamModel, Error> {
     let tol = match tolerance {
         Tolerance::Absolute(t) => t,
-        Tolerance::Relative(r) => r * crate::tessellate::trimmed_bbox(model).diagonal(),
+        Tolerance::Relative(r) => r * crate::model::trimmed_bbox(model).diagonal(),
     };
     if !(tol > 0.0 && tol.is_finite()) {
         return Err(Error::Model { location: "model".into(), message: "has zero size; use an absolute --tol".into() });
