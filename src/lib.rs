@@ -30,6 +30,7 @@ mod quality;
 #[cfg(feature = "repair")]
 mod repair;
 mod reparam;
+mod report;
 mod sort;
 mod tessellate;
 #[cfg(test)]
@@ -58,7 +59,7 @@ pub use io::{
 pub use measure::{measure_mesh, MeasureOptions, MeshMeasure};
 pub use mesh::{
     angle_stats, edge_counts, edge_counts_around_skipped, edge_counts_in_bodies, weld_mesh, weld_positions, AngleStats,
-    EdgeCounts, FaceRange, Mesh, Report,
+    EdgeCounts, FaceRange, Mesh,
 };
 pub use model::{
     share_of_faces, Assembly, AssemblyNode, Face, FaceSurface, Model, PartInstance, SkippedFace, TessellatedFace,
@@ -71,7 +72,6 @@ pub use nurbs::{
 pub use options::{
     ElementSize, MeshMode, MeshOptions, OptionsError, QualityMethod, QualityOptions, Reparam, Tolerance,
 };
-pub use quality::{QualityReport, EDGE_BAND, GOOD_ANGLE_DEG};
 #[cfg(feature = "repair")]
 pub use repair::{
     find_self_intersections, mesh_edge_census, mesh_volume, offset_mesh, repair_mesh, repair_mesh_timed, Bucketing,
@@ -81,11 +81,12 @@ pub use reparam::{
     rebuild_face, reparameterize_model, step_ratio, Rebuilt, ReparamFace, ReparamModel, FIT_LIMIT, FIT_SHARE,
     RATIO_LIMIT,
 };
+pub use report::{MeshResult, QualityReport, Report, EDGE_BAND, GOOD_ANGLE_DEG};
 /// The mesher's stages one at a time, for the criterion benches; not a stable API.
 #[cfg(feature = "std")]
 #[doc(hidden)]
 pub use tessellate::stages;
-pub use tessellate::{mesh_model, mesh_model_with_progress, MeshResult};
+pub use tessellate::{mesh_model, mesh_model_with_progress};
 pub use units::{mesh_model_in_units, mm_per_unit, Units};
 
 /// Reads `bytes` in `format` and meshes the model: the one call both doors use.

@@ -6,7 +6,8 @@ use alloc::format;
 use alloc::string::ToString;
 
 use crate::options::{ElementSize, MeshOptions, OptionsError, Tolerance};
-use crate::tessellate::{mesh_model_with_progress, MeshResult};
+use crate::report::MeshResult;
+use crate::tessellate::mesh_model_with_progress;
 use crate::{Error, Model};
 
 /// Millimetres per unit of the length unit `name`, as the readers name

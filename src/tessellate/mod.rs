@@ -30,17 +30,9 @@ use crate::model::{share_of_faces, trimmed_bbox};
 use crate::nurbs::Surface;
 use crate::options::{MeshMode, MeshOptions, Reparam, Tolerance};
 use crate::reparam::{rebuild_face, step_ratio, Rebuilt, ReparamFace, RATIO_LIMIT};
-use crate::{Error, Mesh, Model, Report};
+use crate::report::{MeshResult, Report};
+use crate::{Error, Mesh, Model};
 use trial::{lift_needles, outline_of, rebuild_loses, shorter_edges, tris_of, SHORTER_TRIES};
-
-/// A mesh and what was measured on it.
-#[derive(Debug, Clone, Default)]
-pub struct MeshResult {
-    /// The triangles.
-    pub mesh: Mesh,
-    /// Measured deviation, angles, edge census, warnings.
-    pub report: Report,
-}
 
 /// Meshes every face of `model` within `options`, and measures the result.
 ///
