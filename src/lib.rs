@@ -23,6 +23,7 @@ mod io;
 mod math;
 mod measure;
 mod mesh;
+mod meshing;
 mod model;
 mod nurbs;
 mod options;
@@ -61,6 +62,7 @@ pub use mesh::{
     angle_stats, edge_counts, edge_counts_around_skipped, edge_counts_in_bodies, weld_mesh, weld_positions, AngleStats,
     EdgeCounts, FaceRange, Mesh,
 };
+pub use meshing::{mesh_model, mesh_model_with_progress};
 pub use model::{
     share_of_faces, Assembly, AssemblyNode, Face, FaceSurface, Model, PartInstance, SkippedFace, TessellatedFace,
     TrimLoop,
@@ -86,7 +88,6 @@ pub use report::{MeshResult, QualityReport, Report, EDGE_BAND, GOOD_ANGLE_DEG};
 #[cfg(feature = "std")]
 #[doc(hidden)]
 pub use tessellate::stages;
-pub use tessellate::{mesh_model, mesh_model_with_progress};
 pub use units::{mesh_model_in_units, mm_per_unit, Units};
 
 /// Reads `bytes` in `format` and meshes the model: the one call both doors use.

@@ -3,7 +3,7 @@
 
 use alloc::vec::Vec;
 
-use super::body_of;
+use super::{body_of, Model};
 
 /// Which faces share `index` of `count` meshes: bodies go, the largest (most
 /// faces) first, to the share with the fewest faces so far; ties by body id
@@ -25,4 +25,12 @@ pub fn share_of_faces(bodies: &[u32], faces: usize, index: u32, count: u32) -> V
         owner.insert(b, to);
     }
     (0..faces).map(|f| owner.get(&body(f)).copied() == Some(index as usize)).collect()
+}
+
+/// How many bodies the faces of `model` fall in.
+pub(crate) fn body_count(model: &Model) -> usize {
+    let mut ids: Vec<u32> = (0..model.face_count()).map(|f| body_of(&model.bodies, f)).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    ids.len()
 }

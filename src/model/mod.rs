@@ -11,6 +11,7 @@ mod assembly;
 mod bodies;
 mod extent;
 pub use assembly::{Assembly, AssemblyNode, PartInstance};
+pub(crate) use bodies::body_count;
 pub use bodies::share_of_faces;
 pub(crate) use extent::trimmed_bbox;
 

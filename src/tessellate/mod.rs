@@ -25,59 +25,34 @@ use alloc::format;
 use alloc::vec::Vec;
 
 use crate::mesh::{angle_stats, edge_census, holes_warning, FaceRange};
-use crate::model::{share_of_faces, trimmed_bbox};
+use crate::model::{body_count, share_of_faces, trimmed_bbox};
 #[cfg(feature = "std")]
 use crate::nurbs::Surface;
-use crate::options::{MeshMode, MeshOptions, Reparam, Tolerance};
+use crate::options::{MeshOptions, Reparam, Tolerance};
 use crate::reparam::{rebuild_face, step_ratio, Rebuilt, ReparamFace, RATIO_LIMIT};
 use crate::report::{MeshResult, Report};
 use crate::{Error, Mesh, Model};
+pub(crate) use tessellated::append_unsewn;
 use trial::{lift_needles, outline_of, rebuild_loses, shorter_edges, tris_of, SHORTER_TRIES};
 
-/// Meshes every face of `model` within `options`, and measures the result.
+/// Meshes every face of `model` in fast mode (paper 000) within `options`,
+/// and measures the result; `progress(faces_done, faces_total)` is called as
+/// faces finish refinement, and stops meshing when it returns `false`.
 ///
 /// Each face gets an iso-parametric grid sized by paper 000's chord test, a
 /// constrained Delaunay band along its trim loops, and refinement until every
 /// triangle's measured deviation, normal turn and edge length pass.
-/// With [`MeshMode::Quality`] the faces get near-equilateral triangles of
-/// the size in [`MeshOptions::quality`] instead (paper 003).
 ///
 /// # Errors
 /// Invalid options, an empty model, a face whose loops cross or leave the
-/// domain, or a tolerance that would need more triangles than the budget.
-pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<MeshResult, Error> {
-    mesh_model_with_progress(model, options, &mut |_, _| true)
-}
-
-/// As [`mesh_model`], calling `progress(faces_done, faces_total)` after each
-/// face; when it returns `false` meshing stops with [`Error::Cancelled`].
-/// (The core has no clock or threads: a caller that wants a time limit or a
-/// cancel button decides inside the callback.)
-///
-/// # Errors
-/// As [`mesh_model`], or [`Error::Cancelled`].
-pub fn mesh_model_with_progress(
+/// domain, a tolerance that would need more triangles than the budget, or
+/// [`Error::Cancelled`].
+pub(crate) fn mesh_fast(
     model: &Model,
     options: &MeshOptions,
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<MeshResult, Error> {
-    let bodies = {
-        let mut ids: Vec<u32> = (0..model.face_count()).map(|f| crate::model::body_of(&model.bodies, f)).collect();
-        ids.sort_unstable();
-        ids.dedup();
-        ids.len()
-    };
-    // A model of tessellated faces only has nothing to mesh in quality mode:
-    // it takes the path below, which passes them through.
-    if options.mode == MeshMode::Quality && !model.faces.is_empty() {
-        let mut r = crate::quality::mesh_quality(model, options, progress)?;
-        // Tessellated faces are passed through unsewn.
-        tessellated::append_unsewn(model, &mut r.mesh, &mut r.report);
-        r.report.bodies = bodies;
-        r.report.units = model.units.clone();
-        r.report.faces_unread = model.skipped.len();
-        return Ok(r);
-    }
+    let bodies = body_count(model);
     // A share meshes its bodies only; the other faces stay empty (not skipped).
     let mine = match options.share {
         Some((index, count)) => share_of_faces(&model.bodies, model.face_count(), index, count),
