@@ -84,10 +84,9 @@ pub use reparam::{
     RATIO_LIMIT,
 };
 pub use report::{MeshResult, QualityReport, Report, EDGE_BAND, GOOD_ANGLE_DEG};
-/// The mesher's stages one at a time, for the criterion benches; not a stable API.
-#[cfg(feature = "std")]
+/// The fast mesher's stages one at a time, for the criterion benches; not a stable API.
 #[doc(hidden)]
-pub use tessellate::stages;
+pub use tessellate::pipeline;
 pub use units::{mesh_model_in_units, mm_per_unit, Units};
 
 /// Reads `bytes` in `format` and meshes the model: the one call both doors use.
