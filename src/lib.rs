@@ -68,8 +68,8 @@ pub use model::{
     TrimLoop,
 };
 pub use nurbs::{
-    project_to_surface, Aabb, BasisDers, CurveDerivs, KnotVector, NurbsCurve, NurbsError, NurbsSurface, Projection,
-    ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
+    project_to_surface, Aabb, BasisDers, CurveDerivs, CurveProjection, KnotVector, NurbsCurve, NurbsError,
+    NurbsSurface, Projection, ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
 };
 pub use options::{
     ElementSize, MeshMode, MeshOptions, OptionsError, QualityMethod, QualityOptions, Reparam, Tolerance,

@@ -316,7 +316,7 @@ impl<'a> Holes<'a> {
         self.curves.iter().any(|(c, b, bbox)| {
             *b == body
                 && points.iter().all(|&q| bbox.contains(q, self.reach))
-                && points.iter().all(|&q| c.project(q).2 <= self.reach)
+                && points.iter().all(|&q| c.project(q).distance <= self.reach)
         })
     }
 }

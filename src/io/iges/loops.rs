@@ -255,7 +255,7 @@ fn rectangle_face(def: &SurfDef, lp: &[Track]) -> Result<Option<Face>, String> {
     }
     // The loop must go round the whole border, not along part of it and back.
     let extra = alloc::vec![0.0; lp.len()];
-    let (area, ..) = loop_shape(lp, &extra, 0);
+    let area = loop_shape(lp, &extra, 0).area;
     if area.abs() < 0.999 * span.x * span.y {
         return Ok(None);
     }
@@ -486,7 +486,7 @@ fn params_match(
             for (m, bx) in model.iter().zip(&boxes) {
                 let gap = (bx.min - p).max(p - bx.max).max(DVec3::ZERO).length();
                 if gap < best {
-                    best = best.min(m.project(p).2);
+                    best = best.min(m.project(p).distance);
                 }
             }
             if best.is_nan() || best > tol {
