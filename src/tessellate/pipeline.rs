@@ -124,6 +124,18 @@ impl Variants<'_> {
 }
 
 impl Works<'_> {
+    /// Debug builds: every face's work mesh keeps its tables in step
+    /// ([`WorkMesh::check_tables`]) after `stage`; a broken one is the
+    /// mesher's bug, named with its face and stage.
+    fn check(&self, stage: &str) {
+        #[cfg(debug_assertions)]
+        for (i, w) in self.faces.iter().enumerate() {
+            let r = w.mesh.check_tables();
+            debug_assert!(r.is_ok(), "face {i} after {stage}: {r:?}");
+        }
+        let _ = stage;
+    }
+
     /// Triangles over all faces.
     pub fn triangles(&self) -> usize {
         self.faces.iter().map(|w| w.mesh.tris.len()).sum()
@@ -302,7 +314,9 @@ impl<'m> Plan<'m> {
         if let Some(e) = run.first_failure.take().filter(|_| works.faces.iter().all(|w| w.mesh.tris.is_empty())) {
             return Err(e);
         }
+        works.check("first meshes");
         tessellated::snap_borders(&mut works.faces, &run.facets, &self.body_ids, self.sew_tol);
+        works.check("snapping to tessellated borders");
         Ok(works)
     }
 
@@ -323,9 +337,11 @@ impl<'m> Plan<'m> {
         works.budget_hit =
             sew::refine_all(&mut works.faces, works.ids, self.sew_tol, self.options.max_triangles, progress)?;
         let (settled, places) = sew::settle_nodes(&mut works.faces, 1e-6 * self.tol);
+        works.check("refinement");
         for (w, moved) in works.faces.iter_mut().zip(&settled) {
             w.mesh.forget(moved);
         }
+        works.check("settling the nodes");
         Ok(Refined { places })
     }
 
@@ -354,6 +370,7 @@ impl<'m> Plan<'m> {
                 }
             }
         }
+        works.check("mending");
     }
 
     /// Stage 6, paper 000's uniform, well-shaped triangles kept after
@@ -377,6 +394,7 @@ impl<'m> Plan<'m> {
             }
             w.mesh.rest();
         }
+        works.check("improving");
     }
 
     /// Stage 7, paper 000 §6's vertex-to-vertex joins where sewing left a
@@ -389,7 +407,9 @@ impl<'m> Plan<'m> {
         for w in works.faces.iter_mut() {
             w.mesh.rest();
         }
+        works.check("closing slivers");
         tessellated::split_rims(&mut works.faces, &mut run.facets, &self.body_ids, self.sew_tol);
+        works.check("splitting tessellated rims");
     }
 
     /// Stage 8, the verification paper 000 leaves to its chord test: each

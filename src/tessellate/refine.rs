@@ -11,6 +11,8 @@ use super::measure::{measure_projection, measure_triangle, sample_count, TriMeas
 use crate::math::angle_between;
 use crate::nurbs::{project_to_surface, regular_normal, NurbsCurve, Surface};
 
+#[cfg(any(test, debug_assertions))]
+mod check;
 mod edges;
 #[cfg(feature = "std")]
 mod lift;
