@@ -6,17 +6,18 @@
 //!
 //! - `evaluation`: surface points and second derivatives;
 //! - `projection`: closest points, from a hint and from no hint;
-//! - `edge_discretization`: the trim loops to checked polylines;
-//! - `grid`: the iso-parametric grid (paper 000 §3.1);
-//! - `cdt`: the constrained Delaunay triangulation of the trimmed band;
+//! - `variants`: each face's variant and outline, the trim loops to checked
+//!   polylines and the iso-parametric grid (paper 000 §1–§3);
+//! - `first_meshes`: the grid's triangles and the constrained Delaunay
+//!   triangulation of the trimmed band (§4–§5);
 //! - `refinement`: measuring and splitting until every triangle is proven;
 //! - `sew`: two faces that share a border against one face;
 //! - `tessellate`: whole-model throughput in triangles per second;
 //! - `measurement`: the benchmark's yardstick (`measure_mesh`) and the mesh
 //!   metrics it builds on (welding, edge census, angles).
 //!
-//! The stages come one at a time through `surfmesh::stages` (hidden, for
-//! benches only). `cargo bench --bench tessellate [-- GROUP]`; CI only
+//! The stages are the mesher's own, one at a time through
+//! `surfmesh::pipeline` (hidden, for benches only). `cargo bench --bench tessellate [-- GROUP]`; CI only
 //! compiles them (`cargo bench --no-run`).
 
 use std::f64::consts::FRAC_1_SQRT_2;
@@ -25,7 +26,7 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion, Throughput};
 use glam::{DVec2, DVec3};
 use surfmesh::{
-    angle_stats, edge_counts, measure_mesh, mesh_model, project_to_surface, stages::FaceStages, weld_positions, Face,
+    angle_stats, edge_counts, measure_mesh, mesh_model, pipeline::Plan, project_to_surface, weld_positions, Face,
     FaceSurface, MeasureOptions, MeshOptions, Model, NurbsCurve, NurbsSurface, ProjectionOptions, Surface, TrimLoop,
 };
 
@@ -166,47 +167,62 @@ fn stage_options() -> MeshOptions {
     MeshOptions::default().with_relative_tolerance(1e-3)
 }
 
-fn edge_discretization(c: &mut Criterion) {
-    let mut group = c.benchmark_group("edge_discretization");
-    let m = trimmed();
-    let s = FaceStages::new(&m, 0, &stage_options()).expect("the bench model is valid");
-    let nodes = s.discretize().expect("the loops discretize").loop_nodes();
-    group.throughput(Throughput::Elements(nodes as u64));
-    group.bench_function("trimmed", |b| b.iter(|| black_box(&s).discretize().map(|d| d.loop_nodes())));
-    group.finish();
-}
-
-fn grid(c: &mut Criterion) {
-    let mut group = c.benchmark_group("grid");
-    let models = stage_models();
+fn variants(c: &mut Criterion) {
+    let mut group = c.benchmark_group("variants");
+    let (models, options) = (stage_models(), stage_options());
     for (name, m) in &models {
-        let s = FaceStages::new(m, 0, &stage_options()).expect("the bench model is valid");
-        let d = s.discretize().expect("the loops discretize");
-        group.bench_function(*name, |b| b.iter(|| s.grid(black_box(&d)).size()));
+        let p = Plan::new(m, &options).expect("the bench model is valid");
+        let nodes = p.choose_variants(&mut p.start()).expect("the loops discretize").loop_nodes();
+        group.throughput(Throughput::Elements(nodes.max(1) as u64));
+        group.bench_function(*name, |b| {
+            b.iter(|| black_box(&p).choose_variants(&mut p.start()).map(|v| v.grid_lines()))
+        });
     }
     group.finish();
 }
 
-fn cdt(c: &mut Criterion) {
-    let mut group = c.benchmark_group("cdt");
-    let m = trimmed();
-    let s = FaceStages::new(&m, 0, &stage_options()).expect("the bench model is valid");
-    let d = s.discretize().expect("the loops discretize");
-    let input = s.cdt_input(&d, &s.grid(&d)).expect("a trimmed face has a band");
-    group.throughput(Throughput::Elements(input.nodes() as u64));
-    group.bench_function("trimmed", |b| b.iter(|| s.cdt(black_box(&input))));
+fn first_meshes(c: &mut Criterion) {
+    let mut group = c.benchmark_group("first_meshes");
+    let (models, options) = (stage_models(), stage_options());
+    for (name, m) in &models {
+        let p = Plan::new(m, &options).expect("the bench model is valid");
+        let sewn = || {
+            let mut run = p.start();
+            let variants = p.choose_variants(&mut run).expect("the loops discretize");
+            let sewn = p.sew_outlines(&run, variants);
+            (run, sewn)
+        };
+        let (mut run, s) = sewn();
+        group.throughput(Throughput::Elements(p.first_meshes(&mut run, s).expect("meshes").triangles() as u64));
+        group.bench_function(*name, |b| {
+            b.iter_batched(
+                sewn,
+                |(mut run, s)| p.first_meshes(&mut run, s).map(|w| w.triangles()),
+                BatchSize::SmallInput,
+            )
+        });
+    }
     group.finish();
 }
 
 fn refinement(c: &mut Criterion) {
     let mut group = c.benchmark_group("refinement");
     group.sample_size(20);
-    let models = stage_models();
+    let (models, options) = (stage_models(), stage_options());
     for (name, m) in &models {
-        let s = FaceStages::new(m, 0, &stage_options()).expect("the bench model is valid");
-        let start = || s.initial().expect("the bench model meshes");
-        group.throughput(Throughput::Elements(s.refine(start()) as u64));
-        group.bench_function(*name, |b| b.iter_batched(start, |i| s.refine(i), BatchSize::SmallInput));
+        let p = Plan::new(m, &options).expect("the bench model is valid");
+        let start = || {
+            let mut run = p.start();
+            let variants = p.choose_variants(&mut run).expect("the loops discretize");
+            let sewn = p.sew_outlines(&run, variants);
+            p.first_meshes(&mut run, sewn).expect("the bench model meshes")
+        };
+        let refine = |mut works| {
+            p.refine(&mut works, &mut |_, _| true).expect("not cancelled");
+            works.triangles()
+        };
+        group.throughput(Throughput::Elements(refine(start()) as u64));
+        group.bench_function(*name, |b| b.iter_batched(start, refine, BatchSize::SmallInput));
     }
     group.finish();
 }
@@ -257,16 +273,5 @@ fn measurement(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(
-    benches,
-    evaluation,
-    projection,
-    edge_discretization,
-    grid,
-    cdt,
-    refinement,
-    sew,
-    tessellate,
-    measurement
-);
+criterion_group!(benches, evaluation, projection, variants, first_meshes, refinement, sew, tessellate, measurement);
 criterion_main!(benches);

@@ -43,11 +43,20 @@ fn main() {
             std::fs::write(out, loops_text(&model.faces[i])).expect("write");
         }
         if let Ok(out) = std::env::var("UV_DUMP") {
-            let opts = MeshOptions::default().with_relative_tolerance(rel);
-            let st = surfmesh::stages::FaceStages::new(&model, i, &opts).expect("face");
+            // The face on its own at the model's tolerance, through the mesher's stages.
+            let sub = Model { faces: vec![model.faces[i].clone()], ..Model::default() };
+            let opts = MeshOptions::default().with_tolerance(tol);
+            let plan = surfmesh::pipeline::Plan::new(&sub, &opts).expect("face");
+            let mut run = plan.start();
+            let variants = plan.choose_variants(&mut run).expect("outline");
+            let sewn = plan.sew_outlines(&run, variants);
+            let mut works = plan.first_meshes(&mut run, sewn).expect("initial");
             let mut s = String::new();
-            for (tag, refined) in [("i", false), ("r", true)] {
-                for (t, inv) in st.uv_triangles(st.initial().expect("initial"), refined) {
+            for tag in ["i", "r"] {
+                if tag == "r" {
+                    plan.refine(&mut works, &mut |_, _| true).expect("refined");
+                }
+                for (t, inv) in works.uv_triangles(0) {
                     let [a, b, c] = t;
                     writeln!(s, "{tag} {} {} {} {} {} {} {}", a.x, a.y, b.x, b.y, c.x, c.y, u8::from(inv)).unwrap();
                 }

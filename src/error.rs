@@ -4,7 +4,7 @@ use alloc::string::String;
 use core::fmt;
 
 use crate::nurbs::NurbsError;
-use crate::tessellate::OptionsError;
+use crate::options::OptionsError;
 
 /// Why a model could not be read or meshed. `Display` gives the one-line
 /// message the CLI prints and the JS binding throws.

@@ -18,10 +18,10 @@ use glam::DAffine3;
 
 use crate::collections::HashMap;
 use crate::model::{body_of, SkippedFace};
-use crate::quality::ElementSize;
-use crate::tessellate::{MeshOptions, MeshResult, Tolerance};
+use crate::options::{ElementSize, MeshOptions, Tolerance};
+use crate::report::{MeshResult, QualityReport, Report};
 use crate::units::{mesh_model_in_units, mm_per_unit, Units};
-use crate::{Assembly, Error, FaceRange, Mesh, Model, Report};
+use crate::{Assembly, Error, FaceRange, Mesh, Model};
 
 /// One shape's mesh, in the coordinates of its instances' node.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -283,7 +283,7 @@ fn absolute(model: &Model, options: &MeshOptions, k: f64) -> MeshOptions {
     if !matches!(o.tolerance, Tolerance::Relative(_)) && !relative_size {
         return o;
     }
-    let diag = crate::tessellate::trimmed_bbox(model).diagonal() * k;
+    let diag = crate::model::trimmed_bbox(model).diagonal() * k;
     // A model of no size keeps its relative tolerance: the mesher says why it cannot mesh.
     let usable = |x: f64| x > 0.0 && x.is_finite();
     if let Tolerance::Relative(r) = o.tolerance {
@@ -358,7 +358,7 @@ fn merge_reports(model: &Model, parts: &[(Report, usize)], options: &MeshOptions
     let mut deviation_sum = 0.0;
     let mut min_angle = f64::INFINITY;
     let mut p1_angle = f64::INFINITY;
-    let mut quality: Option<(crate::QualityReport, f64)> = None;
+    let mut quality: Option<(QualityReport, f64)> = None;
     for (r, n) in parts {
         if out.units.is_empty() {
             out.units = r.units.clone();

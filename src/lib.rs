@@ -23,12 +23,15 @@ mod io;
 mod math;
 mod measure;
 mod mesh;
+mod meshing;
 mod model;
 mod nurbs;
+mod options;
 mod quality;
 #[cfg(feature = "repair")]
 mod repair;
 mod reparam;
+mod report;
 mod sort;
 mod tessellate;
 #[cfg(test)]
@@ -57,32 +60,33 @@ pub use io::{
 pub use measure::{measure_mesh, MeasureOptions, MeshMeasure};
 pub use mesh::{
     angle_stats, edge_counts, edge_counts_around_skipped, edge_counts_in_bodies, weld_mesh, weld_positions, AngleStats,
-    EdgeCounts, FaceRange, Mesh, Report,
+    EdgeCounts, FaceRange, Mesh,
 };
+pub use meshing::{mesh_model, mesh_model_with_progress};
 pub use model::{
-    Assembly, AssemblyNode, Face, FaceSurface, Model, PartInstance, SkippedFace, TessellatedFace, TrimLoop,
+    share_of_faces, Assembly, AssemblyNode, Face, FaceSurface, Model, PartInstance, SkippedFace, TessellatedFace,
+    TrimLoop,
 };
 pub use nurbs::{
-    project_to_surface, Aabb, BasisDers, CurveDerivs, KnotVector, NurbsCurve, NurbsError, NurbsSurface, Projection,
-    ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
+    project_to_surface, Aabb, BasisDers, CurveDerivs, CurveProjection, KnotVector, NurbsCurve, NurbsError,
+    NurbsSurface, Projection, ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
 };
-pub use quality::{ElementSize, QualityMethod, QualityOptions, QualityReport, EDGE_BAND, GOOD_ANGLE_DEG};
+pub use options::{
+    ElementSize, MeshMode, MeshOptions, OptionsError, QualityMethod, QualityOptions, Reparam, Tolerance,
+};
 #[cfg(feature = "repair")]
 pub use repair::{
     find_self_intersections, mesh_edge_census, mesh_volume, offset_mesh, repair_mesh, repair_mesh_timed, Bucketing,
     EdgeCensus, RepairOptions, RepairReport, RepairResult, StageTimes,
 };
 pub use reparam::{
-    rebuild_face, reparameterize_model, step_ratio, Rebuilt, Reparam, ReparamFace, ReparamModel, FIT_LIMIT, FIT_SHARE,
+    rebuild_face, reparameterize_model, step_ratio, Rebuilt, ReparamFace, ReparamModel, FIT_LIMIT, FIT_SHARE,
     RATIO_LIMIT,
 };
-/// The mesher's stages one at a time, for the criterion benches; not a stable API.
-#[cfg(feature = "std")]
+pub use report::{MeshResult, QualityReport, Report, EDGE_BAND, GOOD_ANGLE_DEG};
+/// The fast mesher's stages one at a time, for the criterion benches; not a stable API.
 #[doc(hidden)]
-pub use tessellate::stages;
-pub use tessellate::{
-    mesh_model, mesh_model_with_progress, share_of_faces, MeshMode, MeshOptions, MeshResult, OptionsError, Tolerance,
-};
+pub use tessellate::pipeline;
 pub use units::{mesh_model_in_units, mm_per_unit, Units};
 
 /// Reads `bytes` in `format` and meshes the model: the one call both doors use.

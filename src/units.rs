@@ -5,8 +5,9 @@
 use alloc::format;
 use alloc::string::ToString;
 
-use crate::quality::ElementSize;
-use crate::tessellate::{mesh_model_with_progress, MeshOptions, MeshResult, OptionsError, Tolerance};
+use crate::meshing::mesh_model_with_progress;
+use crate::options::{ElementSize, MeshOptions, OptionsError, Tolerance};
+use crate::report::MeshResult;
 use crate::{Error, Model};
 
 /// Millimetres per unit of the length unit `name`, as the readers name

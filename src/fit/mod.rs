@@ -34,7 +34,7 @@ pub use bezier::{Cubic, PatchPoint, TriPatch};
 pub use points::{read_points, PointFormat, MAX_FILE_POINTS};
 
 use crate::mesh::{edge_counts, Mesh};
-use crate::tessellate::{OptionsError, Tolerance};
+use crate::options::{OptionsError, Tolerance};
 use crate::Error;
 use kdtree::KdTree;
 use normals::Neighbours;
@@ -325,133 +325,12 @@ pub struct FitResult {
 /// `max_points` or `max_triangles`.
 pub fn fit_points(points: &[DVec3], options: &FitOptions) -> Result<FitResult, Error> {
     options.validate()?;
-    if points.len() > options.max_points {
-        return Err(Error::Limit(format!("{} points; at most {} are accepted", points.len(), options.max_points)));
-    }
-    if let Some(i) = points.iter().position(|p| !p.is_finite()) {
-        return Err(Error::Fit(format!("point {i} has a coordinate that is not finite")));
-    }
-    if points.len() < 4 {
-        return Err(Error::Fit(format!("at least 4 points are needed, found {}", points.len())));
-    }
     let mut warnings = Vec::new();
-    let (lo, hi) = points
-        .iter()
-        .fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(l, h), p| (l.min(*p), h.max(*p)));
-    let diag = (hi - lo).length();
-    let (verts, point_index) = merge_duplicates(points, options.merge_distance * diag);
-    let merged = points.len() - verts.len();
-    if merged > 0 {
-        warnings
-            .push(format!("{merged} duplicate point(s) merged (closer than {:.3e})", options.merge_distance * diag));
-    }
-    if verts.len() < 4 {
-        return Err(Error::Fit(format!("at least 4 distinct points are needed, found {}", verts.len())));
-    }
-    let (cov, _) = linalg::covariance(verts.iter().copied());
-    let (ev, axes) = linalg::sym_eigen3(cov);
-    if !(ev[1] > 1e-14 * ev[2]) {
-        return Err(Error::Fit(format!(
-            "the {} points lie on one line (along {:.3?}): no surface passes through them",
-            verts.len(),
-            axes[2].to_array()
-        )));
-    }
-    if !(ev[0] > 1e-14 * ev[2]) {
-        warnings.push("the points lie on one plane: the fit is the flat region of that plane they span".into());
-    }
-
-    // Neighbours, normals, triangle net.
-    let k = options.normal_neighbours.max(options.net_neighbours).min(verts.len() - 1);
-    let tree = KdTree::new(&verts);
-    let mut idx = Vec::with_capacity(verts.len() * k);
-    let mut out = Vec::new();
-    for (i, p) in verts.iter().enumerate() {
-        tree.nearest(*p, k, Some(i as u32), &mut out);
-        idx.extend(out.iter().map(|x| x.0));
-        // Fewer than k found only if points are missing; pad with the nearest.
-        for _ in out.len()..k {
-            idx.push(out.first().map_or(i as u32, |x| x.0));
-        }
-    }
-    let nb = Neighbours { k, idx };
-    let normals = normals::estimate(&verts, &nb, options.normal_neighbours.min(k), options.max_normal_angle / 2.0);
-    let net_opt = trinet::NetOptions {
-        neighbours: options.net_neighbours.min(k),
-        max_normal_angle: options.max_normal_angle,
-        max_hole_edges: options.max_hole_edges,
-    };
-    let mut net = trinet::build(&verts, &normals, &nb, &net_opt);
-    if net.tris.is_empty() {
-        return Err(Error::Fit("no triangle net forms over the points (too sparse or too noisy?)".into()));
-    }
-    let mut normals = normals;
-    if net.borders == 0 && net.holes_open == 0 {
-        // A closed net: orient it outwards (positive enclosed volume).
-        let volume: f64 =
-            net.tris.iter().map(|t| verts[t[0] as usize].dot(verts[t[1] as usize].cross(verts[t[2] as usize]))).sum();
-        if volume < 0.0 {
-            normals.iter_mut().for_each(|n| *n = -*n);
-            net.tris.iter_mut().for_each(|t| t.swap(1, 2));
-        }
-    }
-    if net.holes_open > 0 {
-        warnings.push(format!("{} gap(s) of the triangle net left open", net.holes_open));
-    }
-    let used: usize = {
-        let mut u = vec![false; verts.len()];
-        net.tris.iter().flatten().for_each(|&v| u[v as usize] = true);
-        u.iter().filter(|x| !**x).count()
-    };
-    if used > 0 {
-        warnings.push(format!("{used} point(s) are in no triangle of the net and are not interpolated"));
-    }
-
-    // Polygons and their patches.
-    let poly_opt = polynet::PolyOptions {
-        max_angle: options.max_polygon_angle,
-        max_sides: options.max_polygon_sides,
-        max_tilt: options.max_polygon_tilt,
-    };
-    let corners_list = polynet::merge(&verts, &normals, &net.tris, &poly_opt);
-    let mut polygons = Vec::with_capacity(corners_list.len());
-    let mut failed = 0usize;
-    for corners in corners_list {
-        match polynet::fill(&verts, &normals, &corners, &poly_opt) {
-            Ok(patches) => polygons.push(FitPolygon { corners, patches }),
-            Err(_) => failed += 1,
-        }
-    }
-    if failed > 0 {
-        warnings.push(format!("{failed} polygon(s) could not be filled and leave holes"));
-    }
-    let surface = FitSurface { points: verts, normals, polygons };
-
-    // Tessellation.
-    let tol = match options.tolerance {
-        Tolerance::Absolute(t) => t,
-        Tolerance::Relative(r) => r * diag,
-    };
-    let mut estimate = 0usize;
-    for poly in &surface.polygons {
-        let m = poly.patches.iter().map(|p| p.level_for(tol, options.max_level)).max().unwrap_or(1);
-        estimate = estimate.saturating_add(poly.patches.len().saturating_mul(m * m));
-    }
-    if estimate > options.max_triangles {
-        return Err(Error::Limit(format!(
-            "about {estimate} triangles needed for tolerance {tol:.3e}; at most {} (give a larger tolerance)",
-            options.max_triangles
-        )));
-    }
-    let polys: Vec<tessellate::PolyPatches> =
-        surface.polygons.iter().map(|p| tessellate::PolyPatches { corners: &p.corners, patches: &p.patches }).collect();
-    let tess = tessellate::tessellate(&surface.points, &surface.normals, &polys, tol, options.max_level);
-    let mesh = tess.mesh;
-    if tess.levels.iter().any(|&l| l >= options.max_level) {
-        warnings
-            .push(format!("some patches hit the split limit of {} and may exceed the tolerance", options.max_level));
-    }
-
+    let distinct = distinct_points(points, options, &mut warnings)?;
+    let Distinct { verts, point_index, merged, diag } = distinct;
+    let (normals, net) = triangle_net(&verts, options, &mut warnings)?;
+    let surface = polygons(verts, normals, &net.tris, options, &mut warnings);
+    let (tol, mesh) = tessellated(&surface, options, diag, &mut warnings)?;
     let counts = edge_counts(&mesh, 1e-12 * diag.max(1e-300), 0.0);
     let mut sides = Vec::new();
     for poly in &surface.polygons {
@@ -484,6 +363,184 @@ pub fn fit_points(points: &[DVec3], options: &FitOptions) -> Result<FitResult, E
         warnings,
     };
     Ok(FitResult { surface, mesh, net: net.tris, point_index, report })
+}
+
+/// The input points with duplicates merged, and what merging took.
+struct Distinct {
+    verts: Vec<DVec3>,
+    /// For each input point, its kept index.
+    point_index: Vec<u32>,
+    /// Points merged away.
+    merged: usize,
+    /// Diagonal of the points' bounding box.
+    diag: f64,
+}
+
+/// The distinct points of `points` (closer than the merge distance are
+/// one), checked: finite, at least 4, not on one line; points on one plane
+/// leave a warning.
+///
+/// # Errors
+/// As [`fit_points`] for the points themselves.
+fn distinct_points(points: &[DVec3], options: &FitOptions, warnings: &mut Vec<String>) -> Result<Distinct, Error> {
+    if points.len() > options.max_points {
+        return Err(Error::Limit(format!("{} points; at most {} are accepted", points.len(), options.max_points)));
+    }
+    if let Some(i) = points.iter().position(|p| !p.is_finite()) {
+        return Err(Error::Fit(format!("point {i} has a coordinate that is not finite")));
+    }
+    if points.len() < 4 {
+        return Err(Error::Fit(format!("at least 4 points are needed, found {}", points.len())));
+    }
+    let (lo, hi) = points
+        .iter()
+        .fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(l, h), p| (l.min(*p), h.max(*p)));
+    let diag = (hi - lo).length();
+    let (verts, point_index) = merge_duplicates(points, options.merge_distance * diag);
+    let merged = points.len() - verts.len();
+    if merged > 0 {
+        warnings
+            .push(format!("{merged} duplicate point(s) merged (closer than {:.3e})", options.merge_distance * diag));
+    }
+    if verts.len() < 4 {
+        return Err(Error::Fit(format!("at least 4 distinct points are needed, found {}", verts.len())));
+    }
+    let (cov, _) = linalg::covariance(verts.iter().copied());
+    let (ev, axes) = linalg::sym_eigen3(cov);
+    if !(ev[1] > 1e-14 * ev[2]) {
+        return Err(Error::Fit(format!(
+            "the {} points lie on one line (along {:.3?}): no surface passes through them",
+            verts.len(),
+            axes[2].to_array()
+        )));
+    }
+    if !(ev[0] > 1e-14 * ev[2]) {
+        warnings.push("the points lie on one plane: the fit is the flat region of that plane they span".into());
+    }
+    Ok(Distinct { verts, point_index, merged, diag })
+}
+
+/// Paper 004 §1: each point's neighbours and normal, and the triangle net
+/// over the points, a closed net oriented outwards.
+///
+/// # Errors
+/// [`Error::Fit`] when no triangle net forms.
+fn triangle_net(
+    verts: &[DVec3],
+    options: &FitOptions,
+    warnings: &mut Vec<String>,
+) -> Result<(Vec<DVec3>, trinet::TriNet), Error> {
+    let k = options.normal_neighbours.max(options.net_neighbours).min(verts.len() - 1);
+    let tree = KdTree::new(verts);
+    let mut idx = Vec::with_capacity(verts.len() * k);
+    let mut out = Vec::new();
+    for (i, p) in verts.iter().enumerate() {
+        tree.nearest(*p, k, Some(i as u32), &mut out);
+        idx.extend(out.iter().map(|x| x.0));
+        // Fewer than k found only if points are missing; pad with the nearest.
+        for _ in out.len()..k {
+            idx.push(out.first().map_or(i as u32, |x| x.0));
+        }
+    }
+    let nb = Neighbours { k, idx };
+    let normals = normals::estimate(verts, &nb, options.normal_neighbours.min(k), options.max_normal_angle / 2.0);
+    let net_opt = trinet::NetOptions {
+        neighbours: options.net_neighbours.min(k),
+        max_normal_angle: options.max_normal_angle,
+        max_hole_edges: options.max_hole_edges,
+    };
+    let mut net = trinet::build(verts, &normals, &nb, &net_opt);
+    if net.tris.is_empty() {
+        return Err(Error::Fit("no triangle net forms over the points (too sparse or too noisy?)".into()));
+    }
+    let mut normals = normals;
+    if net.borders == 0 && net.holes_open == 0 {
+        // A closed net: orient it outwards (positive enclosed volume).
+        let volume: f64 =
+            net.tris.iter().map(|t| verts[t[0] as usize].dot(verts[t[1] as usize].cross(verts[t[2] as usize]))).sum();
+        if volume < 0.0 {
+            normals.iter_mut().for_each(|n| *n = -*n);
+            net.tris.iter_mut().for_each(|t| t.swap(1, 2));
+        }
+    }
+    if net.holes_open > 0 {
+        warnings.push(format!("{} gap(s) of the triangle net left open", net.holes_open));
+    }
+    let used: usize = {
+        let mut u = vec![false; verts.len()];
+        net.tris.iter().flatten().for_each(|&v| u[v as usize] = true);
+        u.iter().filter(|x| !**x).count()
+    };
+    if used > 0 {
+        warnings.push(format!("{used} point(s) are in no triangle of the net and are not interpolated"));
+    }
+    Ok((normals, net))
+}
+
+/// Paper 004 §2–§4: the net's triangles merged into convex polygons, each
+/// filled with its G¹ sub-patches; a polygon that cannot be filled leaves
+/// a hole, with a warning.
+fn polygons(
+    verts: Vec<DVec3>,
+    normals: Vec<DVec3>,
+    tris: &[[u32; 3]],
+    options: &FitOptions,
+    warnings: &mut Vec<String>,
+) -> FitSurface {
+    let poly_opt = polynet::PolyOptions {
+        max_angle: options.max_polygon_angle,
+        max_sides: options.max_polygon_sides,
+        max_tilt: options.max_polygon_tilt,
+    };
+    let corners_list = polynet::merge(&verts, &normals, tris, &poly_opt);
+    let mut polygons = Vec::with_capacity(corners_list.len());
+    let mut failed = 0usize;
+    for corners in corners_list {
+        match polynet::fill(&verts, &normals, &corners, &poly_opt) {
+            Ok(patches) => polygons.push(FitPolygon { corners, patches }),
+            Err(_) => failed += 1,
+        }
+    }
+    if failed > 0 {
+        warnings.push(format!("{failed} polygon(s) could not be filled and leave holes"));
+    }
+    FitSurface { points: verts, normals, polygons }
+}
+
+/// The surface's tessellation within the tolerance (relative: of `diag`):
+/// the tolerance and the mesh.
+///
+/// # Errors
+/// [`Error::Limit`] when the tolerance needs more than `max_triangles`.
+fn tessellated(
+    surface: &FitSurface,
+    options: &FitOptions,
+    diag: f64,
+    warnings: &mut Vec<String>,
+) -> Result<(f64, Mesh), Error> {
+    let tol = match options.tolerance {
+        Tolerance::Absolute(t) => t,
+        Tolerance::Relative(r) => r * diag,
+    };
+    let mut estimate = 0usize;
+    for poly in &surface.polygons {
+        let m = poly.patches.iter().map(|p| p.level_for(tol, options.max_level)).max().unwrap_or(1);
+        estimate = estimate.saturating_add(poly.patches.len().saturating_mul(m * m));
+    }
+    if estimate > options.max_triangles {
+        return Err(Error::Limit(format!(
+            "about {estimate} triangles needed for tolerance {tol:.3e}; at most {} (give a larger tolerance)",
+            options.max_triangles
+        )));
+    }
+    let polys: Vec<tessellate::PolyPatches> =
+        surface.polygons.iter().map(|p| tessellate::PolyPatches { corners: &p.corners, patches: &p.patches }).collect();
+    let tess = tessellate::tessellate(&surface.points, &surface.normals, &polys, tol, options.max_level);
+    if tess.levels.iter().any(|&l| l >= options.max_level) {
+        warnings
+            .push(format!("some patches hit the split limit of {} and may exceed the tolerance", options.max_level));
+    }
+    Ok((tol, tess.mesh))
 }
 
 /// Merges points closer than `dist` (grid hashing); returns the kept points

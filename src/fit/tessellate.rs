@@ -59,33 +59,70 @@ pub(crate) fn tessellate(
             *e = (*e).max(levels[p]);
         }
     }
-
-    let mut mesh = Mesh::default();
-    let mut sources = Vec::new();
-    // Net vertex → mesh vertex.
-    let mut corner_vertex: HashMap<u32, u32> = HashMap::default();
-    // Net edge (low, high) → interior vertices, low to high.
-    let mut edge_vertices: HashMap<(u32, u32), Vec<u32>> = HashMap::default();
-    let push = |mesh: &mut Mesh, p: DVec3, n: DVec3| -> u32 {
-        mesh.positions.push(p);
-        mesh.normals.push(n);
-        (mesh.positions.len() - 1) as u32
+    let mut b = Builder {
+        mesh: Mesh::default(),
+        sources: Vec::new(),
+        corner_vertex: HashMap::default(),
+        edge_vertices: HashMap::default(),
     };
-
     for (pi, poly) in polys.iter().enumerate() {
+        let first = (b.mesh.indices.len() / 3) as u32;
+        b.polygon(pi, poly, levels[pi], &edge_level, (points, normals));
+        let last = (b.mesh.indices.len() / 3) as u32;
+        b.mesh.face_ranges.push(FaceRange { first, count: last - first });
+    }
+    Tessellation { mesh: b.mesh, sources: b.sources, levels }
+}
+
+/// The mesh as it grows, with the vertices polygons share.
+struct Builder {
+    mesh: Mesh,
+    sources: Vec<TriSource>,
+    /// Net vertex → mesh vertex.
+    corner_vertex: HashMap<u32, u32>,
+    /// Net edge (low, high) → interior vertices, low to high.
+    edge_vertices: HashMap<(u32, u32), Vec<u32>>,
+}
+
+impl Builder {
+    fn push(&mut self, p: DVec3, n: DVec3) -> u32 {
+        self.mesh.positions.push(p);
+        self.mesh.normals.push(n);
+        (self.mesh.positions.len() - 1) as u32
+    }
+
+    /// Triangle `v` of sub-patch `(polygon, patch)`, its corners at `params`.
+    fn tri(&mut self, (polygon, patch): (usize, usize), v: [u32; 3], params: [(f64, f64); 3]) {
+        self.mesh.indices.extend_from_slice(&v);
+        self.sources.push(TriSource { polygon: polygon as u32, patch: patch as u32, params });
+    }
+
+    /// Polygon `pi` at level `m`: its corners (shared), centre and spokes,
+    /// then each sub-patch; `(points, normals)` are the net's.
+    fn polygon(
+        &mut self,
+        pi: usize,
+        poly: &PolyPatches,
+        m: usize,
+        edge_level: &HashMap<(u32, u32), usize>,
+        (points, normals): (&[DVec3], &[DVec3]),
+    ) {
         let n = poly.corners.len();
-        let m = levels[pi];
-        let first = (mesh.indices.len() / 3) as u32;
         let corner: Vec<u32> = poly
             .corners
             .iter()
-            .map(|&c| {
-                *corner_vertex.entry(c).or_insert_with(|| push(&mut mesh, points[c as usize], normals[c as usize]))
+            .map(|&c| match self.corner_vertex.get(&c) {
+                Some(&v) => v,
+                None => {
+                    let v = self.push(points[c as usize], normals[c as usize]);
+                    self.corner_vertex.insert(c, v);
+                    v
+                }
             })
             .collect();
         // Centre.
         let c = poly.patches[0].eval(0.0, 1.0);
-        let centre = push(&mut mesh, c.point, c.normal());
+        let centre = self.push(c.point, c.normal());
         // Spoke i: Z_i → O, m + 1 vertices, evaluated on S_i at (0, t).
         let spokes: Vec<Vec<u32>> = (0..n)
             .map(|i| {
@@ -93,7 +130,7 @@ pub(crate) fn tessellate(
                 s.push(corner[i]);
                 for k in 1..m {
                     let e = poly.patches[i].eval(0.0, k as f64 / m as f64);
-                    s.push(push(&mut mesh, e.point, e.normal()));
+                    s.push(self.push(e.point, e.normal()));
                 }
                 s.push(centre);
                 s
@@ -101,98 +138,112 @@ pub(crate) fn tessellate(
             .collect();
         for i in 0..n {
             let j = (i + 1) % n;
-            let patch = &poly.patches[i];
             let (a, b) = (poly.corners[i], poly.corners[j]);
             let ke = edge_level.get(&key(a, b)).copied().unwrap_or(m).max(m);
-            // Edge vertices a → b, discretized once for both polygons.
-            let inner = edge_vertices.entry(key(a, b)).or_insert_with(|| {
+            let row0 = self.net_edge(&poly.patches[i], (a, b), ke, (corner[i], corner[j]));
+            self.sub_patch((pi, i), &poly.patches[i], m, row0, (&spokes[i], &spokes[j]));
+        }
+    }
+
+    /// The vertices of net edge `a → b` at `ke` segments, its ends the
+    /// mesh vertices `ends`: its interior discretized once for both
+    /// polygons (on `patch`, low to high).
+    fn net_edge(&mut self, patch: &TriPatch, (a, b): (u32, u32), ke: usize, ends: (u32, u32)) -> Vec<u32> {
+        let inner = match self.edge_vertices.get(&key(a, b)) {
+            Some(v) => v.clone(),
+            None => {
                 let mut v = Vec::with_capacity(ke.saturating_sub(1));
                 for s in 1..ke {
                     let t = s as f64 / ke as f64;
                     // Evaluate in the direction low → high.
                     let e = if a < b { patch.eval(t, 0.0) } else { patch.eval(1.0 - t, 0.0) };
-                    v.push(push(&mut mesh, e.point, e.normal()));
+                    v.push(self.push(e.point, e.normal()));
                 }
+                self.edge_vertices.insert(key(a, b), v.clone());
                 v
-            });
-            let mut row0: Vec<u32> = Vec::with_capacity(ke + 1);
-            row0.push(corner[i]);
-            if a < b {
-                row0.extend(inner.iter().copied());
-            } else {
-                row0.extend(inner.iter().rev().copied());
             }
-            row0.push(corner[j]);
+        };
+        let mut row0: Vec<u32> = Vec::with_capacity(ke + 1);
+        row0.push(ends.0);
+        if a < b {
+            row0.extend(inner.iter().copied());
+        } else {
+            row0.extend(inner.iter().rev().copied());
+        }
+        row0.push(ends.1);
+        row0
+    }
 
-            // Grid vertex (j, k) of this sub-patch, k ≥ 1.
-            let mut grid: Vec<Vec<u32>> = Vec::with_capacity(m + 1);
-            grid.push(if ke == m { row0.clone() } else { Vec::new() });
-            for k in 1..=m {
-                let mut row = Vec::with_capacity(m - k + 1);
-                for jj in 0..=m - k {
-                    let v = if jj == 0 {
-                        spokes[i][k]
-                    } else if jj == m - k {
-                        spokes[j][k]
-                    } else {
-                        let e = patch.eval(jj as f64 / m as f64, k as f64 / m as f64);
-                        push(&mut mesh, e.point, e.normal())
-                    };
-                    row.push(v);
-                }
-                grid.push(row);
+    /// Sub-patch `at = (polygon, patch)` at level `m`: its grid between its
+    /// two spokes `(left, right)` above the net edge's vertices `row0`,
+    /// joined to them by a zipper where the edge has more segments.
+    fn sub_patch(&mut self, at: (usize, usize), patch: &TriPatch, m: usize, row0: Vec<u32>, spokes: (&[u32], &[u32])) {
+        let ke = row0.len() - 1;
+        // Grid vertex (j, k) of this sub-patch, k ≥ 1.
+        let mut grid: Vec<Vec<u32>> = Vec::with_capacity(m + 1);
+        grid.push(if ke == m { row0.clone() } else { Vec::new() });
+        for k in 1..=m {
+            let mut row = Vec::with_capacity(m - k + 1);
+            for jj in 0..=m - k {
+                let v = if jj == 0 {
+                    spokes.0[k]
+                } else if jj == m - k {
+                    spokes.1[k]
+                } else {
+                    let e = patch.eval(jj as f64 / m as f64, k as f64 / m as f64);
+                    self.push(e.point, e.normal())
+                };
+                row.push(v);
             }
-            let param = |jj: usize, k: usize| (jj as f64 / m as f64, k as f64 / m as f64);
-            let mut tri = |mesh: &mut Mesh, v: [u32; 3], params: [(f64, f64); 3]| {
-                mesh.indices.extend_from_slice(&v);
-                sources.push(TriSource { polygon: pi as u32, patch: i as u32, params });
-            };
-            let k_start = if ke == m { 0 } else { 1 };
-            for k in k_start..m {
-                for jj in 0..m - k {
-                    tri(
-                        &mut mesh,
-                        [grid[k][jj], grid[k][jj + 1], grid[k + 1][jj]],
-                        [param(jj, k), param(jj + 1, k), param(jj, k + 1)],
+            grid.push(row);
+        }
+        let param = |jj: usize, k: usize| (jj as f64 / m as f64, k as f64 / m as f64);
+        let k_start = if ke == m { 0 } else { 1 };
+        for k in k_start..m {
+            for jj in 0..m - k {
+                self.tri(
+                    at,
+                    [grid[k][jj], grid[k][jj + 1], grid[k + 1][jj]],
+                    [param(jj, k), param(jj + 1, k), param(jj, k + 1)],
+                );
+                if jj + 1 < m - k {
+                    self.tri(
+                        at,
+                        [grid[k][jj + 1], grid[k + 1][jj + 1], grid[k + 1][jj]],
+                        [param(jj + 1, k), param(jj + 1, k + 1), param(jj, k + 1)],
                     );
-                    if jj + 1 < m - k {
-                        tri(
-                            &mut mesh,
-                            [grid[k][jj + 1], grid[k + 1][jj + 1], grid[k + 1][jj]],
-                            [param(jj + 1, k), param(jj + 1, k + 1), param(jj, k + 1)],
-                        );
-                    }
-                }
-            }
-            if ke != m {
-                // Zipper between row 0 (ke segments) and row 1 (m vertices at
-                // λ1 = j/m): each row-0 segment joins the row-1 vertex whose
-                // cell [j/m, (j+1)/m] holds its middle, so every zipper edge
-                // runs between the grid directions λ2 and λ2 − λ1 and the
-                // flatness bound of the grid still holds.
-                let row1 = &grid[1];
-                let pa = |s: usize| (s as f64 / ke as f64, 0.0);
-                let pb = |s: usize| (s as f64 / m as f64, 1.0 / m as f64);
-                let mut ib = 0usize;
-                for ia in 0..ke {
-                    let mid = (ia as f64 + 0.5) / ke as f64;
-                    let target = ((mid * m as f64) as usize).min(row1.len() - 1);
-                    while ib < target {
-                        tri(&mut mesh, [row0[ia], row1[ib + 1], row1[ib]], [pa(ia), pb(ib + 1), pb(ib)]);
-                        ib += 1;
-                    }
-                    tri(&mut mesh, [row0[ia], row0[ia + 1], row1[ib]], [pa(ia), pa(ia + 1), pb(ib)]);
-                }
-                while ib + 1 < row1.len() {
-                    tri(&mut mesh, [row0[ke], row1[ib + 1], row1[ib]], [pa(ke), pb(ib + 1), pb(ib)]);
-                    ib += 1;
                 }
             }
         }
-        let last = (mesh.indices.len() / 3) as u32;
-        mesh.face_ranges.push(FaceRange { first, count: last - first });
+        if ke != m {
+            self.zipper(at, &row0, &grid[1], m);
+        }
     }
-    Tessellation { mesh, sources, levels }
+
+    /// Zipper between row 0 (`row0`, its segments) and row 1 (`row1`, m
+    /// vertices at λ1 = j/m): each row-0 segment joins the row-1 vertex whose
+    /// cell [j/m, (j+1)/m] holds its middle, so every zipper edge runs
+    /// between the grid directions λ2 and λ2 − λ1 and the flatness bound of
+    /// the grid still holds.
+    fn zipper(&mut self, at: (usize, usize), row0: &[u32], row1: &[u32], m: usize) {
+        let ke = row0.len() - 1;
+        let pa = |s: usize| (s as f64 / ke as f64, 0.0);
+        let pb = |s: usize| (s as f64 / m as f64, 1.0 / m as f64);
+        let mut ib = 0usize;
+        for ia in 0..ke {
+            let mid = (ia as f64 + 0.5) / ke as f64;
+            let target = ((mid * m as f64) as usize).min(row1.len() - 1);
+            while ib < target {
+                self.tri(at, [row0[ia], row1[ib + 1], row1[ib]], [pa(ia), pb(ib + 1), pb(ib)]);
+                ib += 1;
+            }
+            self.tri(at, [row0[ia], row0[ia + 1], row1[ib]], [pa(ia), pa(ia + 1), pb(ib)]);
+        }
+        while ib + 1 < row1.len() {
+            self.tri(at, [row0[ke], row1[ib + 1], row1[ib]], [pa(ke), pb(ib + 1), pb(ib)]);
+            ib += 1;
+        }
+    }
 }
 
 fn key(a: u32, b: u32) -> (u32, u32) {

@@ -78,30 +78,7 @@ pub(crate) fn edge_census(
     let face_of = face_lookup(mesh);
     let body_of_face = |f: u32| crate::model::body_of(bodies, f as usize);
     if !bodies.is_empty() {
-        // Each vertex's body, from the triangles that use it (faces own their vertices).
-        let mut body_of_vertex = alloc::vec![0u32; mesh.positions.len()];
-        for (ti, t) in mesh.indices.chunks_exact(3).enumerate() {
-            for &v in t {
-                if let Some(b) = body_of_vertex.get_mut(v as usize) {
-                    *b = body_of_face(face_of(ti));
-                }
-            }
-        }
-        // A welded vertex splits by body: one keeps its id (the body of
-        // its first position), the few that touch another body get new ones.
-        let mut home = alloc::vec![u32::MAX; nverts];
-        let mut extra: crate::collections::HashMap<(u32, u32), u32> = crate::collections::HashMap::default();
-        for (v, m) in map.iter_mut().enumerate() {
-            let b = body_of_vertex[v];
-            let h = &mut home[*m as usize];
-            if *h == u32::MAX {
-                *h = b;
-            } else if *h != b {
-                let next = (nverts + extra.len()) as u32;
-                *m = *extra.entry((*m, b)).or_insert(next);
-            }
-        }
-        nverts += extra.len();
+        split_by_body(mesh, body_of_face, &face_of, &mut map, &mut nverts);
     }
     // Each welded vertex's last position stands for it.
     let mut rep = alloc::vec![0u32; nverts];
@@ -187,6 +164,40 @@ pub(crate) fn edge_census(
     }
     gaps.sort_by_key(|g| g.faces);
     (out, gaps)
+}
+
+/// Welded vertices (`map`, `nverts` of them) split by body: one keeps its
+/// id (the body of its first position), the few that touch another body get
+/// new ones. Each vertex's body comes from the triangles that use it (faces
+/// own their vertices).
+fn split_by_body(
+    mesh: &Mesh,
+    body_of_face: impl Fn(u32) -> u32,
+    face_of: impl Fn(usize) -> u32,
+    map: &mut [u32],
+    nverts: &mut usize,
+) {
+    let mut body_of_vertex = alloc::vec![0u32; mesh.positions.len()];
+    for (ti, t) in mesh.indices.chunks_exact(3).enumerate() {
+        for &v in t {
+            if let Some(b) = body_of_vertex.get_mut(v as usize) {
+                *b = body_of_face(face_of(ti));
+            }
+        }
+    }
+    let mut home = alloc::vec![u32::MAX; *nverts];
+    let mut extra: crate::collections::HashMap<(u32, u32), u32> = crate::collections::HashMap::default();
+    for (v, m) in map.iter_mut().enumerate() {
+        let b = body_of_vertex[v];
+        let h = &mut home[*m as usize];
+        if *h == u32::MAX {
+            *h = b;
+        } else if *h != b {
+            let next = (*nverts + extra.len()) as u32;
+            *m = *extra.entry((*m, b)).or_insert(next);
+        }
+    }
+    *nverts += extra.len();
 }
 
 /// The report's line about faces the reader skipped, if any: how many, and
@@ -316,7 +327,7 @@ impl<'a> Holes<'a> {
         self.curves.iter().any(|(c, b, bbox)| {
             *b == body
                 && points.iter().all(|&q| bbox.contains(q, self.reach))
-                && points.iter().all(|&q| c.project(q).2 <= self.reach)
+                && points.iter().all(|&q| c.project(q).distance <= self.reach)
         })
     }
 }

@@ -8,7 +8,12 @@ use glam::{DVec2, DVec3};
 use crate::nurbs::{Aabb, NurbsCurve, NurbsSurface, Surface, SurfaceDerivs};
 
 mod assembly;
+mod bodies;
+mod extent;
 pub use assembly::{Assembly, AssemblyNode, PartInstance};
+pub(crate) use bodies::body_count;
+pub use bodies::share_of_faces;
+pub(crate) use extent::trimmed_bbox;
 
 /// Everything read from one input file.
 #[derive(Debug, Clone, Default)]

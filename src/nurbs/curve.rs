@@ -6,7 +6,7 @@ use core::cmp::Ordering;
 use glam::{DVec3, DVec4};
 
 use super::knots::{KnotVector, MAX_DERIV};
-use super::{Aabb, NurbsError, MAX_DEGREE};
+use super::{Aabb, CurveProjection, NurbsError, MAX_DEGREE};
 
 /// A (possibly rational) B-spline curve. 2-D curves (trim loops in (u,v)) keep z = 0.
 ///
@@ -223,6 +223,14 @@ impl NurbsCurve {
         Aabb::from_points(self.control_points())
     }
 
+    /// Closest point on the curve to `target`: its parameter, the point and
+    /// its distance, found by a branch and bound over the curve's Bézier
+    /// pieces finished by Newton's method; never leaves the domain.
+    pub fn project(&self, target: DVec3) -> CurveProjection {
+        let (t, point, distance) = self.closest(target);
+        CurveProjection { t, point, distance }
+    }
+
     /// Closest point on the curve to `target`: `(t, point, distance)`.
     ///
     /// Branch and bound over Bézier pieces: every knot span is converted to
@@ -235,7 +243,7 @@ impl NurbsCurve {
     /// of rational spans, corners at knots and seams of closed curves are all
     /// searched; the work is capped at a few thousand pieces. Never leaves
     /// the domain.
-    pub fn project(&self, target: DVec3) -> (f64, DVec3, f64) {
+    fn closest(&self, target: DVec3) -> (f64, DVec3, f64) {
         let (a, _) = self.domain();
         let p = self.degree();
         let pa = self.point(a);

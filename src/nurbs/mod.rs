@@ -19,7 +19,7 @@ pub use bbox::Aabb;
 pub use curve::{CurveDerivs, NurbsCurve};
 pub use error::NurbsError;
 pub use knots::{BasisDers, KnotVector};
-pub use project::{project_to_surface, Projection, ProjectionOptions};
+pub use project::{project_to_surface, CurveProjection, Projection, ProjectionOptions};
 pub use surface::NurbsSurface;
 
 /// Highest degree accepted (basis functions use fixed-size scratch arrays).

@@ -34,6 +34,17 @@ pub struct Projection {
     pub distance: f64,
 }
 
+/// Result of projecting a point on a curve ([`crate::NurbsCurve::project`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurveProjection {
+    /// Parameter of the closest point found.
+    pub t: f64,
+    /// The closest point found on the curve.
+    pub point: DVec3,
+    /// Its distance to the target.
+    pub distance: f64,
+}
+
 /// Newton runs at most from the coarse search (its best distinct local minima).
 const MAX_STARTS: usize = 4;
 

@@ -175,7 +175,62 @@ pub(crate) fn discretize(
     sew: f64,
     budget: usize,
 ) -> Result<Vec<Result<FaceBoundary, String>>, String> {
-    // Traces of every face, loops oriented (outer counter-clockwise first).
+    let (loops_of, traces) = collect_traces(faces);
+    let samples = sample_traces(faces, &traces, h, budget)?;
+    // Vertices: curve ends welded.
+    let ends: Vec<DVec3> = samples
+        .iter()
+        .flat_map(|s| [s.x.first().copied().unwrap_or(DVec3::ZERO), s.x.last().copied().unwrap_or(DVec3::ZERO)])
+        .collect();
+    let (vmap, nverts) = weld_positions(&ends, sew);
+    let mut vpos = alloc::vec![DVec3::ZERO; nverts];
+    let mut vseen = alloc::vec![false; nverts];
+    for (i, &m) in vmap.iter().enumerate() {
+        if !vseen[m as usize] {
+            vseen[m as usize] = true;
+            vpos[m as usize] = ends[i];
+        }
+    }
+    let (mut pieces, pieces_of_trace) = split_at_vertices(&traces, &samples, &vmap, &vpos, sew);
+    // Pieces that are one model edge.
+    let groups = match_pieces(&pieces, &samples, sew);
+    // Node counts per edge: ceil(L/H), and enough for every loop to have three nodes.
+    let mut loop_pieces = alloc::vec![0usize; pieces.len()];
+    for lp in loops_of.iter().flatten().flatten() {
+        let count: usize = lp.iter().map(|&t| pieces_of_trace[t].len()).sum();
+        for &t in lp {
+            for &p in &pieces_of_trace[t] {
+                loop_pieces[p] = count;
+            }
+        }
+    }
+    let divider = Divider { faces, traces: &traces, samples: &samples, vpos: &vpos, h, sew };
+    for g in &groups {
+        divider.divide_edge(g, &loop_pieces, &mut pieces);
+    }
+    // Each face's loops from its pieces' nodes.
+    Ok(loops_of
+        .into_iter()
+        .map(|loops| loops.and_then(|l| face_boundary(&l, &traces, &pieces_of_trace, &pieces, h)))
+        .collect())
+}
+
+/// What dividing the model's edges reads: the faces, their traces and
+/// samples, the welded vertices, the element size and the sewing distance.
+struct Divider<'a, 'f> {
+    faces: &'f [Face],
+    traces: &'a [(usize, Trace<'f>)],
+    samples: &'a [Samples],
+    vpos: &'a [DVec3],
+    h: f64,
+    sew: f64,
+}
+
+/// Every face's boundary traces, loops oriented (outer counter-clockwise
+/// first), numbered across the model: per face, its loops as trace numbers
+/// (or why it has none), and each trace with its face.
+#[allow(clippy::type_complexity)]
+fn collect_traces(faces: &[Face]) -> (Vec<Result<Vec<Vec<usize>>, String>>, Vec<(usize, Trace<'_>)>) {
     let mut loops_of: Vec<Result<Vec<Vec<usize>>, String>> = Vec::with_capacity(faces.len());
     let mut traces: Vec<(usize, Trace<'_>)> = Vec::new();
     for (fi, f) in faces.iter().enumerate() {
@@ -193,10 +248,17 @@ pub(crate) fn discretize(
                 .collect()
         }));
     }
-    // Model-space samples, dense enough for the size.
+    (loops_of, traces)
+}
+
+/// Model-space samples of every trace, dense enough for the size `h`.
+///
+/// # Errors
+/// A message when the boundary alone needs more than `budget` nodes.
+fn sample_traces(faces: &[Face], traces: &[(usize, Trace<'_>)], h: f64, budget: usize) -> Result<Vec<Samples>, String> {
     let mut samples: Vec<Samples> = Vec::with_capacity(traces.len());
     let mut total_nodes = 0usize;
-    for (fi, tr) in &traces {
+    for (fi, tr) in traces {
         let s: &dyn Surface = &faces[*fi].surface;
         let mut sm = Samples::take(s, tr, 16, 64);
         let need = 4.0 * sm.length() / h;
@@ -211,26 +273,24 @@ pub(crate) fn discretize(
         }
         samples.push(sm);
     }
-    // Vertices: curve ends welded.
-    let ends: Vec<DVec3> = samples
-        .iter()
-        .flat_map(|s| [s.x.first().copied().unwrap_or(DVec3::ZERO), s.x.last().copied().unwrap_or(DVec3::ZERO)])
-        .collect();
-    let (vmap, nverts) = weld_positions(&ends, sew);
-    let mut vpos = alloc::vec![DVec3::ZERO; nverts];
-    let mut vseen = alloc::vec![false; nverts];
-    for (i, &m) in vmap.iter().enumerate() {
-        if !vseen[m as usize] {
-            vseen[m as usize] = true;
-            vpos[m as usize] = ends[i];
-        }
-    }
-    // Vertices on other traces' interiors split them.
+    Ok(samples)
+}
+
+/// Each trace cut into pieces at the vertices (`vpos`; its own ends are
+/// `vmap[2 t]` and `vmap[2 t + 1]`) that lie on its interior within `sew`:
+/// the pieces, and each trace's pieces in order.
+fn split_at_vertices(
+    traces: &[(usize, Trace<'_>)],
+    samples: &[Samples],
+    vmap: &[u32],
+    vpos: &[DVec3],
+    sew: f64,
+) -> (Vec<Piece>, Vec<Vec<usize>>) {
     let mut pieces: Vec<Piece> = Vec::new();
     let mut pieces_of_trace: Vec<Vec<usize>> = alloc::vec![Vec::new(); traces.len()];
     for (ti, sm) in samples.iter().enumerate() {
         let (va, vb) = (vmap[2 * ti], vmap[2 * ti + 1]);
-        let mut cuts: Vec<(f64, u32)> = on_trace(sm, &vpos, va, vb, sew);
+        let mut cuts: Vec<(f64, u32)> = on_trace(sm, vpos, va, vb, sew);
         cuts.sort_by(|a, b| a.0.total_cmp(&b.0));
         let len = sm.length();
         let mut prev = (0.0, va);
@@ -252,19 +312,16 @@ pub(crate) fn discretize(
             prev = (s, v);
         }
     }
-    // Pieces that are one model edge.
-    let groups = match_pieces(&pieces, &samples, sew);
-    // Node counts per edge: ceil(L/H), and enough for every loop to have three nodes.
-    let mut loop_pieces = alloc::vec![0usize; pieces.len()];
-    for lp in loops_of.iter().flatten().flatten() {
-        let count: usize = lp.iter().map(|&t| pieces_of_trace[t].len()).sum();
-        for &t in lp {
-            for &p in &pieces_of_trace[t] {
-                loop_pieces[p] = count;
-            }
-        }
-    }
-    for g in &groups {
+    (pieces, pieces_of_trace)
+}
+
+impl Divider<'_, '_> {
+    /// Divides the model edge made of the pieces `g` (the first the master)
+    /// into ceil(L/H) parts by the master's arc length (at least as many as
+    /// a loop of few pieces needs, per `loop_pieces`), and gives every piece
+    /// the same 3-D nodes at its own curve parameters.
+    fn divide_edge(&self, g: &[usize], loop_pieces: &[usize], pieces: &mut [Piece]) {
+        let (h, sew, samples) = (self.h, self.sew, self.samples);
         let master = pieces[g[0]].clone();
         let master = &master;
         let len = master.len();
@@ -281,12 +338,12 @@ pub(crate) fn discretize(
         }
         // The master's nodes at equal arc length; its ends are the vertices.
         let msm = &samples[master.trace];
-        let tr = &traces[master.trace].1;
-        let surface: &dyn Surface = &faces[master.face].surface;
+        let tr = &self.traces[master.trace].1;
+        let surface: &dyn Surface = &self.faces[master.face].surface;
         let mut xs: Vec<DVec3> = Vec::with_capacity(n);
         for k in 0..n {
             if k == 0 {
-                xs.push(vpos[master.va as usize]);
+                xs.push(self.vpos[master.va as usize]);
             } else {
                 let t = msm.t_at(master.s0 + len * k as f64 / n as f64);
                 xs.push(surface.point(tr.uv(t)));
@@ -295,13 +352,13 @@ pub(crate) fn discretize(
         for &p in g {
             let piece = &pieces[p];
             let sm = &samples[piece.trace];
-            let same = piece.va == master.va && (piece.va != piece.vb || same_direction(piece, master, &samples));
+            let same = piece.va == master.va && (piece.va != piece.vb || same_direction(piece, master, samples));
             let mut nodes = Vec::with_capacity(n);
             for k in 0..n {
                 let (x, frac) = if same {
                     (xs[k], k as f64 / n as f64)
                 } else if k == 0 {
-                    (vpos[piece.va as usize], 0.0)
+                    (self.vpos[piece.va as usize], 0.0)
                 } else {
                     (xs[n - k], k as f64 / n as f64)
                 };
@@ -317,46 +374,41 @@ pub(crate) fn discretize(
             pieces[p].nodes = nodes;
         }
     }
-    // Each face's loops from its pieces' nodes.
-    let mut out = Vec::with_capacity(faces.len());
-    for (fi, loops) in loops_of.into_iter().enumerate() {
-        let loops = match loops {
-            Ok(l) => l,
-            Err(e) => {
-                out.push(Err(e));
-                continue;
-            }
-        };
-        let mut fb = FaceBoundary::default();
-        let mut bad = None;
-        for (li, lp) in loops.iter().enumerate() {
-            let mut nodes: Vec<BNode> = Vec::new();
-            for &ti in lp {
-                let tr = &traces[ti].1;
-                for &p in &pieces_of_trace[ti] {
-                    for &(t, x) in &pieces[p].nodes {
-                        nodes.push(BNode { uv: tr.uv(t), x, h });
-                    }
+}
+
+/// A face's boundary from its `loops` (trace numbers) and their pieces' nodes.
+///
+/// # Errors
+/// A loop left with fewer than three nodes: it encloses no area.
+fn face_boundary(
+    loops: &[Vec<usize>],
+    traces: &[(usize, Trace<'_>)],
+    pieces_of_trace: &[Vec<usize>],
+    pieces: &[Piece],
+    h: f64,
+) -> Result<FaceBoundary, String> {
+    let mut fb = FaceBoundary::default();
+    for (li, lp) in loops.iter().enumerate() {
+        let mut nodes: Vec<BNode> = Vec::new();
+        for &ti in lp {
+            let tr = &traces[ti].1;
+            for &p in &pieces_of_trace[ti] {
+                for &(t, x) in &pieces[p].nodes {
+                    nodes.push(BNode { uv: tr.uv(t), x, h });
                 }
             }
-            nodes.dedup_by(|a, b| a.uv == b.uv);
-            while nodes.len() > 1 && nodes.first().map(|n| n.uv) == nodes.last().map(|n| n.uv) {
-                nodes.pop();
-            }
-            if nodes.len() < 3 {
-                bad = Some(format!("loop {li} has {} boundary nodes; it encloses no area", nodes.len()));
-                break;
-            }
-            set_sizes(&mut nodes, h);
-            fb.loops.push(nodes);
         }
-        let _ = fi;
-        out.push(match bad {
-            Some(e) => Err(e),
-            None => Ok(fb),
-        });
+        nodes.dedup_by(|a, b| a.uv == b.uv);
+        while nodes.len() > 1 && nodes.first().map(|n| n.uv) == nodes.last().map(|n| n.uv) {
+            nodes.pop();
+        }
+        if nodes.len() < 3 {
+            return Err(format!("loop {li} has {} boundary nodes; it encloses no area", nodes.len()));
+        }
+        set_sizes(&mut nodes, h);
+        fb.loops.push(nodes);
     }
-    Ok(out)
+    Ok(fb)
 }
 
 /// The face's boundary traces by loop, oriented: outer loop (largest area in

@@ -11,13 +11,13 @@ use super::delaunay;
 use super::improve::{self, min_angle, FaceMesh};
 use super::looping;
 use super::mapping::PlaneMap;
-use super::{ElementSize, QualityMethod, QualityReport, EDGE_BAND, GOOD_ANGLE_DEG};
 use crate::mesh::{angle_stats, edge_counts_around_skipped, weld_positions, FaceRange};
 use crate::model::Face;
 use crate::nurbs::Surface;
 use crate::nurbs::{project_to_surface, ProjectionOptions};
-use crate::tessellate::{MeshOptions, MeshResult, Tolerance};
-use crate::{Error, Mesh, Model, Report};
+use crate::options::{ElementSize, MeshOptions, QualityMethod, Tolerance};
+use crate::report::{MeshResult, QualityReport, Report, EDGE_BAND, GOOD_ANGLE_DEG};
+use crate::{Error, Mesh, Model};
 
 /// Quality of one face's mesh: (good-angle fraction, edge-band fraction).
 fn face_score(m: &FaceMesh, size: f64) -> (f64, f64) {
@@ -62,7 +62,7 @@ pub(crate) fn mesh_quality(
     if model.faces.is_empty() {
         return Err(Error::Model { location: "model".into(), message: "has no faces".into() });
     }
-    let diag = crate::tessellate::trimmed_bbox(model).diagonal();
+    let diag = crate::model::trimmed_bbox(model).diagonal();
     let size = match q.size {
         ElementSize::Absolute(h) => h,
         ElementSize::Relative(r) => r * diag,

@@ -139,31 +139,7 @@ pub(crate) fn build(g: &Geometry<'_>, points: &mut Points, t: u32) -> Sub {
     let tv = g.tris[t as usize];
     let corners = tv.map(|v| g.positions[v as usize]);
     let segs: Vec<u32> = g.x.of(t).to_vec();
-    let partner_of = |s: u32| {
-        let seg = &g.x.segments[s as usize];
-        if seg.tris[0] == t {
-            seg.tris[1]
-        } else {
-            seg.tris[0]
-        }
-    };
-    // Triple points on each segment: (other triangle, key).
-    let mut triples: Vec<Vec<(u32, PointKey)>> = alloc::vec![Vec::new(); segs.len()];
-    for i in 0..segs.len() {
-        for j in i + 1..segs.len() {
-            let (b, c) = (partner_of(segs[i]), partner_of(segs[j]));
-            if b == c {
-                continue;
-            }
-            let mut abc = [t, b, c];
-            abc.sort_unstable();
-            if triple_exists(g.positions, g.tris, g.x, abc) {
-                let k = PointKey::Triple(abc[0], abc[1], abc[2]);
-                triples[i].push((c, k));
-                triples[j].push((b, k));
-            }
-        }
-    }
+    let triples = triple_points(g, t, &segs);
     // Local points: corners, edge points, then the rest.
     let mut local: Vec<PointKey> = tv.map(PointKey::Vertex).to_vec();
     let mut on_edge: [Vec<u32>; 3] = [Vec::new(), Vec::new(), Vec::new()];
@@ -178,37 +154,7 @@ pub(crate) fn build(g: &Geometry<'_>, points: &mut Points, t: u32) -> Sub {
         }
     }
     let boundary_count = local.len();
-    let local_of = |local: &mut Vec<PointKey>, p: PointKey| -> u32 {
-        match local.iter().position(|&q| q == p) {
-            Some(i) => i as u32,
-            None => {
-                local.push(p);
-                (local.len() - 1) as u32
-            }
-        }
-    };
-    // Constraint pieces along each segment, with the segment's other triangle.
-    let mut pieces: Vec<([u32; 2], u32)> = Vec::new();
-    for (i, &s) in segs.iter().enumerate() {
-        let seg = g.x.segments[s as usize];
-        let (p0, p1) =
-            (position(g.positions, g.tris, g.x, seg.ends[0]), position(g.positions, g.tris, g.x, seg.ends[1]));
-        let mut inner: Vec<(f64, u32, PointKey)> = triples[i]
-            .iter()
-            .map(|&(c, k)| (crossing_parameter(p0, p1, g.tris[c as usize].map(|v| g.positions[v as usize])), c, k))
-            .collect();
-        inner.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let mut chain = alloc::vec![local_of(&mut local, seg.ends[0])];
-        for &(_, _, k) in &inner {
-            chain.push(local_of(&mut local, k));
-        }
-        chain.push(local_of(&mut local, seg.ends[1]));
-        for w in chain.windows(2) {
-            if w[0] != w[1] {
-                pieces.push(([w[0], w[1]], partner_of(s)));
-            }
-        }
-    }
+    let mut pieces = segment_pieces(g, t, &segs, &triples, &mut local);
     let globals: Vec<u32> = local.iter().map(|&k| points.id(k, g)).collect();
     let built = plane_points(&corners, &local, &on_edge, boundary_count, &globals, points).and_then(|pts| {
         let inside: Vec<u32> = (boundary_count as u32..local.len() as u32).collect();
@@ -230,6 +176,92 @@ pub(crate) fn build(g: &Geometry<'_>, points: &mut Points, t: u32) -> Sub {
             (cdt, true)
         }
     };
+    let (partner, base_edge) = edge_labels(&cdt, &pieces, &on_edge);
+    let n = cdt.tris.len();
+    let pts = local.iter().enumerate().map(|(i, _)| globals.get(i).copied().unwrap_or(NONE)).collect();
+    Sub { pts, cdt, partner, base_edge, visited: alloc::vec![false; n], fallback }
+}
+
+/// The triangle other than `t` of segment `s`.
+fn partner_of(g: &Geometry<'_>, t: u32, s: u32) -> u32 {
+    let seg = &g.x.segments[s as usize];
+    if seg.tris[0] == t {
+        seg.tris[1]
+    } else {
+        seg.tris[0]
+    }
+}
+
+/// Triple points on each of `t`'s segments `segs`: (other triangle, key),
+/// where two of its segments meet a third triangle's plane.
+fn triple_points(g: &Geometry<'_>, t: u32, segs: &[u32]) -> Vec<Vec<(u32, PointKey)>> {
+    let mut triples: Vec<Vec<(u32, PointKey)>> = alloc::vec![Vec::new(); segs.len()];
+    for i in 0..segs.len() {
+        for j in i + 1..segs.len() {
+            let (b, c) = (partner_of(g, t, segs[i]), partner_of(g, t, segs[j]));
+            if b == c {
+                continue;
+            }
+            let mut abc = [t, b, c];
+            abc.sort_unstable();
+            if triple_exists(g.positions, g.tris, g.x, abc) {
+                let k = PointKey::Triple(abc[0], abc[1], abc[2]);
+                triples[i].push((c, k));
+                triples[j].push((b, k));
+            }
+        }
+    }
+    triples
+}
+
+/// The constraint pieces along each of `t`'s segments (local point ids,
+/// new points added to `local`), split at its triple points in order, each
+/// with the segment's other triangle.
+fn segment_pieces(
+    g: &Geometry<'_>,
+    t: u32,
+    segs: &[u32],
+    triples: &[Vec<(u32, PointKey)>],
+    local: &mut Vec<PointKey>,
+) -> Vec<([u32; 2], u32)> {
+    let local_of = |local: &mut Vec<PointKey>, p: PointKey| -> u32 {
+        match local.iter().position(|&q| q == p) {
+            Some(i) => i as u32,
+            None => {
+                local.push(p);
+                (local.len() - 1) as u32
+            }
+        }
+    };
+    let mut pieces: Vec<([u32; 2], u32)> = Vec::new();
+    for (i, &s) in segs.iter().enumerate() {
+        let seg = g.x.segments[s as usize];
+        let (p0, p1) =
+            (position(g.positions, g.tris, g.x, seg.ends[0]), position(g.positions, g.tris, g.x, seg.ends[1]));
+        let mut inner: Vec<(f64, u32, PointKey)> = triples[i]
+            .iter()
+            .map(|&(c, k)| (crossing_parameter(p0, p1, g.tris[c as usize].map(|v| g.positions[v as usize])), c, k))
+            .collect();
+        inner.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let mut chain = alloc::vec![local_of(local, seg.ends[0])];
+        for &(_, _, k) in &inner {
+            chain.push(local_of(local, k));
+        }
+        chain.push(local_of(local, seg.ends[1]));
+        for w in chain.windows(2) {
+            if w[0] != w[1] {
+                pieces.push(([w[0], w[1]], partner_of(g, t, s)));
+            }
+        }
+    }
+    pieces
+}
+
+/// Per sub-triangle edge: the other triangle of the segment a constraint
+/// edge runs along (else [`NONE`]), and which of the triangle's edges (0..3)
+/// a boundary edge lies on (else 3).
+#[allow(clippy::type_complexity)]
+fn edge_labels(cdt: &Cdt, pieces: &[([u32; 2], u32)], on_edge: &[Vec<u32>; 3]) -> (Vec<[u32; 3]>, Vec<[u8; 3]>) {
     let n = cdt.tris.len();
     let mut partner = alloc::vec![[NONE; 3]; n];
     let mut base_edge = alloc::vec![[3u8; 3]; n];
@@ -259,8 +291,7 @@ pub(crate) fn build(g: &Geometry<'_>, points: &mut Points, t: u32) -> Sub {
             }
         }
     }
-    let pts = local.iter().enumerate().map(|(i, _)| globals.get(i).copied().unwrap_or(NONE)).collect();
-    Sub { pts, cdt, partner, base_edge, visited: alloc::vec![false; n], fallback }
+    (partner, base_edge)
 }
 
 /// The 2-D picture of the triangle's points: the plane is projected along

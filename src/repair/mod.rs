@@ -23,21 +23,19 @@ mod intersect;
 mod offset;
 mod predicates;
 mod region;
+mod steps;
 mod topology;
 mod tritri;
 
 use alloc::format;
 use alloc::string::String;
 use alloc::vec::Vec;
-use glam::DVec3;
 use serde::Serialize;
 
 pub use check::{find_self_intersections, mesh_edge_census, mesh_volume, EdgeCensus};
 pub use offset::offset_mesh;
 
-use crate::io::MAX_COORDINATE;
-use crate::nurbs::Aabb;
-use crate::{weld_positions, Error, Mesh};
+use crate::{Error, Mesh};
 
 /// How the self-intersection search finds candidate pairs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -276,209 +274,16 @@ pub fn repair_mesh_timed(
     let t0 = clock();
     let mut report =
         RepairReport { triangles_in: mesh.triangle_count(), vertices_in: mesh.positions.len(), ..Default::default() };
-    if mesh.triangle_count() > options.max_triangles {
-        return Err(Error::Limit(format!("{} triangles (at most {})", mesh.triangle_count(), options.max_triangles)));
-    }
-    let tris_in = check::triangles(mesh)?;
-    if tris_in.is_empty() {
-        return Err(Error::Repair { location: "mesh".into(), message: "it has no triangles".into() });
-    }
-    if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite() || p.abs().max_element() > MAX_COORDINATE) {
-        let p = mesh.positions[i];
-        return Err(Error::Repair {
-            location: format!("vertex {i}"),
-            message: format!("coordinate {} {} {} is not a finite number within ±1e30", p.x, p.y, p.z),
-        });
-    }
-    let diag = Aabb::from_points(mesh.positions.iter().copied()).diagonal();
-    // Weld. Vertices an offset brought together from different sheets would
-    // join them at an edge of four triangles: then the input's own indices
-    // are kept instead, and the crossing is left to step 2.
-    let mut welded = None;
-    if options.weld_tolerance > 0.0 && diag > 0.0 {
-        let (map, count) = weld_positions(&mesh.positions, options.weld_tolerance * diag);
-        let mut pos = alloc::vec![DVec3::ZERO; count];
-        let mut set = alloc::vec![false; count];
-        for (i, &m) in map.iter().enumerate() {
-            if !set[m as usize] {
-                set[m as usize] = true;
-                pos[m as usize] = mesh.positions[i];
-            }
-        }
-        let mut tris = drop_collapsed_and_duplicates(tris_in.iter().map(|t| t.map(|i| map[i as usize])).collect());
-        match topology::orient_consistently(&mut tris) {
-            Ok(flipped) => welded = Some((pos, tris, flipped, mesh.positions.len() - count)),
-            Err(e) => {
-                // Non-manifold as given too: say so in the input's own vertex numbers.
-                let mut own = drop_collapsed_and_duplicates(tris_in.clone());
-                topology::orient_consistently(&mut own)?;
-                report.warnings.push(format!(
-                    "welding within {:e} of the diagonal would make the mesh non-manifold ({e}); vertices were not welded",
-                    options.weld_tolerance
-                ));
-            }
-        }
-    }
-    let (mut positions, mut tris) = match welded {
-        Some((pos, tris, flipped, merged)) => {
-            report.vertices_welded = merged;
-            report.triangles_reoriented = flipped;
-            report.triangles_dropped = tris_in.len() - tris.len();
-            (pos, tris)
-        }
-        None => {
-            let mut tris = drop_collapsed_and_duplicates(tris_in.clone());
-            report.triangles_dropped = tris_in.len() - tris.len();
-            report.triangles_reoriented = topology::orient_consistently(&mut tris)?;
-            (mesh.positions.clone(), tris)
-        }
-    };
-    let before = tris.len();
-    if tris.is_empty() {
-        return Err(Error::Repair {
-            location: "mesh".into(),
-            message: "no triangle is left after welding (all collapsed)".into(),
-        });
-    }
-    let mut nbr = topology::adjacency(&tris);
-    report.free_edges_in = nbr.iter().flatten().filter(|&&u| u == topology::NONE).count();
-    if report.free_edges_in > 0 {
-        report.warnings.push(format!(
-            "the input is open ({} free edges): its boundary stays open and growth stops there",
-            report.free_edges_in
-        ));
-    }
-    let (comp, ncomp) = topology::components(&nbr);
-    report.components = ncomp;
-    let mut volume = alloc::vec![0.0; ncomp];
-    for (t, tri) in tris.iter().enumerate() {
-        volume[comp[t] as usize] += topology::signed_volume(&positions, core::iter::once(*tri));
-    }
-    let inside_out: Vec<bool> = volume.iter().map(|&v| v < 0.0).collect();
-    if report.free_edges_in == 0 && inside_out.iter().any(|&b| b) {
-        let mut flipped = 0;
-        for (t, tri) in tris.iter_mut().enumerate() {
-            if inside_out[comp[t] as usize] {
-                tri.swap(1, 2);
-                flipped += 1;
-            }
-        }
-        report.triangles_reoriented += flipped;
-        report.warnings.push(format!(
-            "{} of {ncomp} components enclosed a negative volume (inside out) and were turned outward",
-            inside_out.iter().filter(|&&b| b).count()
-        ));
-        nbr = topology::adjacency(&tris);
-    }
-    report.volume_in = topology::signed_volume(&positions, tris.iter().copied());
+    let (tris_in, diag) = steps::checked_input(mesh, options)?;
+    let prepared = steps::weld_and_orient(mesh, tris_in, diag, options, &mut report)?;
     let t1 = clock();
-
-    // Step 1.
-    let mut edit = degenerate::EditMesh {
-        positions: &mut positions,
-        tris: &mut tris,
-        nbr: &mut nbr,
-        alive: alloc::vec![true; before],
-    };
-    edit.alive.truncate(edit.tris.len());
-    let stats = degenerate::remove_degenerate(&mut edit, options.zero_length * diag, options.zero_angle);
-    let alive = edit.alive;
-    report.degenerate_collapsed = stats.collapses;
-    report.degenerate_swapped = stats.swaps;
-    report.degenerate_left = stats.left;
-    if stats.left > 0 {
-        report
-            .warnings
-            .push(format!("{} degenerate triangles could not be removed without breaking the manifold", stats.left));
-    }
-    let tris: Vec<[u32; 3]> = tris.iter().zip(&alive).filter(|(_, &a)| a).map(|(t, _)| *t).collect();
-    let nbr = topology::adjacency(&tris);
-    let (comp, ncomp) = topology::components(&nbr);
+    let clean = steps::remove_degenerate(prepared, diag, options, &mut report);
     let t2 = clock();
-
-    // Steps 2-5, again on slightly moved vertices when exact coincidences
-    // (symmetric input) leave contacts or sub-triangulations unresolved.
-    let sizes = if options.perturbation > 0.0 {
-        [options.perturbation, 100.0 * options.perturbation]
-    } else {
-        [0.0, PERTURBATION_FALLBACK]
-    };
-    let mut attempt = 0;
-    let (x, grown, positions) = loop {
-        let size = sizes[attempt];
-        let moved = if size > 0.0 { perturbed(&positions, size * diag) } else { positions.clone() };
-        let t = clock();
-        let x = intersect::find_intersections(
-            &moved,
-            &tris,
-            options.bucketing,
-            options.bucket_capacity,
-            options.max_segments,
-        )?;
-        let t_x = clock();
-        let g = arrange::Geometry { positions: &moved, tris: &tris, nbr: &nbr, x: &x };
-        let grown = region::grow(&g, &comp, ncomp, report.free_edges_in == 0);
-        let t_g = clock();
-        report.time_ms.intersect += t_x - t;
-        report.time_ms.regions += t_g - t_x;
-        let clean = x.degenerate == 0 && grown.fallbacks == 0 && grown.stitch_misses == 0 && grown.closed;
-        if clean || attempt + 1 == sizes.len() {
-            if attempt > 0 {
-                report.warnings.push(format!(
-                    "the arrangement had unresolved coincidences; vertices were moved by up to {size:e} of the diagonal"
-                ));
-            }
-            report.perturbation = size;
-            break (x, grown, moved);
-        }
-        attempt += 1;
-    };
-    report.bucketing = Some(options.bucketing);
-    report.kd_leaves = x.leaves;
-    report.candidate_pairs = x.candidates;
-    report.segments = x.segments.len();
-    report.degenerate_contacts = x.degenerate;
-    if x.degenerate > 0 {
-        report.warnings.push(format!(
-            "{} triangle pairs touch or overlap in a way not handled (coplanar, or a vertex exactly on another triangle); left as they are",
-            x.degenerate
-        ));
-    }
+    let (x, grown) = steps::intersect_and_grow(&clean, diag, options, &mut report, clock)?;
     let t3 = clock();
-    let _ = positions;
-    report.regions = grown.regions;
-    report.triangles_subdivided = grown.subdivided;
-    report.subdivision_fallbacks = grown.fallbacks;
-    report.stitch_misses = grown.stitch_misses;
-    if grown.unseeded > 0 {
-        report.warnings.push(format!(
-            "{} components had no triangle on the outside of the enclosed space and were left out",
-            grown.unseeded
-        ));
-    }
-    if grown.fallbacks > 0 {
-        report.warnings.push(format!(
-            "{} triangles could not be split along their segments (points closer than rounding separates) and were kept or dropped whole",
-            grown.fallbacks
-        ));
-    }
-    let (out_pos, out_idx) = region::compact(&grown.points.pos, &grown.tris);
-    let out_tris: Vec<[u32; 3]> = out_idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-    report.triangles_out = out_tris.len();
-    report.vertices_out = out_pos.len();
-    report.census_out = check::census(&out_tris);
-    report.volume_out = topology::signed_volume(&out_pos, out_tris.iter().copied());
-    if out_tris.is_empty() {
-        report.warnings.push("nothing valid was found: the result is empty".into());
-    }
-    let c = report.census_out;
-    if c.nonmanifold_edges > 0 || c.misoriented_edges > 0 {
-        // Seen only from open input, where growth can pass round the border.
-        report.warnings.push(format!(
-            "the result is not a clean 2-manifold: {} edges of more than two triangles, {} edges whose triangles disagree",
-            c.nonmanifold_edges, c.misoriented_edges
-        ));
-    }
+    steps::report_regions(&grown, &mut report);
+    let (out_pos, out_idx, out_tris) = steps::output(&grown, &mut report);
+    drop((x, grown));
     let t4 = clock();
     if options.verify {
         report.self_intersections_out = Some(check::self_intersections(&out_pos, &out_tris).len());
@@ -491,52 +296,4 @@ pub fn repair_mesh_timed(
     report.time_ms.total = t5 - t0;
     let mesh = Mesh { positions: out_pos, normals: Vec::new(), indices: out_idx, face_ranges: Vec::new() };
     Ok(RepairResult { mesh, report })
-}
-
-/// Relative size (of the diagonal) of the vertex moves tried when the
-/// unmoved input (perturbation 0) leaves coincidences unresolved.
-const PERTURBATION_FALLBACK: f64 = 1e-9;
-
-/// Every vertex moved by a pseudo-random vector (fixed seed, so runs repeat)
-/// with coordinates up to `size` in magnitude.
-fn perturbed(positions: &[DVec3], size: f64) -> Vec<DVec3> {
-    let mut state = 0x9E37_79B9_7F4A_7C15u64;
-    let mut next = move || {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
-    positions.iter().map(|p| *p + DVec3::new(next(), next(), next()) * size).collect()
-}
-
-/// Drops triangles with a repeated vertex, and duplicates: two triangles on
-/// the same three vertices cancel when they face opposite ways (a zero-volume
-/// pocket), and only the first is kept when they face the same way.
-fn drop_collapsed_and_duplicates(tris: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
-    let tris: Vec<[u32; 3]> = tris.into_iter().filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0]).collect();
-    let mut seen: crate::collections::HashMap<[u32; 3], (usize, bool)> =
-        crate::collections::HashMap::with_capacity_and_hasher(tris.len(), Default::default());
-    let mut keep = alloc::vec![true; tris.len()];
-    for (i, t) in tris.iter().enumerate() {
-        let mut s = *t;
-        s.sort_unstable();
-        // Even permutations of the sorted triple face the same way.
-        let r = t.iter().position(|&v| v == s[0]).unwrap_or(0);
-        let parity = t[(r + 1) % 3] == s[1];
-        match seen.get(&s) {
-            Some(&(j, p)) if keep[j] => {
-                keep[i] = false;
-                if p != parity {
-                    keep[j] = false;
-                }
-            }
-            _ => {
-                seen.insert(s, (i, parity));
-            }
-        }
-    }
-    tris.into_iter().zip(keep).filter(|(_, k)| *k).map(|(t, _)| t).collect()
 }

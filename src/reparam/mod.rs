@@ -17,27 +17,11 @@ use glam::{DVec2, DVec3};
 use serde::Serialize;
 
 use crate::model::{Face, FaceSurface, Model, TrimLoop};
-use crate::nurbs::{project_to_surface, NurbsCurve, Surface};
-use crate::tessellate::Tolerance;
+use crate::nurbs::{project_to_surface, NurbsCurve, ProjectionOptions, Surface};
+use crate::options::{Reparam, Tolerance};
 use crate::Error;
 
 pub(crate) use interp::{chord_params, interpolate_curve};
-
-/// When faces are re-parameterized before meshing.
-///
-/// Auto by default: a flagged face's rebuild is kept only where its mesh
-/// wins (no more triangles, better angles) and the original is meshed
-/// otherwise, so the default never meshes a face worse than `Off`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Reparam {
-    /// Faces the ratio test flags (the default).
-    #[default]
-    Auto,
-    /// Never.
-    Off,
-    /// Every face.
-    Force,
-}
 
 /// Paper 001's empirical limit `k`: a parameter step whose model-space length
 /// is more than `k` times, or less than `1/k` of, the iso-line's mean step is poor.
@@ -151,7 +135,7 @@ pub struct ReparamModel {
 pub fn reparameterize_model(model: &Model, mode: Reparam, tolerance: Tolerance) -> Result<ReparamModel, Error> {
     let tol = match tolerance {
         Tolerance::Absolute(t) => t,
-        Tolerance::Relative(r) => r * crate::tessellate::trimmed_bbox(model).diagonal(),
+        Tolerance::Relative(r) => r * crate::model::trimmed_bbox(model).diagonal(),
     };
     if !(tol > 0.0 && tol.is_finite()) {
         return Err(Error::Model { location: "model".into(), message: "has zero size; use an absolute --tol".into() });
@@ -331,64 +315,10 @@ fn rebuild_loop(
     lp: &TrimLoop,
     goal: f64,
 ) -> Result<(Vec<NurbsCurve>, f64), String> {
-    let map = |uv: DVec2| DVec2::new(fit.map_u.to_new(uv.x), fit.map_v.to_new(uv.y));
-    let opts = projection();
-    let cell = DVec2::new(1.0 / (fit.map_u.new.len().max(2) - 1) as f64, 1.0 / (fit.map_v.new.len().max(2) - 1) as f64);
-    let [lo, hi] = old.domain();
-    let edge = |x: f64, a: f64, b: f64| (x - a).abs() <= 1e-9 * (b - a) || (b - x).abs() <= 1e-9 * (b - a);
-    // A point inside the old domain stays as far inside the new one as the
-    // (monotone) map puts it, within [`BORDER_BAND`] of the border:
-    // projection alone would push a curve running just inside the border
-    // onto it, over the loop's own stretch along the border.
-    let inside = |x: f64, hint: f64| {
-        if hint > 1.0 - BORDER_BAND {
-            x.min(hint)
-        } else if hint < BORDER_BAND {
-            x.max(hint)
-        } else {
-            x
-        }
-    };
-    // Where an old (u,v) lands on the new surface; a coordinate on the old
-    // domain's border stays on the new one's (the map takes borders to
-    // borders, and the new border interpolates the old one's samples).
-    let land = |uv: DVec2| -> DVec2 {
-        let hint = map(uv);
-        let p = old.point(uv);
-        let pr = project_to_surface(new, p, Some(hint), &opts);
-        let off = (pr.uv - hint).abs();
-        let mut at =
-            if off.x <= 2.0 * cell.x && off.y <= 2.0 * cell.y && pr.distance.is_finite() { pr.uv } else { hint };
-        if edge(uv.x, lo.x, hi.x) {
-            at.x = hint.x;
-        } else {
-            at.x = inside(at.x, hint.x);
-        }
-        if edge(uv.y, lo.y, hi.y) {
-            at.y = hint.y;
-        } else {
-            at.y = inside(at.y, hint.y);
-        }
-        at
-    };
+    let lander = Lander::new(old, new, fit);
     // Loop vertices landed once, so curves meet exactly.
-    let mut ends: Vec<DVec2> = lp.curves.iter().map(|c| land(c.point(c.domain().0).truncate())).collect();
-    // A piece of no length in model space whose ends land within a millionth
-    // of the unit domain (a stub a file's loop closes with; not a piece along
-    // a pole) is left out, its neighbours meeting there: as a curve it would
-    // double back over them.
-    let n = lp.curves.len();
-    let mut stub = vec![false; n];
-    for (ci, c) in lp.curves.iter().enumerate() {
-        let next = (ci + 1) % n;
-        if n - stub.iter().filter(|&&s| s).count() > 1
-            && ends[ci].distance(ends[next]) <= 1e-6
-            && model_length(old, c) <= 1e-3 * goal
-        {
-            stub[ci] = true;
-            ends[next] = ends[ci];
-        }
-    }
+    let mut ends: Vec<DVec2> = lp.curves.iter().map(|c| lander.land(c.point(c.domain().0).truncate())).collect();
+    let stub = stubs(old, lp, &mut ends, goal);
     let mut out = Vec::with_capacity(lp.curves.len());
     let mut worst = 0.0f64;
     for (ci, c) in lp.curves.iter().enumerate() {
@@ -397,67 +327,10 @@ fn rebuild_loop(
         }
         let start = ends[ci];
         let end = ends[(ci + 1) % ends.len()];
-        let (a, b) = c.domain();
         let mut samples = STEPS;
         loop {
-            // Dense model-space polyline of the old curve, 8 points per sample interval.
-            let dense = 8 * samples;
-            let ts: Vec<f64> = (0..=dense).map(|k| a + (b - a) * k as f64 / dense as f64).collect();
-            let pts: Vec<DVec3> = ts.iter().map(|&t| old.point(c.point(t).truncate())).collect();
-            let lengths: Vec<f64> = pts.windows(2).map(|w| w[0].distance(w[1])).collect();
-            let total: f64 = lengths.iter().sum();
-            let degenerate = !(total > 1e-3 * goal && total.is_finite());
-            let arc = chord_params(&lengths);
-            // Parameters of the old curve at equal arc length (equal parameter steps when degenerate).
-            let picks: Vec<f64> = (0..=samples)
-                .map(|i| {
-                    let x = i as f64 / samples as f64;
-                    if degenerate {
-                        a + (b - a) * x
-                    } else {
-                        Map1::lerp(&arc, &ts, x)
-                    }
-                })
-                .collect();
-            let mut st: Vec<DVec2> = picks
-                .iter()
-                .map(|&t| {
-                    let uv = c.point(t).truncate();
-                    if degenerate {
-                        map(uv)
-                    } else {
-                        land(uv)
-                    }
-                })
-                .collect();
-            if degenerate {
-                // The mapped path (along a pole) moved to the landed ends: the map
-                // is only close to where projection puts them.
-                let (d0, d1) = (start - st[0], end - st[samples]);
-                for (i, q) in st.iter_mut().enumerate() {
-                    let x = i as f64 / samples as f64;
-                    *q += d0 * (1.0 - x) + d1 * x;
-                }
-            }
-            st[0] = start;
-            st[samples] = end;
-            // The samples are equally spaced in model space: equal parameter steps keep the
-            // curve from curling where (u,v) speed varies along it.
-            let params: Vec<f64> = (0..=samples).map(|i| i as f64 / samples as f64).collect();
-            let curve = interpolate_curve(&st, &params).map_err(|e| format!("curve {ci}: {e}"))?;
-            // Check: mid-points of the new curve against the old polyline nearby.
-            let mut err = 0.0f64;
-            if !degenerate {
-                for i in 0..samples {
-                    let q = new.point(curve.point(0.5 * (params[i] + params[i + 1])).truncate());
-                    // The old polyline between the two samples' arc lengths, one segment either side.
-                    let (x0, x1) = (i as f64 / samples as f64, (i + 1) as f64 / samples as f64);
-                    let k0 = arc.partition_point(|&x| x < x0).saturating_sub(1);
-                    let k1 = (arc.partition_point(|&x| x <= x1) + 1).min(dense);
-                    let d = (k0..k1).map(|k| segment_distance(q, pts[k], pts[k + 1])).fold(f64::INFINITY, f64::min);
-                    err = err.max(d);
-                }
-            }
+            let (curve, err) =
+                lander.curve_through(c, samples, (start, end), goal).map_err(|e| format!("curve {ci}: {e}"))?;
             if err <= goal {
                 worst = worst.max(err);
                 out.push(curve);
@@ -470,6 +343,168 @@ fn rebuild_loop(
         }
     }
     Ok((out, worst))
+}
+
+/// The pieces of `lp` of no length in model space whose ends (`ends`, as
+/// landed) lie within a millionth of the unit domain (a stub a file's loop
+/// closes with; not a piece along a pole): each is left out, its
+/// neighbours meeting there (its end moved to its start in `ends`), since
+/// as a curve it would double back over them.
+fn stubs(old: &FaceSurface, lp: &TrimLoop, ends: &mut [DVec2], goal: f64) -> Vec<bool> {
+    let n = lp.curves.len();
+    let mut stub = vec![false; n];
+    for (ci, c) in lp.curves.iter().enumerate() {
+        let next = (ci + 1) % n;
+        if n - stub.iter().filter(|&&s| s).count() > 1
+            && ends[ci].distance(ends[next]) <= 1e-6
+            && model_length(old, c) <= 1e-3 * goal
+        {
+            stub[ci] = true;
+            ends[next] = ends[ci];
+        }
+    }
+    stub
+}
+
+/// Where points of the old surface's (u,v) land on the new surface.
+struct Lander<'a> {
+    old: &'a FaceSurface,
+    new: &'a FaceSurface,
+    fit: &'a Fit,
+    opts: ProjectionOptions,
+    /// One sample interval of the new surface, per direction.
+    cell: DVec2,
+    /// The old surface's domain.
+    lo: DVec2,
+    hi: DVec2,
+}
+
+impl<'a> Lander<'a> {
+    fn new(old: &'a FaceSurface, new: &'a FaceSurface, fit: &'a Fit) -> Self {
+        let cell =
+            DVec2::new(1.0 / (fit.map_u.new.len().max(2) - 1) as f64, 1.0 / (fit.map_v.new.len().max(2) - 1) as f64);
+        let [lo, hi] = old.domain();
+        Self { old, new, fit, opts: projection(), cell, lo, hi }
+    }
+
+    /// The fit's map of an old (u,v) to the new parameters.
+    fn map(&self, uv: DVec2) -> DVec2 {
+        DVec2::new(self.fit.map_u.to_new(uv.x), self.fit.map_v.to_new(uv.y))
+    }
+
+    /// Where an old (u,v) lands on the new surface; a coordinate on the old
+    /// domain's border stays on the new one's (the map takes borders to
+    /// borders, and the new border interpolates the old one's samples).
+    fn land(&self, uv: DVec2) -> DVec2 {
+        let edge = |x: f64, a: f64, b: f64| (x - a).abs() <= 1e-9 * (b - a) || (b - x).abs() <= 1e-9 * (b - a);
+        let hint = self.map(uv);
+        let p = self.old.point(uv);
+        let pr = project_to_surface(self.new, p, Some(hint), &self.opts);
+        let off = (pr.uv - hint).abs();
+        let cell = self.cell;
+        let mut at =
+            if off.x <= 2.0 * cell.x && off.y <= 2.0 * cell.y && pr.distance.is_finite() { pr.uv } else { hint };
+        if edge(uv.x, self.lo.x, self.hi.x) {
+            at.x = hint.x;
+        } else {
+            at.x = inside(at.x, hint.x);
+        }
+        if edge(uv.y, self.lo.y, self.hi.y) {
+            at.y = hint.y;
+        } else {
+            at.y = inside(at.y, hint.y);
+        }
+        at
+    }
+
+    /// The cubic (u,v) curve on the new surface through `samples + 1`
+    /// points of the old trim curve `c` at equal model-space arc length,
+    /// from `start` to `end`, and how far its mid-points stray from the old
+    /// curve (0 for a curve of no length, whose mapped path is moved to the
+    /// landed ends instead).
+    fn curve_through(
+        &self,
+        c: &NurbsCurve,
+        samples: usize,
+        (start, end): (DVec2, DVec2),
+        goal: f64,
+    ) -> Result<(NurbsCurve, f64), String> {
+        let (old, new) = (self.old, self.new);
+        let (a, b) = c.domain();
+        // Dense model-space polyline of the old curve, 8 points per sample interval.
+        let dense = 8 * samples;
+        let ts: Vec<f64> = (0..=dense).map(|k| a + (b - a) * k as f64 / dense as f64).collect();
+        let pts: Vec<DVec3> = ts.iter().map(|&t| old.point(c.point(t).truncate())).collect();
+        let lengths: Vec<f64> = pts.windows(2).map(|w| w[0].distance(w[1])).collect();
+        let total: f64 = lengths.iter().sum();
+        let degenerate = !(total > 1e-3 * goal && total.is_finite());
+        let arc = chord_params(&lengths);
+        // Parameters of the old curve at equal arc length (equal parameter steps when degenerate).
+        let picks: Vec<f64> = (0..=samples)
+            .map(|i| {
+                let x = i as f64 / samples as f64;
+                if degenerate {
+                    a + (b - a) * x
+                } else {
+                    Map1::lerp(&arc, &ts, x)
+                }
+            })
+            .collect();
+        let mut st: Vec<DVec2> = picks
+            .iter()
+            .map(|&t| {
+                let uv = c.point(t).truncate();
+                if degenerate {
+                    self.map(uv)
+                } else {
+                    self.land(uv)
+                }
+            })
+            .collect();
+        if degenerate {
+            // The mapped path (along a pole) moved to the landed ends: the map
+            // is only close to where projection puts them.
+            let (d0, d1) = (start - st[0], end - st[samples]);
+            for (i, q) in st.iter_mut().enumerate() {
+                let x = i as f64 / samples as f64;
+                *q += d0 * (1.0 - x) + d1 * x;
+            }
+        }
+        st[0] = start;
+        st[samples] = end;
+        // The samples are equally spaced in model space: equal parameter steps keep the
+        // curve from curling where (u,v) speed varies along it.
+        let params: Vec<f64> = (0..=samples).map(|i| i as f64 / samples as f64).collect();
+        let curve = interpolate_curve(&st, &params).map_err(|e| format!("{e}"))?;
+        // Check: mid-points of the new curve against the old polyline nearby.
+        let mut err = 0.0f64;
+        if !degenerate {
+            for i in 0..samples {
+                let q = new.point(curve.point(0.5 * (params[i] + params[i + 1])).truncate());
+                // The old polyline between the two samples' arc lengths, one segment either side.
+                let (x0, x1) = (i as f64 / samples as f64, (i + 1) as f64 / samples as f64);
+                let k0 = arc.partition_point(|&x| x < x0).saturating_sub(1);
+                let k1 = (arc.partition_point(|&x| x <= x1) + 1).min(dense);
+                let d = (k0..k1).map(|k| segment_distance(q, pts[k], pts[k + 1])).fold(f64::INFINITY, f64::min);
+                err = err.max(d);
+            }
+        }
+        Ok((curve, err))
+    }
+}
+
+/// A point inside the old domain stays as far inside the new one as the
+/// (monotone) map puts it (`hint`), within [`BORDER_BAND`] of the border:
+/// projection alone would push a curve running just inside the border onto
+/// it, over the loop's own stretch along the border.
+fn inside(x: f64, hint: f64) -> f64 {
+    if hint > 1.0 - BORDER_BAND {
+        x.min(hint)
+    } else if hint < BORDER_BAND {
+        x.max(hint)
+    } else {
+        x
+    }
 }
 
 /// Length in model space of the trim curve `c` on `surface`, from 64 chords.

@@ -590,6 +590,7 @@ pub(super) fn check_grid(index: usize, pu: &[f64], pv: &[f64], budget: usize) ->
 
 /// Welds grid nodes that coincide in model space (closed seams, poles) so that
 /// refinement sees one shared edge; returns the vertex of each node.
+#[cfg(not(feature = "std"))]
 fn weld_nodes(surface: &dyn Surface, nodes: &[DVec2], wm: &mut WorkMesh) -> (Vec<u32>, Vec<u32>) {
     let pts: Vec<DVec3> = nodes.iter().map(|&q| surface.point(q)).collect();
     let diag = crate::nurbs::Aabb::from_points(pts.iter().copied()).diagonal();
@@ -611,7 +612,8 @@ fn weld_nodes(surface: &dyn Surface, nodes: &[DVec2], wm: &mut WorkMesh) -> (Vec
 
 /// Untrimmed surface: the grid's quads, each split along its shorter diagonal
 /// (in model space) into two counter-clockwise triangles.
-pub(super) fn build_full_grid(surface: &dyn Surface, pu: &[f64], pv: &[f64], wm: &mut WorkMesh) {
+#[cfg(not(feature = "std"))]
+fn build_full_grid(surface: &dyn Surface, pu: &[f64], pv: &[f64], wm: &mut WorkMesh) {
     let (nu, nv) = (pu.len(), pv.len());
     let nodes: Vec<DVec2> = (0..nu).flat_map(|i| pv.iter().map(move |&v| DVec2::new(pu[i], v))).collect();
     let (vid, mult) = weld_nodes(surface, &nodes, wm);
@@ -641,6 +643,7 @@ pub(super) fn build_full_grid(surface: &dyn Surface, pu: &[f64], pv: &[f64], wm:
 /// At a pole many grid nodes are one vertex; its (u,v) in a triangle is taken
 /// midway along the collapsed direction between the other two corners, so the
 /// triangle's (u,v) interpolation follows the surface (better Newton hints).
+#[cfg(not(feature = "std"))]
 fn fix_pole_corners(uv: &mut [DVec2; 3], mult: [u32; 3]) {
     for k in 0..3 {
         if mult[k] > 4 {

@@ -11,6 +11,8 @@ use super::measure::{measure_projection, measure_triangle, sample_count, TriMeas
 use crate::math::angle_between;
 use crate::nurbs::{project_to_surface, regular_normal, NurbsCurve, Surface};
 
+#[cfg(any(test, debug_assertions))]
+mod check;
 mod edges;
 #[cfg(feature = "std")]
 mod lift;
@@ -88,10 +90,20 @@ pub(crate) struct WorkMesh {
     measures: Vec<Packed>,
 }
 
-/// One triangle of an edge being split: the triangle, its corners and their
-/// (u,v) starting at the edge, the new vertex's (u,v), and the edge's own
-/// (u,v) point at the split fraction.
-type SplitPlan = (u32, [u32; 3], [DVec2; 3], DVec2, DVec2);
+/// One triangle of an edge being split.
+#[derive(Debug, Clone, Copy)]
+struct SplitSide {
+    /// The triangle.
+    t: u32,
+    /// Its corners starting at the edge (the edge's two ends, then the third).
+    corners: [u32; 3],
+    /// Their (u,v) in this triangle.
+    uv: [DVec2; 3],
+    /// The new vertex's (u,v).
+    uv_m: DVec2,
+    /// The edge's own (u,v) point at the split fraction.
+    guess: DVec2,
+}
 
 fn key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
@@ -521,7 +533,7 @@ impl WorkMesh {
         }
         // First where the new vertex goes in each triangle on the edge, then
         // (when it is a real split) the change.
-        let mut plan: Vec<SplitPlan> = Vec::with_capacity(2);
+        let mut plan: Vec<SplitSide> = Vec::with_capacity(2);
         let mut m_pos: Option<DVec3> = None;
         let mut m_normal = DVec3::ZERO;
         for &t in adj.iter().filter(|&&t| t != NONE) {
@@ -548,7 +560,7 @@ impl WorkMesh {
                 m_pos = Some(target.unwrap_or_else(|| surface.point(uv_m)));
                 m_normal = surface.normal(uv_m);
             }
-            plan.push((t, [x0, x1, x2], [u0, u1, u2], uv_m, guess));
+            plan.push(SplitSide { t, corners: [x0, x1, x2], uv: [u0, u1, u2], uv_m, guess });
         }
         let mut p = m_pos?;
         let folds = |u: [DVec2; 3], uv_m: DVec2| {
@@ -564,12 +576,12 @@ impl WorkMesh {
             // once, a node off its (u,v) folded the thin children in space,
             // and refinement split those folds down to slivers (99 on one
             // cylinder of a valve body).
-            if plan.iter().any(|item| folds(item.2, item.3)) {
-                for item in &mut plan {
-                    item.3 = item.4;
+            if plan.iter().any(|s| folds(s.uv, s.uv_m)) {
+                for s in &mut plan {
+                    s.uv_m = s.guess;
                 }
-                p = surface.point(plan[0].4);
-                m_normal = surface.normal(plan[0].4);
+                p = surface.point(plan[0].guess);
+                m_normal = surface.normal(plan[0].guess);
             }
         }
         if target.is_none() {
@@ -581,14 +593,14 @@ impl WorkMesh {
             let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
             let near = 1e-6 * pa.distance(pb);
             let bad = !(p.distance(pa) > near && p.distance(pb) > near)
-                || plan.iter().any(|&(_, x, u, uv_m, _)| p.distance(self.pos[x[2] as usize]) <= near || folds(u, uv_m));
+                || plan.iter().any(|s| p.distance(self.pos[s.corners[2] as usize]) <= near || folds(s.uv, s.uv_m));
             if bad {
                 return None;
             }
         }
         self.room(1, plan.len());
         let m = self.push_vertex(p, m_normal);
-        for (t, [x0, x1, x2], [u0, u1, u2], uv_m, _) in plan {
+        for SplitSide { t, corners: [x0, x1, x2], uv: [u0, u1, u2], uv_m, .. } in plan {
             // Replace t by [x0, m, x2] and add [m, x1, x2].
             self.detach(x0, x1, t);
             self.detach(x1, x2, t);

@@ -23,8 +23,9 @@ use glam::DVec3;
 
 use super::refine::WorkMesh;
 use super::sew::FaceWork;
-use crate::mesh::{FaceRange, Mesh, Report};
+use crate::mesh::{FaceRange, Mesh};
 use crate::model::{body_of, Model, TessellatedFace};
+use crate::report::Report;
 
 const NONE: u32 = u32::MAX;
 

@@ -5,6 +5,7 @@ mod cli;
 mod corpus_files;
 mod fit;
 mod iges;
+mod layers;
 mod mesh;
 mod nurbs;
 mod quality;

@@ -812,7 +812,7 @@ proptest! {
         let t0 = lerp(a, b, f);
         let d0 = c.derivs(t0);
         prop_assume!(d0.d1.length() > 1e-6);
-        let (t, point, dist) = c.project(d0.point);
+        let surfmesh::CurveProjection { t, point, distance: dist } = c.project(d0.point);
         prop_assert!(dist <= 1e-10 * 30.0, "distance {}", dist);
         prop_assert!(point.distance(c.point(t)) <= 1e-12 * 30.0);
         prop_assert!((t - t0).abs() <= 1e-7 * (b - a) || c.point(t).distance(d0.point) <= 1e-10 * 30.0);
@@ -823,14 +823,14 @@ proptest! {
         let kappa = d0.d1.cross(d0.d2).length() / d0.d1.length().powi(3);
         let d = fd * (0.3 / kappa.max(1e-9)).min(2.0);
         let target = d0.point + normal.normalize() * d;
-        let (_, _, dist) = c.project(target);
+        let dist = c.project(target).distance;
         prop_assert!(dist <= d.abs() + 1e-9 * (1.0 + d.abs()), "{} > {}", dist, d.abs());
 
         // Exact circle of radius 5 in the plane z = 0.
         let circle = shapes::uv_circle(DVec2::ZERO, 5.0).build();
         let q = DVec3::new(q.0, q.1, q.2);
         prop_assume!(q.truncate().length() > 0.5);
-        let (_, point, dist) = circle.project(q);
+        let surfmesh::CurveProjection { point, distance: dist, .. } = circle.project(q);
         let exact = (q.truncate().length() - 5.0).hypot(q.z);
         prop_assert!((dist - exact).abs() <= 1e-9, "circle at {}: {} vs {}", q, dist, exact);
         prop_assert!((point.truncate().length() - 5.0).abs() <= 1e-12 * 5.0);

@@ -154,12 +154,7 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
             "--angle" => options = options.with_angle(number(&name, value()?)?),
             "--max-edge" => options = options.with_max_edge(Some(number(&name, value()?)?)),
             "--min-edge" => options = options.with_min_edge(Some(number(&name, value()?)?)),
-            "--max-triangles" => {
-                let v = value()?;
-                let n = v.to_str().and_then(|s| s.parse().ok());
-                let n = n.ok_or_else(|| format!("{name}: '{}' is not a count", v.to_string_lossy()))?;
-                options = options.with_max_triangles(n);
-            }
+            "--max-triangles" => options = options.with_max_triangles(count(&name, value()?)?),
             "--mode" => match value()?.to_str() {
                 Some("fast") => options = options.with_mode(MeshMode::Fast),
                 Some("quality") => options = options.with_mode(MeshMode::Quality),
@@ -176,28 +171,8 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
                 };
                 quality = quality.with_method(method);
             }
-            "--weights" => {
-                let v = value()?;
-                let c: Vec<f64> = v
-                    .to_str()
-                    .unwrap_or("")
-                    .split(',')
-                    .map(|x| x.trim().parse::<f64>())
-                    .collect::<Result<_, _>>()
-                    .map_err(|_| {
-                        format!("{name}: '{}' is not four numbers separated by commas", v.to_string_lossy())
-                    })?;
-                let c: [f64; 4] = c.try_into().map_err(|_| {
-                    format!("{name}: '{}' is not four numbers separated by commas", v.to_string_lossy())
-                })?;
-                quality = quality.with_weights(c);
-            }
-            "--passes" => {
-                let v = value()?;
-                let n = v.to_str().and_then(|s| s.parse().ok());
-                quality =
-                    quality.with_passes(n.ok_or_else(|| format!("{name}: '{}' is not a count", v.to_string_lossy()))?);
-            }
+            "--weights" => quality = quality.with_weights(weights(&name, value()?)?),
+            "--passes" => quality = quality.with_passes(count(&name, value()?)?),
             "--reparam" => {
                 let mode = match value()?.to_str() {
                     Some("auto") => Reparam::Auto,
@@ -247,6 +222,25 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
         }
     }
     Ok(Command::Mesh(MeshArgs { input, format, options, units, output, report }))
+}
+
+/// A count given to option `name`.
+fn count(name: &str, value: OsString) -> Result<usize, String> {
+    let n = value.to_str().and_then(|s| s.parse().ok());
+    n.ok_or_else(|| format!("{name}: '{}' is not a count", value.to_string_lossy()))
+}
+
+/// The four weights c1..c4 given to option `name`, separated by commas.
+fn weights(name: &str, value: OsString) -> Result<[f64; 4], String> {
+    let bad = || format!("{name}: '{}' is not four numbers separated by commas", value.to_string_lossy());
+    let c: Vec<f64> = value
+        .to_str()
+        .unwrap_or("")
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad())?;
+    c.try_into().map_err(|_| bad())
 }
 
 fn number(name: &str, value: OsString) -> Result<f64, String> {

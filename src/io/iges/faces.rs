@@ -34,11 +34,66 @@ pub(super) fn read_faces(
     skipped: &mut Vec<SkippedFace>,
 ) -> (Vec<Face>, Vec<u32>, Option<Error>) {
     let dir = ctx.dir;
-    // Surfaces that faces (or offsets) use are not faces themselves.
+    let (used, in_shell, shell_in_solid) = uses(ctx);
+    let subfigures = Subfigures::scan(ctx);
+    let shells = Shells { used: &used, in_shell: &in_shell, shell_in_solid: &shell_in_solid };
+    // Hidden (blanked) faces are not part of what the file shows, unless
+    // the file shows nothing else.
+    let face_entity = |e: &Entity| match e.kind {
+        144 | 143 | 186 => true,
+        514 => !shell_in_solid.contains(&e.de),
+        510 => !in_shell.contains(&e.de),
+        108 => !used.contains(&e.de),
+        k => is_surface(k) && !used.contains(&e.de) && e.subordinate & 1 == 0,
+    };
+    let any_shown = dir.entities.iter().any(|e| face_entity(e) && !e.blanked);
+    let mut hidden = 0usize;
+    let mut r = FaceReader {
+        ctx,
+        out: Vec::new(),
+        bodies: Vec::new(),
+        shell_body: crate::collections::HashMap::default(),
+        first_error: None,
+        unsupported: Vec::new(),
+        count: Count::default(),
+        warnings,
+        skipped,
+    };
+    for e in &dir.entities {
+        if any_shown && e.blanked && (face_entity(e) || subfigures.is_root_instance(e)) {
+            hidden += 1;
+            continue;
+        }
+        if subfigures.is_member(e.de) {
+            continue; // read where its subfigure's instances place it
+        }
+        let Some(jobs) = r.jobs(e, &subfigures, &shells) else { continue };
+        for (de, job, at) in jobs {
+            r.read(e, de, &job, at);
+        }
+    }
+    let FaceReader { out, mut bodies, first_error, unsupported, warnings, skipped, .. } = r;
+    if hidden > 0 {
+        warnings
+            .push(alloc::format!("{hidden} hidden (blanked) surface entities skipped: the file does not show them"));
+    }
+    for (kind, n) in unsupported {
+        let what = if kind == 402 { "perforated planes" } else { "array or network subfigure instances" };
+        warnings.push(alloc::format!("{n} entities of type {kind} ({what}) skipped: not supported"));
+    }
+    if bodies.iter().all(|&b| b == 0) && skipped.iter().all(|s| s.body == 0) {
+        bodies.clear();
+    }
+    (out, bodies, first_error)
+}
+
+/// The surfaces that faces (or offsets) use, which are not faces
+/// themselves; the faces in a shell; the shells in a solid.
+fn uses(ctx: &Ctx<'_>) -> (HashSet<usize>, HashSet<usize>, HashSet<usize>) {
     let mut used: HashSet<usize> = HashSet::default();
     let mut in_shell: HashSet<usize> = HashSet::default();
     let mut shell_in_solid: HashSet<usize> = HashSet::default();
-    for e in &dir.entities {
+    for e in &ctx.dir.entities {
         let at = match e.kind {
             144 | 510 => Some(1),
             143 | 142 => Some(2),
@@ -60,115 +115,106 @@ pub(super) fn read_faces(
             }
         }
     }
-    let subfigures = Subfigures::scan(ctx);
-    let mut out = Vec::new();
-    let mut bodies: Vec<u32> = Vec::new();
-    let mut shell_body: crate::collections::HashMap<(u32, usize), u32> = crate::collections::HashMap::default();
-    let mut first_error: Option<Error> = None;
-    let mut unsupported: Vec<(u32, usize)> = Vec::new();
-    let shells = Shells { used: &used, in_shell: &in_shell, shell_in_solid: &shell_in_solid };
-    // Hidden (blanked) faces are not part of what the file shows, unless
-    // the file shows nothing else.
-    let face_entity = |e: &Entity| match e.kind {
-        144 | 143 | 186 => true,
-        514 => !shell_in_solid.contains(&e.de),
-        510 => !in_shell.contains(&e.de),
-        108 => !used.contains(&e.de),
-        k => is_surface(k) && !used.contains(&e.de) && e.subordinate & 1 == 0,
-    };
-    let any_shown = dir.entities.iter().any(|e| face_entity(e) && !e.blanked);
-    let mut hidden = 0usize;
-    let mut count = Count::default();
-    let top = At { m: ctx.world, instance: 0 };
-    for e in &dir.entities {
-        if any_shown && e.blanked && (face_entity(e) || subfigures.is_root_instance(e)) {
-            hidden += 1;
-            continue;
-        }
-        if subfigures.is_member(e.de) {
-            continue; // read where its subfigure's instances place it
-        }
+    (used, in_shell, shell_in_solid)
+}
+
+/// The faces read so far, and what reading them left to say.
+struct FaceReader<'c, 'r> {
+    ctx: &'c Ctx<'c>,
+    out: Vec<Face>,
+    bodies: Vec<u32>,
+    /// Each B-rep shell's body, by subfigure instance and shell entity.
+    shell_body: crate::collections::HashMap<(u32, usize), u32>,
+    first_error: Option<Error>,
+    /// Entity types not supported, and how many of each.
+    unsupported: Vec<(u32, usize)>,
+    /// Subfigure instances expanded so far.
+    count: Count,
+    warnings: &'r mut Vec<String>,
+    skipped: &'r mut Vec<SkippedFace>,
+}
+
+impl FaceReader<'_, '_> {
+    /// The faces entity `e` makes, each with where it is read (a subfigure
+    /// instance's members where it places them); `None` when it makes none
+    /// (not supported, or skipped with a warning).
+    fn jobs(&mut self, e: &Entity, subfigures: &Subfigures, shells: &Shells<'_>) -> Option<Vec<(usize, Job, At)>> {
+        let ctx = self.ctx;
         let mut jobs: Vec<(usize, Job, At)> = Vec::new();
         if subfigures.is_root_instance(e) {
             let mut placed = Vec::new();
-            if let Err(err) = subfigures.expand(ctx, e.de, ctx.world, 0, &mut count, &mut placed) {
-                skip(warnings, &mut first_error, e, err);
-                continue;
+            if let Err(err) = subfigures.expand(ctx, e.de, ctx.world, 0, &mut self.count, &mut placed) {
+                skip(self.warnings, &mut self.first_error, e, err);
+                return None;
             }
             for p in placed {
-                let Some(member) = dir.get(p.de) else { continue };
+                let Some(member) = ctx.dir.get(p.de) else { continue };
                 match shells.jobs(ctx, member, true) {
                     Ok(j) => jobs.extend(j.into_iter().map(|(de, job)| (de, job, At { m: p.m, instance: p.instance }))),
-                    Err(err) => skip(warnings, &mut first_error, member, err),
+                    Err(err) => skip(self.warnings, &mut self.first_error, member, err),
                 }
             }
-        } else {
-            if matches!(e.kind, 402 | 412 | 414 | 420) && (e.kind != 402 || e.form == 9) {
-                match unsupported.iter_mut().find(|(k, _)| *k == e.kind) {
-                    Some(x) => x.1 += 1,
-                    None => unsupported.push((e.kind, 1)),
-                }
-                continue;
-            }
-            match shells.jobs(ctx, e, false) {
-                Ok(j) => jobs.extend(j.into_iter().map(|(de, job)| (de, job, top))),
-                Err(err) => {
-                    skip(warnings, &mut first_error, e, err);
-                    continue;
-                }
-            }
+            return Some(jobs);
         }
-        for (de, job, at) in jobs {
-            let fe = match ctx.entity(de) {
-                Ok(fe) => fe,
-                // Damaged parameter data: the directory's warning named it already.
-                Err(err) if ctx.dir.get(de).is_some_and(|x| x.damage.is_some()) => {
-                    first_error.get_or_insert(err);
-                    continue;
-                }
-                Err(err) => {
-                    skip(warnings, &mut first_error, e, err);
-                    continue;
-                }
-            };
-            let mut local = Vec::new();
-            let result =
-                face_source(ctx, fe, &job, at.m).and_then(|src| build_face(src, &mut local).map_err(|m| fe.error(m)));
-            for w in local {
-                warnings.push(alloc::format!("DE {} (type {}): {w}", fe.de, fe.kind));
+        if matches!(e.kind, 402 | 412 | 414 | 420) && (e.kind != 402 || e.form == 9) {
+            match self.unsupported.iter_mut().find(|(k, _)| *k == e.kind) {
+                Some(x) => x.1 += 1,
+                None => self.unsupported.push((e.kind, 1)),
             }
-            let body = match &job {
-                Job::Brep(parents) if !parents.is_empty() => {
-                    let next = shell_body.len() as u32 + 1;
-                    *shell_body.entry((at.instance, parents[0])).or_insert(next)
-                }
-                _ => 0,
-            };
-            match result {
-                Ok(mut face) => {
-                    face.name = name_of(ctx, fe, &job);
-                    out.push(face);
-                    bodies.push(body);
-                }
-                Err(err) => {
-                    skip(warnings, &mut first_error, fe, err);
-                    skipped.push(SkippedFace { body, border: skipped::border(ctx, fe, &job, at.m) });
-                }
+            return None;
+        }
+        let top = At { m: ctx.world, instance: 0 };
+        match shells.jobs(ctx, e, false) {
+            Ok(j) => Some(j.into_iter().map(|(de, job)| (de, job, top)).collect()),
+            Err(err) => {
+                skip(self.warnings, &mut self.first_error, e, err);
+                None
             }
         }
     }
-    if hidden > 0 {
-        warnings
-            .push(alloc::format!("{hidden} hidden (blanked) surface entities skipped: the file does not show them"));
+
+    /// Reads entity `de` as a face by `job`, placed by `at`, for entity
+    /// `e` (named when it is skipped): the face and its body, or a warning
+    /// and the skipped face's border.
+    fn read(&mut self, e: &Entity, de: usize, job: &Job, at: At) {
+        let ctx = self.ctx;
+        let fe = match ctx.entity(de) {
+            Ok(fe) => fe,
+            // Damaged parameter data: the directory's warning named it already.
+            Err(err) if ctx.dir.get(de).is_some_and(|x| x.damage.is_some()) => {
+                self.first_error.get_or_insert(err);
+                return;
+            }
+            Err(err) => {
+                skip(self.warnings, &mut self.first_error, e, err);
+                return;
+            }
+        };
+        let mut local = Vec::new();
+        let result =
+            face_source(ctx, fe, job, at.m).and_then(|src| build_face(src, &mut local).map_err(|m| fe.error(m)));
+        for w in local {
+            self.warnings.push(alloc::format!("DE {} (type {}): {w}", fe.de, fe.kind));
+        }
+        let body = match job {
+            Job::Brep(parents) if !parents.is_empty() => {
+                let next = self.shell_body.len() as u32 + 1;
+                *self.shell_body.entry((at.instance, parents[0])).or_insert(next)
+            }
+            _ => 0,
+        };
+        match result {
+            Ok(mut face) => {
+                face.name = name_of(ctx, fe, job);
+                self.out.push(face);
+                self.bodies.push(body);
+            }
+            Err(err) => {
+                skip(self.warnings, &mut self.first_error, fe, err);
+                self.skipped.push(SkippedFace { body, border: skipped::border(ctx, fe, job, at.m) });
+            }
+        }
     }
-    for (kind, n) in unsupported {
-        let what = if kind == 402 { "perforated planes" } else { "array or network subfigure instances" };
-        warnings.push(alloc::format!("{n} entities of type {kind} ({what}) skipped: not supported"));
-    }
-    if bodies.iter().all(|&b| b == 0) && skipped.iter().all(|s| s.body == 0) {
-        bodies.clear();
-    }
-    (out, bodies, first_error)
 }
 
 /// Where a face is read: the map of its definition space to the output, and

@@ -67,112 +67,13 @@ pub(in crate::io) fn build_face_oriented(
     let mut def = src.def.clone();
     let periods = def.periods();
     let natural = def.natural();
-    // Parameter curves on a B-spline surface in its own parameters need no fitting.
-    let direct = def.fixed_domain() && src.native;
-    let mut loops_2d: Vec<Vec<NurbsCurve>> = Vec::new();
-    let mut tracks: Vec<Vec<Track>> = Vec::new();
-    for lp in &src.loops {
-        match (&lp.params, src.native) {
-            (Some(pc), true) if !pc.is_empty() && direct => {
-                let mut pieces = pc.clone();
-                orient_chain(&mut pieces);
-                loops_2d.push(pieces);
-            }
-            (Some(pc), true) if !pc.is_empty() => tracks.push(sample_loop(&def, pc.clone(), false, periods)?),
-            _ if !lp.model.is_empty() => tracks.push(sample_loop(&def, lp.model.clone(), true, periods)?),
-            (Some(_), false) => {
-                return Err("parameter-space trim curves on a surface whose parameters are not read, \
-                            and no model-space curves"
-                    .into())
-            }
-            _ => return Err("a boundary loop without curves".into()),
-        }
-    }
-    // Check the file's parameter curves against its model-space ones.
-    if direct && !loops_2d.is_empty() {
-        let (s, m) = def.build((0.0, 1.0), (0.0, 1.0))?;
-        let mut k = 0;
-        let mut bad = false;
-        for lp in &src.loops {
-            if matches!(&lp.params, Some(pc) if !pc.is_empty()) {
-                if !lp.model.is_empty() && !params_match(&s, &m, &loops_2d[k], &lp.model, &src) {
-                    bad = true;
-                }
-                k += 1;
-            }
-        }
-        if bad {
-            warn.push("parameter-space trim curves disagree with the model-space ones; projected instead".into());
-            loops_2d.clear();
-            tracks.clear();
-            for lp in &src.loops {
-                if lp.model.is_empty() {
-                    return Err("parameter-space trim curves off the surface and no model-space curves".into());
-                }
-                tracks.push(sample_loop(&def, lp.model.clone(), true, periods)?);
-            }
-        }
-    }
+    let (mut loops_2d, mut tracks) = read_loops(&src, &def, warn)?;
     // Each sampled loop continuous; those going round a period closed or joined.
     let windings: Vec<[i64; 2]> = tracks.iter_mut().map(|lp| chain_loop(lp, periods, left)).collect();
     resolve_windings(&def, &mut tracks, &windings, periods, natural, left)?;
-    // One window of the periods for all loops; the NURBS range.
-    let mut polys: Vec<Vec<DVec2>> = loops_2d.iter().map(|lp| pieces_poly(lp)).collect();
-    polys.extend(tracks.iter().map(|lp| lp.iter().flat_map(|t| t.qs.iter().copied()).collect()));
-    let (surface, maps) = if polys.is_empty() {
-        let [u, v] = natural;
-        let (Some(u), Some(v)) = (u, v) else {
-            return Err("an unbounded surface without trim curves".into());
-        };
-        def.build(u, v)?
-    } else {
-        let (mut shifts, range) = windows(&polys, periods, natural)?;
-        if def.fixed_domain() {
-            // Loops straddling the seam of a closed B-spline: move the seam,
-            // or unroll the surface over more than a period where they wrap further.
-            let [lo, hi] = def.build((0.0, 1.0), (0.0, 1.0))?.0.domain();
-            for k in 0..2 {
-                let (Some(p), (a, b)) = (periods[k], range[k]) else { continue };
-                let eps = 1e-9 * p;
-                if a >= lo[k] - eps && b <= hi[k] + eps {
-                    continue;
-                }
-                let cannot = "trim loops cross the seam of a closed surface that cannot be re-cut there";
-                if b - a > p * (1.0 + 1e-6) {
-                    def = def.unroll(k == 0, a, b).ok_or(cannot)?;
-                    continue;
-                }
-                let c = lo[k] + (a - lo[k] - p * libm::floor((a - lo[k]) / p));
-                def = def.rotate_seam(k == 0, c).ok_or(cannot)?;
-                for s in &mut shifts {
-                    s[k] += c - a;
-                }
-            }
-        }
-        let n2d = loops_2d.len();
-        for (lp, s) in loops_2d.iter_mut().zip(&shifts) {
-            if *s != DVec2::ZERO {
-                for c in lp.iter_mut() {
-                    *c = map_points(c, |p| p + s.extend(0.0)).map_err(|e| alloc::format!("trim curve: {e}"))?;
-                }
-            }
-        }
-        for (lp, s) in tracks.iter_mut().zip(&shifts[n2d..]) {
-            for t in lp.iter_mut() {
-                t.shift(*s);
-            }
-        }
-        if let (true, [lp]) = (loops_2d.is_empty() && !src.domain_outer, tracks.as_slice()) {
-            if let Some(face) = rectangle_face(&def, lp)? {
-                return Ok(face);
-            }
-        }
-        let (u, v) = if def.fixed_domain() {
-            ((0.0, 1.0), (0.0, 1.0))
-        } else {
-            extents(&def, &tracks, periods, natural, src.domain_outer)?
-        };
-        def.build(u, v)?
+    let (surface, maps) = match place_loops(&src, &mut def, &mut loops_2d, &mut tracks)? {
+        Placed::Face(face) => return Ok(face),
+        Placed::Surface(surface, maps) => (surface, maps),
     };
     // Fit the sampled loops.
     let size = model_size(&surface, &tracks, &loops_2d, &maps);
@@ -212,6 +113,150 @@ pub(in crate::io) fn build_face_oriented(
         }
     }
     Ok(Face { name: None, surface, loops })
+}
+
+/// The face's loops as read: the file's parameter curves where they are in
+/// a B-spline surface's own parameters and agree with its model-space
+/// curves (`loops_2d`), else sampled tracks to fit (from the parameter
+/// curves, or from the model-space ones, projected).
+///
+/// # Errors
+/// A loop without curves, or one only in parameters that are not read.
+#[allow(clippy::type_complexity)]
+fn read_loops(
+    src: &FaceSrc,
+    def: &SurfDef,
+    warn: &mut Vec<String>,
+) -> Result<(Vec<Vec<NurbsCurve>>, Vec<Vec<Track>>), String> {
+    let periods = def.periods();
+    // Parameter curves on a B-spline surface in its own parameters need no fitting.
+    let direct = def.fixed_domain() && src.native;
+    let mut loops_2d: Vec<Vec<NurbsCurve>> = Vec::new();
+    let mut tracks: Vec<Vec<Track>> = Vec::new();
+    for lp in &src.loops {
+        match (&lp.params, src.native) {
+            (Some(pc), true) if !pc.is_empty() && direct => {
+                let mut pieces = pc.clone();
+                orient_chain(&mut pieces);
+                loops_2d.push(pieces);
+            }
+            (Some(pc), true) if !pc.is_empty() => tracks.push(sample_loop(def, pc.clone(), false, periods)?),
+            _ if !lp.model.is_empty() => tracks.push(sample_loop(def, lp.model.clone(), true, periods)?),
+            (Some(_), false) => {
+                return Err("parameter-space trim curves on a surface whose parameters are not read, \
+                            and no model-space curves"
+                    .into())
+            }
+            _ => return Err("a boundary loop without curves".into()),
+        }
+    }
+    // Check the file's parameter curves against its model-space ones.
+    if direct && !loops_2d.is_empty() {
+        let (s, m) = def.build((0.0, 1.0), (0.0, 1.0))?;
+        let mut k = 0;
+        let mut bad = false;
+        for lp in &src.loops {
+            if matches!(&lp.params, Some(pc) if !pc.is_empty()) {
+                if !lp.model.is_empty() && !params_match(&s, &m, &loops_2d[k], &lp.model, src) {
+                    bad = true;
+                }
+                k += 1;
+            }
+        }
+        if bad {
+            warn.push("parameter-space trim curves disagree with the model-space ones; projected instead".into());
+            loops_2d.clear();
+            tracks.clear();
+            for lp in &src.loops {
+                if lp.model.is_empty() {
+                    return Err("parameter-space trim curves off the surface and no model-space curves".into());
+                }
+                tracks.push(sample_loop(def, lp.model.clone(), true, periods)?);
+            }
+        }
+    }
+    Ok((loops_2d, tracks))
+}
+
+/// What placing the loops on the surface gave: a face already (a single
+/// loop round the rectangle of a plane), or the surface to fit them to.
+enum Placed {
+    Face(Face),
+    Surface(FaceSurface, [AxisMap; 2]),
+}
+
+/// One window of the periods for all loops (the loops shifted into it; the
+/// seam of a closed B-spline moved, or the surface unrolled, where they
+/// straddle or wrap past it), then the surface over the NURBS range they need.
+///
+/// # Errors
+/// An unbounded surface without loops, a seam that cannot be re-cut, or
+/// loops the surface cannot be built under.
+fn place_loops(
+    src: &FaceSrc,
+    def: &mut SurfDef,
+    loops_2d: &mut [Vec<NurbsCurve>],
+    tracks: &mut [Vec<Track>],
+) -> Result<Placed, String> {
+    let (periods, natural) = (def.periods(), def.natural());
+    let mut polys: Vec<Vec<DVec2>> = loops_2d.iter().map(|lp| pieces_poly(lp)).collect();
+    polys.extend(tracks.iter().map(|lp| lp.iter().flat_map(|t| t.qs.iter().copied()).collect()));
+    if polys.is_empty() {
+        let [u, v] = natural;
+        let (Some(u), Some(v)) = (u, v) else {
+            return Err("an unbounded surface without trim curves".into());
+        };
+        let (surface, maps) = def.build(u, v)?;
+        return Ok(Placed::Surface(surface, maps));
+    }
+    let (mut shifts, range) = windows(&polys, periods, natural)?;
+    if def.fixed_domain() {
+        // Loops straddling the seam of a closed B-spline: move the seam,
+        // or unroll the surface over more than a period where they wrap further.
+        let [lo, hi] = def.build((0.0, 1.0), (0.0, 1.0))?.0.domain();
+        for k in 0..2 {
+            let (Some(p), (a, b)) = (periods[k], range[k]) else { continue };
+            let eps = 1e-9 * p;
+            if a >= lo[k] - eps && b <= hi[k] + eps {
+                continue;
+            }
+            let cannot = "trim loops cross the seam of a closed surface that cannot be re-cut there";
+            if b - a > p * (1.0 + 1e-6) {
+                *def = def.unroll(k == 0, a, b).ok_or(cannot)?;
+                continue;
+            }
+            let c = lo[k] + (a - lo[k] - p * libm::floor((a - lo[k]) / p));
+            *def = def.rotate_seam(k == 0, c).ok_or(cannot)?;
+            for s in &mut shifts {
+                s[k] += c - a;
+            }
+        }
+    }
+    let n2d = loops_2d.len();
+    for (lp, s) in loops_2d.iter_mut().zip(&shifts) {
+        if *s != DVec2::ZERO {
+            for c in lp.iter_mut() {
+                *c = map_points(c, |p| p + s.extend(0.0)).map_err(|e| alloc::format!("trim curve: {e}"))?;
+            }
+        }
+    }
+    for (lp, s) in tracks.iter_mut().zip(&shifts[n2d..]) {
+        for t in lp.iter_mut() {
+            t.shift(*s);
+        }
+    }
+    if let (true, [lp]) = (loops_2d.is_empty() && !src.domain_outer, &*tracks) {
+        if let Some(face) = rectangle_face(def, lp)? {
+            return Ok(Placed::Face(face));
+        }
+    }
+    let (u, v) = if def.fixed_domain() {
+        ((0.0, 1.0), (0.0, 1.0))
+    } else {
+        extents(def, tracks, periods, natural, src.domain_outer)?
+    };
+    let (surface, maps) = def.build(u, v)?;
+    Ok(Placed::Surface(surface, maps))
 }
 
 /// Points along the pieces (17 per piece), a polygon of the loop.
@@ -255,7 +300,7 @@ fn rectangle_face(def: &SurfDef, lp: &[Track]) -> Result<Option<Face>, String> {
     }
     // The loop must go round the whole border, not along part of it and back.
     let extra = alloc::vec![0.0; lp.len()];
-    let (area, ..) = loop_shape(lp, &extra, 0);
+    let area = loop_shape(lp, &extra, 0).area;
     if area.abs() < 0.999 * span.x * span.y {
         return Ok(None);
     }
@@ -486,7 +531,7 @@ fn params_match(
             for (m, bx) in model.iter().zip(&boxes) {
                 let gap = (bx.min - p).max(p - bx.max).max(DVec3::ZERO).length();
                 if gap < best {
-                    best = best.min(m.project(p).2);
+                    best = best.min(m.project(p).distance);
                 }
             }
             if best.is_nan() || best > tol {

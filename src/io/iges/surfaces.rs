@@ -303,7 +303,7 @@ impl Revolution {
             }
             Profile::Curve(curve) => {
                 let q = self.origin + self.axis * h + x * r;
-                curve.project(q).0
+                curve.project(q).t
             }
         };
         Native { q: DVec2::new(t, theta), free: [false, on_axis] }

@@ -61,7 +61,7 @@ pub(super) fn chain_loop(lp: &mut [Track], periods: [Option<f64>; 2], left: Opti
                     }
                     extra[j] = acc;
                 }
-                let (area, lo, hi, first, last) = loop_shape(lp, &extra, k);
+                let LoopShape { area, lo, hi, first, last } = loop_shape(lp, &extra, k);
                 let turns = if closes_at_pole { 0 } else { libm::round((last - first) / p) as i64 };
                 let key = (turns == 0, hi - lo <= p * (1.0 + 1e-6), area * want > 0.0, -moved);
                 if best.as_ref().is_none_or(|(b, _)| key > *b) {
@@ -87,9 +87,22 @@ pub(super) fn chain_loop(lp: &mut [Track], periods: [Option<f64>; 2], left: Opti
     winding
 }
 
-/// Signed area of the polygon through a loop's samples (piece `i` moved by
-/// `extra[i]` along coordinate `k`), the range of `k`, and its first and last value.
-pub(super) fn loop_shape(lp: &[Track], extra: &[f64], k: usize) -> (f64, f64, f64, f64, f64) {
+/// What [`loop_shape`] measures of a loop along one coordinate.
+pub(super) struct LoopShape {
+    /// Signed area of the polygon through the loop's samples.
+    pub area: f64,
+    /// Smallest and largest value of the coordinate.
+    pub lo: f64,
+    pub hi: f64,
+    /// The coordinate's value at the loop's first and last sample.
+    pub first: f64,
+    pub last: f64,
+}
+
+/// The shape of the polygon through a loop's samples, piece `i` moved by
+/// `extra[i]` along coordinate `k`: its signed area, and the range and the
+/// first and last value of `k`.
+pub(super) fn loop_shape(lp: &[Track], extra: &[f64], k: usize) -> LoopShape {
     let mut area = 0.0;
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     let mut first: Option<DVec2> = None;
@@ -109,9 +122,9 @@ pub(super) fn loop_shape(lp: &[Track], extra: &[f64], k: usize) -> (f64, f64, f6
     }
     if let (Some(p), Some(f)) = (prev, first) {
         area += p.perp_dot(f);
-        return (0.5 * area, lo, hi, f[k], p[k]);
+        return LoopShape { area: 0.5 * area, lo, hi, first: f[k], last: p[k] };
     }
-    (0.0, lo, hi, 0.0, 0.0)
+    LoopShape { area: 0.0, lo, hi, first: 0.0, last: 0.0 }
 }
 
 /// Loops that go round a periodic coordinate bound the face only with a

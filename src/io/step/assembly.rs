@@ -130,33 +130,99 @@ fn root(parent: &mut [usize], mut i: usize) -> usize {
     i
 }
 
-/// Works out every placed shape.
+/// The representations of the file: id, items and context of each, the
+/// index of each id, and the units of each one's context.
+struct Reps {
+    list: Vec<(u64, Vec<u64>, u64)>,
+    index: HashMap<u64, usize>,
+    units: Vec<Units>,
+}
+
+/// A placement of one representation in another.
+struct Relation {
+    parent: u64,
+    child: u64,
+    /// From the child's coordinates to the parent's, millimetres.
+    m: DAffine3,
+    /// Product name.
+    name: Option<String>,
+    /// The occurrence's own name.
+    occurrence: Option<String>,
+}
+
+/// A child group of a group: its group, its map to the parent (mm), its
+/// product name and its occurrence name.
+type Child = (usize, DAffine3, Option<String>, Option<String>);
+
+/// Representations related without a transformation, joined into groups,
+/// and the placements between groups.
+struct Groups {
+    /// Each group's child groups, placed.
+    children: HashMap<usize, Vec<Child>>,
+    /// Each group's representations.
+    members: HashMap<usize, Vec<usize>>,
+    /// Groups that are nobody's child, in group order.
+    roots: Vec<usize>,
+}
+
+/// Works out every placed shape: the representations, the relations that
+/// place one in another, the groups they form, the output unit, then a walk
+/// down the placements from each root; solids no representation lists are
+/// read in place, and faces a shell also holds are dropped.
 ///
 /// # Errors
 /// Malformed relations (bad references, placements that are not placements).
 pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error> {
-    // Representations.
-    let mut reps: Vec<(u64, Vec<u64>, u64)> = Vec::new();
-    let mut rep_index: HashMap<u64, usize> = HashMap::default();
+    let reps = representations(g, warnings);
+    let mut parent: Vec<usize> = (0..reps.list.len()).collect();
+    let cdsr = cdsr_products(g);
+    let product_of_rep = rep_products(g);
+    let mut relations = relationships(g, &reps, &cdsr, &product_of_rep, &mut parent)?;
+    relations.extend(mapped_items(g, &reps)?);
+    let groups = groups(&reps, parent, &relations);
+    let out_mm = output_unit(g, &reps, &groups);
+    let mut plan = Plan { units: unit_name(out_mm), ..Plan::default() };
+    let (emitted, tol) = walk(g, &reps, &groups, &product_of_rep, out_mm, &mut plan, warnings);
+    read_unlisted_solids(g, &emitted, &mut plan, warnings);
+    drop_shell_faces(g, &mut plan);
+    plan.tolerance = (tol > 0.0 && tol.is_finite()).then_some(tol);
+    Ok(plan)
+}
+
+/// Every representation of `g`, and the units of its context.
+fn representations(g: &Graph, warnings: &mut Vec<String>) -> Reps {
+    let mut list: Vec<(u64, Vec<u64>, u64)> = Vec::new();
+    let mut index: HashMap<u64, usize> = HashMap::default();
     for e in g.all() {
         if let Some((items, ctx)) = representation(e) {
-            rep_index.insert(e.id(), reps.len());
-            reps.push((e.id(), items, ctx));
+            index.insert(e.id(), list.len());
+            list.push((e.id(), items, ctx));
         }
     }
     let mut unit_cache: HashMap<u64, Units> = HashMap::default();
-    let units: Vec<Units> = reps
+    let units = list
         .iter()
         .map(|(_, _, ctx)| *unit_cache.entry(*ctx).or_insert_with(|| context_units(g, *ctx, warnings)))
         .collect();
-    // Groups: representations related without a transformation.
-    let n = reps.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    // Parent rep, child rep, child→parent (mm), product name, occurrence name.
-    type Edge = (u64, u64, DAffine3, Option<String>, Option<String>);
-    let mut edges: Vec<Edge> = Vec::new();
-    let cdsr = cdsr_products(g);
-    let product_of_rep = rep_products(g);
+    Reps { list, index, units }
+}
+
+/// The representation relationships of `g`: those without a transformation
+/// join their two representations' groups in `parent`; the others are
+/// placements, the child the one the product structure (`cdsr`,
+/// `product_of_rep`) names, else `rep_1`.
+///
+/// # Errors
+/// A transformation that is not one, or a reference that is not an entity.
+fn relationships(
+    g: &Graph,
+    reps: &Reps,
+    cdsr: &HashMap<u64, (Option<String>, u64, Option<String>)>,
+    product_of_rep: &HashMap<u64, (u64, Option<String>)>,
+    parent: &mut [usize],
+) -> Result<Vec<Relation>, Error> {
+    let units = &reps.units;
+    let mut out = Vec::new();
     for e in g.all() {
         if !(e.has("REPRESENTATION_RELATIONSHIP") || e.has("SHAPE_REPRESENTATION_RELATIONSHIP")) {
             continue;
@@ -166,9 +232,9 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
             None => e.attrs(),
         };
         let (Ok(r1), Ok(r2)) = (a.refr(2), a.refr(3)) else { continue };
-        let (Some(&i1), Some(&i2)) = (rep_index.get(&r1), rep_index.get(&r2)) else { continue };
+        let (Some(&i1), Some(&i2)) = (reps.index.get(&r1), reps.index.get(&r2)) else { continue };
         let Some(t) = e.part("REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION") else {
-            let (x, y) = (root(&mut parent, i1), root(&mut parent, i2));
+            let (x, y) = (root(parent, i1), root(parent, i2));
             parent[x] = y;
             continue;
         };
@@ -191,10 +257,20 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
         };
         let name = cdsr.get(&e.id()).and_then(|(n, _, _)| n.clone());
         let occurrence = cdsr.get(&e.id()).and_then(|(_, _, o)| o.clone());
-        edges.push((par, child, m, name, occurrence));
+        out.push(Relation { parent: par, child, m, name, occurrence });
     }
-    // Mapped items.
-    for (ri, (rid, items, _)) in reps.iter().enumerate() {
+    Ok(out)
+}
+
+/// The `MAPPED_ITEM`s among the representations' items: each places its
+/// source representation in the one that lists it.
+///
+/// # Errors
+/// A mapped item whose attributes are not the entities they must be.
+fn mapped_items(g: &Graph, reps: &Reps) -> Result<Vec<Relation>, Error> {
+    let units = &reps.units;
+    let mut out = Vec::new();
+    for (ri, (rid, items, _)) in reps.list.iter().enumerate() {
         for &it in items {
             let Some(e) = g.find(it) else { continue };
             if !e.has("MAPPED_ITEM") {
@@ -205,25 +281,30 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
             let ma = map.attrs();
             let origin = ma.ent(0)?;
             let child = ma.refr(1)?;
-            let Some(&ci) = rep_index.get(&child) else { continue };
+            let Some(&ci) = reps.index.get(&child) else { continue };
             let go = Geo { g, angle: units[ci].rad, uncertainty: 0.0 };
             let gt = Geo { g, angle: units[ri].rad, uncertainty: 0.0 };
             let m =
                 in_mm(gt.transform(a.ent(2)?)?, units[ri].mm) * in_mm(go.transform(origin)?, units[ci].mm).inverse();
-            edges.push((*rid, child, m, None, None));
+            out.push(Relation { parent: *rid, child, m, name: None, occurrence: None });
         }
     }
-    // Groups and their children.
-    let group = |parent: &mut Vec<usize>, rep: u64| rep_index.get(&rep).map(|&i| root(parent, i));
-    type Child = (usize, DAffine3, Option<String>, Option<String>);
+    Ok(out)
+}
+
+/// The groups `parent` joined, each group's placed children and members,
+/// and the roots in group order.
+fn groups(reps: &Reps, mut parent: Vec<usize>, relations: &[Relation]) -> Groups {
+    let n = reps.list.len();
     let mut children: HashMap<usize, Vec<Child>> = HashMap::default();
     let mut is_child: HashSet<usize> = HashSet::default();
-    for (p, c, m, name, occurrence) in &edges {
-        let (Some(gp), Some(gc)) = (group(&mut parent, *p), group(&mut parent, *c)) else { continue };
+    for r in relations {
+        let group = |parent: &mut Vec<usize>, rep: u64| reps.index.get(&rep).map(|&i| root(parent, i));
+        let (Some(gp), Some(gc)) = (group(&mut parent, r.parent), group(&mut parent, r.child)) else { continue };
         if gp == gc {
             continue;
         }
-        children.entry(gp).or_default().push((gc, *m, name.clone(), occurrence.clone()));
+        children.entry(gp).or_default().push((gc, r.m, r.name.clone(), r.occurrence.clone()));
         is_child.insert(gc);
     }
     let mut members: HashMap<usize, Vec<usize>> = HashMap::default();
@@ -234,38 +315,66 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
     let mut roots: Vec<usize> = (0..n).map(|i| root(&mut parent, i)).filter(|r| !is_child.contains(r)).collect();
     roots.sort_unstable();
     roots.dedup();
-    // Output unit: the first root that holds shapes.
+    Groups { children, members, roots }
+}
+
+impl Groups {
+    /// Whether group `gi` is in the product structure: it has children or a
+    /// product owns one of its representations.
+    fn in_products(&self, gi: usize, reps: &Reps, product_of_rep: &HashMap<u64, (u64, Option<String>)>) -> bool {
+        self.children.contains_key(&gi)
+            || self.members.get(&gi).is_some_and(|ms| ms.iter().any(|&i| product_of_rep.contains_key(&reps.list[i].0)))
+    }
+}
+
+/// Millimetres per output unit: the unit of the first root that holds shapes.
+fn output_unit(g: &Graph, reps: &Reps, groups: &Groups) -> f64 {
     let holds_shapes = |gi: usize| {
-        members.get(&gi).is_some_and(|ms| {
-            ms.iter()
-                .any(|&i| reps[i].1.iter().any(|&it| g.find(it).is_some_and(|e| is_shape(e) || e.has("MAPPED_ITEM"))))
-        }) || children.contains_key(&gi)
+        groups.members.get(&gi).is_some_and(|ms| {
+            ms.iter().any(|&i| {
+                reps.list[i].1.iter().any(|&it| g.find(it).is_some_and(|e| is_shape(e) || e.has("MAPPED_ITEM")))
+            })
+        }) || groups.children.contains_key(&gi)
     };
-    let out_mm = roots
+    groups
+        .roots
         .iter()
         .find(|&&r| holds_shapes(r))
-        .and_then(|r| members.get(r))
+        .and_then(|r| groups.members.get(r))
         .and_then(|ms| ms.first())
-        .map_or(1.0, |&i| units[i].mm);
-    let mut plan = Plan { units: unit_name(out_mm), ..Plan::default() };
+        .map_or(1.0, |&i| reps.units[i].mm)
+}
+
+/// A node to visit: its group, its map to the output (mm), its name, its
+/// depth, its parent node, its map to the parent (mm) and its occurrence name.
+type Visit = (usize, DAffine3, Option<String>, usize, Option<usize>, DAffine3, Option<String>);
+
+/// Depth-first over the placements from each root (those in the product
+/// structure first: a representation no product owns, such as validation
+/// properties or presentation, that lists their shapes again adds nothing),
+/// the path kept to refuse cycles: the product tree into `plan.nodes` and
+/// each shape item once per distinct placement into `plan.placed`, in the
+/// output unit (`out_mm` millimetres). The items placed, and the largest
+/// uncertainty of their contexts in the output unit.
+fn walk(
+    g: &Graph,
+    reps: &Reps,
+    groups: &Groups,
+    product_of_rep: &HashMap<u64, (u64, Option<String>)>,
+    out_mm: f64,
+    plan: &mut Plan,
+    warnings: &mut Vec<String>,
+) -> (HashSet<u64>, f64) {
+    let (members, children) = (&groups.members, &groups.children);
     let mut seen: HashSet<(u64, [u64; 12])> = HashSet::default();
     let mut emitted: HashSet<u64> = HashSet::default();
     let mut tol: f64 = 0.0;
     let scale_out = DAffine3::from_scale(DVec3::splat(1.0 / out_mm));
-    // Depth-first over placements, with the path kept to refuse cycles.
-    // Roots in the product structure first: a representation no product
-    // owns (validation properties, presentation) that lists their shapes
-    // again adds nothing.
-    let in_products = |gi: usize| {
-        children.contains_key(&gi)
-            || members.get(&gi).is_some_and(|ms| ms.iter().any(|&i| product_of_rep.contains_key(&reps[i].0)))
-    };
+    let in_products = |gi: usize| groups.in_products(gi, reps, product_of_rep);
+    let mut roots = groups.roots.clone();
     crate::sort::by_u64(&mut roots, |&r| u64::from(!in_products(r)));
     // The output unit's view of a map between millimetre coordinates.
     let out_map = |m: DAffine3| scale_out * m * scale_out.inverse();
-    /// A node to visit: its group, its map to the output (mm), its name, its
-    /// depth, its parent node, its map to the parent (mm) and its occurrence name.
-    type Visit = (usize, DAffine3, Option<String>, usize, Option<usize>, DAffine3, Option<String>);
     let mut stack: Vec<Visit> =
         roots.iter().rev().map(|&r| (r, DAffine3::IDENTITY, None, 0, None, DAffine3::IDENTITY, None)).collect();
     let mut visits = 0usize;
@@ -280,7 +389,7 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
         let orphan = depth == 0 && !in_products(gi);
         let own_name = members
             .get(&gi)
-            .and_then(|ms| ms.iter().find_map(|&i| product_of_rep.get(&reps[i].0).and_then(|(_, n)| n.clone())));
+            .and_then(|ms| ms.iter().find_map(|&i| product_of_rep.get(&reps.list[i].0).and_then(|(_, n)| n.clone())));
         let name = own_name.or(name);
         let node = plan.nodes.len();
         plan.nodes.push(PlanNode {
@@ -291,10 +400,10 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
             world: out_map(m),
         });
         for &i in members.get(&gi).map_or(&[][..], Vec::as_slice) {
-            let u = units[i];
-            for &it in &reps[i].1 {
+            let u = reps.units[i];
+            for &it in &reps.list[i].1 {
                 let Some(e) = g.find(it) else {
-                    warnings.push(format!("#{}: item #{it} is not defined; skipped", reps[i].0));
+                    warnings.push(format!("#{}: item #{it} is not defined; skipped", reps.list[i].0));
                     continue;
                 };
                 if !is_shape(e) || (orphan && emitted.contains(&it)) {
@@ -323,7 +432,12 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
             }
         }
     }
-    // Solids and surface models no representation lists.
+    (emitted, tol)
+}
+
+/// Solids and surface models no representation lists (none of the items
+/// `emitted` and not inside one of them): read in place, each a root node.
+fn read_unlisted_solids(g: &Graph, emitted: &HashSet<u64>, plan: &mut Plan, warnings: &mut Vec<String>) {
     let mut nested: HashSet<u64> = HashSet::default();
     for p in &plan.placed {
         if let Some(e) = g.find(p.item) {
@@ -360,8 +474,11 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
             });
         }
     }
-    // Faces that a representation lists on their own but that a shell also
-    // holds are references (annotations, PMI), not more geometry.
+}
+
+/// Faces that a representation lists on their own but that a shell also
+/// holds are references (annotations, PMI), not more geometry: dropped.
+fn drop_shell_faces(g: &Graph, plan: &mut Plan) {
     let mut in_shells: HashSet<u64> = HashSet::default();
     for e in g.all() {
         if e.has("CLOSED_SHELL") || e.has("OPEN_SHELL") || e.has("CONNECTED_FACE_SET") {
@@ -374,8 +491,6 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
         let face = g.find(p.item).is_some_and(|e| e.has("ADVANCED_FACE") || e.has("FACE_SURFACE"));
         !(face && in_shells.contains(&p.item))
     });
-    plan.tolerance = (tol > 0.0 && tol.is_finite()).then_some(tol);
-    Ok(plan)
 }
 
 /// The product tree and the part instances of the read faces. `placed`

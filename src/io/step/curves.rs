@@ -513,7 +513,7 @@ pub(super) fn param_of(c: &Curve3, p: DVec3) -> f64 {
         }
         Curve3::Hyperbola { c, y, .. } => libm::asinh((p - *c).dot(*y) / y.length_squared().max(1e-300)),
         Curve3::Parabola { c, y, .. } => (p - *c).dot(*y) / y.length_squared().max(1e-300),
-        Curve3::Nurbs { c, .. } => c.project(p).0,
+        Curve3::Nurbs { c, .. } => c.project(p).t,
     }
 }
 

@@ -301,7 +301,7 @@ fn extrusion_of(e: Ent<'_>, curve: NurbsCurve, dir: DVec3, points: &[DVec3]) -> 
     let flat_curve = map_points(&curve, flat).map_err(|x| e.error(format!("{x}")))?;
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for &q in points {
-        let (t, _, _) = flat_curve.project(flat(q));
+        let t = flat_curve.project(flat(q)).t;
         let v = (q - curve.point(t)).dot(dir) / d2;
         lo = lo.min(v);
         hi = hi.max(v);

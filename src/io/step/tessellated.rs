@@ -255,39 +255,73 @@ impl Reader<'_, '_> {
                 }
             }
         }
+        let points = self.points(e, &a, at)?;
+        let n = points.len();
+        let (triangles, repeated) = self.triangles(e, &a, at, complex, n)?;
+        if triangles.is_empty() {
+            return Err(e.error("has no triangles"));
+        }
+        if repeated > 0 {
+            self.warnings.push(format!(
+                "#{} {}: {repeated} triangles name one point twice (no area); left out",
+                e.id(),
+                e.type_name()
+            ));
+        }
+        let normals = self.normals(e, &a, n)?;
+        let name = a.string(0).unwrap_or("").trim();
+        let name =
+            if name.is_empty() || name.eq_ignore_ascii_case("NONE") { format!("#{}", e.id()) } else { name.into() };
+        Ok(Some(TessellatedFace { name: Some(name), positions: points, normals, triangles }))
+    }
+
+    /// The face's points as its index lists see them (1-based): its
+    /// coordinates list, or the points `pnindex` (attribute `at`) picks from it.
+    fn points(&mut self, e: Ent<'_>, a: &Attrs<'_>, at: usize) -> Result<Vec<DVec3>, Error> {
         let coords_id = a.refr(1)?;
         let coords = self.coordinates(coords_id, e)?;
         let pnmax = a.int(2)?;
-        let pnindex = if omitted(&a, at) { Vec::new() } else { a.ints(at)? };
-        // The face's points, 1-based, as its index lists see them.
-        let points: Vec<DVec3> = if pnindex.is_empty() {
+        let pnindex = if omitted(a, at) { Vec::new() } else { a.ints(at)? };
+        if pnindex.is_empty() {
             if pnmax != coords.len() as i64 {
                 return Err(e.error(format!(
                     "pnmax is {pnmax} but its coordinates list #{coords_id} has {} points (and pnindex is empty)",
                     coords.len()
                 )));
             }
-            coords.clone()
-        } else {
-            if pnmax != pnindex.len() as i64 {
-                return Err(e.error(format!("pnmax is {pnmax} but pnindex lists {} points", pnindex.len())));
-            }
-            let mut pts = Vec::with_capacity(pnindex.len());
-            for (k, &i) in pnindex.iter().enumerate() {
-                match usize::try_from(i).ok().filter(|&i| (1..=coords.len()).contains(&i)) {
-                    Some(i) => pts.push(coords[i - 1]),
-                    None => {
-                        return Err(e.error(format!(
-                            "pnindex entry {} is {i}, not a point of its coordinates list #{coords_id} (1 to {})",
-                            k + 1,
-                            coords.len()
-                        )))
-                    }
+            return Ok(coords.clone());
+        }
+        if pnmax != pnindex.len() as i64 {
+            return Err(e.error(format!("pnmax is {pnmax} but pnindex lists {} points", pnindex.len())));
+        }
+        let mut pts = Vec::with_capacity(pnindex.len());
+        for (k, &i) in pnindex.iter().enumerate() {
+            match usize::try_from(i).ok().filter(|&i| (1..=coords.len()).contains(&i)) {
+                Some(i) => pts.push(coords[i - 1]),
+                None => {
+                    return Err(e.error(format!(
+                        "pnindex entry {} is {i}, not a point of its coordinates list #{coords_id} (1 to {})",
+                        k + 1,
+                        coords.len()
+                    )))
                 }
             }
-            pts
-        };
-        let n = points.len();
+        }
+        Ok(pts)
+    }
+
+    /// The face's triangles over its `n` points: its triangle list (after
+    /// `at`), or for a complex face its strips and fans expanded; triangles
+    /// that name one point twice are left out, and counted (a strip's or a
+    /// fan's are not: they close strips by design).
+    fn triangles(
+        &self,
+        e: Ent<'_>,
+        a: &Attrs<'_>,
+        at: usize,
+        complex: bool,
+        n: usize,
+    ) -> Result<(Vec<[u32; 3]>, usize), Error> {
         let index = |what: &str, i: &Value| -> Result<u32, Error> {
             match i {
                 Value::Int(x) if *x >= 1 && (*x as u64) <= n as u64 => Ok((*x - 1) as u32),
@@ -296,7 +330,7 @@ impl Reader<'_, '_> {
             }
         };
         let lists = |i: usize| -> Result<Vec<&[Value]>, Error> {
-            if omitted(&a, i) {
+            if omitted(a, i) {
                 return Ok(Vec::new());
             }
             let outer = a.list(i)?;
@@ -323,44 +357,30 @@ impl Reader<'_, '_> {
                     repeated += 1;
                 }
             }
-        } else {
-            for (k, s) in lists(at + 1)?.into_iter().enumerate() {
-                let what = format!("triangle strip {}", k + 1);
-                let v: Vec<u32> = s.iter().map(|i| index(&what, i)).collect::<Result<_, _>>()?;
-                if v.len() < 3 {
-                    return Err(e.error(format!("{what} has {} points; a strip needs 3 or more", v.len())));
-                }
-                for j in 2..v.len() {
-                    let t = if j % 2 == 0 { [v[j - 2], v[j - 1], v[j]] } else { [v[j - 1], v[j - 2], v[j]] };
-                    push(t, &mut triangles);
-                }
+            return Ok((triangles, repeated));
+        }
+        for (k, s) in lists(at + 1)?.into_iter().enumerate() {
+            let what = format!("triangle strip {}", k + 1);
+            let v: Vec<u32> = s.iter().map(|i| index(&what, i)).collect::<Result<_, _>>()?;
+            if v.len() < 3 {
+                return Err(e.error(format!("{what} has {} points; a strip needs 3 or more", v.len())));
             }
-            for (k, s) in lists(at + 2)?.into_iter().enumerate() {
-                let what = format!("triangle fan {}", k + 1);
-                let v: Vec<u32> = s.iter().map(|i| index(&what, i)).collect::<Result<_, _>>()?;
-                if v.len() < 3 {
-                    return Err(e.error(format!("{what} has {} points; a fan needs 3 or more", v.len())));
-                }
-                for j in 2..v.len() {
-                    push([v[0], v[j - 1], v[j]], &mut triangles);
-                }
+            for j in 2..v.len() {
+                let t = if j % 2 == 0 { [v[j - 2], v[j - 1], v[j]] } else { [v[j - 1], v[j - 2], v[j]] };
+                push(t, &mut triangles);
             }
         }
-        if triangles.is_empty() {
-            return Err(e.error("has no triangles"));
+        for (k, s) in lists(at + 2)?.into_iter().enumerate() {
+            let what = format!("triangle fan {}", k + 1);
+            let v: Vec<u32> = s.iter().map(|i| index(&what, i)).collect::<Result<_, _>>()?;
+            if v.len() < 3 {
+                return Err(e.error(format!("{what} has {} points; a fan needs 3 or more", v.len())));
+            }
+            for j in 2..v.len() {
+                push([v[0], v[j - 1], v[j]], &mut triangles);
+            }
         }
-        if repeated > 0 {
-            self.warnings.push(format!(
-                "#{} {}: {repeated} triangles name one point twice (no area); left out",
-                e.id(),
-                e.type_name()
-            ));
-        }
-        let normals = self.normals(e, &a, n)?;
-        let name = a.string(0).unwrap_or("").trim();
-        let name =
-            if name.is_empty() || name.eq_ignore_ascii_case("NONE") { format!("#{}", e.id()) } else { name.into() };
-        Ok(Some(TessellatedFace { name: Some(name), positions: points, normals, triangles }))
+        Ok((triangles, repeated))
     }
 
     /// The face's normals, one per point (`n` points): none, the one given

@@ -1,7 +1,7 @@
 //! Options of the quality mesher (paper 003): element size, method, the
 //! splitting function's weights, and the improvement passes.
 
-use crate::tessellate::OptionsError;
+use super::OptionsError;
 
 /// The wanted element size H (edge length), in model units or relative to the model.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,10 +1,28 @@
-//! Meshing options: plain struct, documented defaults, validated at every entry.
+//! Options of every mesher and the errors that reject them: plain structs,
+//! documented defaults, validated at every entry. A leaf: it uses no other
+//! module of the crate, so every layer can read its options from here.
 
-use alloc::vec::Vec;
+mod quality;
+
 use core::fmt;
 
-use crate::quality::QualityOptions;
-use crate::reparam::Reparam;
+pub use quality::{ElementSize, QualityMethod, QualityOptions};
+
+/// When faces are re-parameterized before meshing (paper 001).
+///
+/// Auto by default: a flagged face's rebuild is kept only where its mesh
+/// wins (no more triangles, better angles) and the original is meshed
+/// otherwise, so the default never meshes a face worse than `Off`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Reparam {
+    /// Faces the ratio test flags (the default).
+    #[default]
+    Auto,
+    /// Never.
+    Off,
+    /// Every face.
+    Force,
+}
 
 /// What the mesher aims at.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -66,34 +84,12 @@ pub struct MeshOptions {
     /// Settings of [`MeshMode::Quality`]: element size, method, weights.
     pub quality: QualityOptions,
     /// `Some((index, count))`: mesh only share `index` of `count` of the
-    /// model's bodies (see [`share_of_faces`]), so that workers can mesh one
+    /// model's bodies (see [`crate::share_of_faces`]), so that workers can mesh one
     /// model side by side. Bodies share no border, so the shares' meshes
     /// together are the whole model's mesh (`Report::bodies` says how many
     /// there are). A share given no body returns at once, its mesh empty and
     /// its report's tolerance 0. Default `None`: every face. Fast mode only.
     pub share: Option<(u32, u32)>,
-}
-
-/// Which faces share `index` of `count` meshes: bodies go, the largest (most
-/// faces) first, to the share with the fewest faces so far; ties by body id
-/// and by share index, so every worker computes the same split.
-pub fn share_of_faces(bodies: &[u32], faces: usize, index: u32, count: u32) -> Vec<bool> {
-    let body = |f: usize| crate::model::body_of(bodies, f);
-    let mut sizes: crate::collections::HashMap<u32, usize> = crate::collections::HashMap::default();
-    for f in 0..faces {
-        *sizes.entry(body(f)).or_insert(0) += 1;
-    }
-    let mut order: Vec<(u32, usize)> = sizes.into_iter().collect();
-    crate::sort::by_u64(&mut order, |o| crate::sort::pair(u32::MAX - o.1.min(u32::MAX as usize) as u32, o.0));
-    let count = count.max(1) as usize;
-    let mut load = alloc::vec![0usize; count];
-    let mut owner: crate::collections::HashMap<u32, usize> = crate::collections::HashMap::default();
-    for (b, n) in order {
-        let to = (0..count).min_by_key(|&i| (load[i], i)).unwrap_or(0);
-        load[to] += n;
-        owner.insert(b, to);
-    }
-    (0..faces).map(|f| owner.get(&body(f)).copied() == Some(index as usize)).collect()
 }
 
 impl Default for MeshOptions {

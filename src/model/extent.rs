@@ -1,0 +1,69 @@
+//! The extent of a model: the box its trimmed geometry fills, which a
+//! relative tolerance or element size is a fraction of.
+
+use alloc::vec::Vec;
+use glam::DVec2;
+
+use super::Model;
+use crate::nurbs::{Aabb, Surface};
+
+/// Box of the trimmed geometry, from a 17×17 sample of each face's surface over
+/// its loops' parameter box (points inside the region) and the loops themselves.
+pub(crate) fn trimmed_bbox(model: &Model) -> Aabb {
+    let mut b = Aabb::EMPTY;
+    for t in &model.tessellated {
+        for &p in t.positions.iter().filter(|p| p.is_finite()) {
+            b.add_point(p);
+        }
+    }
+    for f in &model.faces {
+        let s: &dyn Surface = &f.surface;
+        let [mut lo, mut hi] = s.domain();
+        let mut polys: Vec<Vec<DVec2>> = Vec::new();
+        if !f.loops.is_empty() {
+            let (mut llo, mut lhi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+            for lp in &f.loops {
+                let mut poly = Vec::new();
+                for c in &lp.curves {
+                    let (a, z) = c.domain();
+                    for k in 0..16 {
+                        let q = c.point(a + (z - a) * k as f64 / 16.0).truncate();
+                        llo = llo.min(q);
+                        lhi = lhi.max(q);
+                        b.add_point(s.point(q));
+                        poly.push(q);
+                    }
+                }
+                polys.push(poly);
+            }
+            lo = llo.max(lo);
+            hi = lhi.min(hi);
+        }
+        let inside = |q: DVec2| {
+            if polys.is_empty() {
+                return true;
+            }
+            let mut c = false;
+            for p in &polys {
+                let n = p.len();
+                for i in 0..n {
+                    let (a, z) = (p[i], p[(i + 1) % n]);
+                    if (a.y > q.y) != (z.y > q.y) && a.x + (q.y - a.y) / (z.y - a.y) * (z.x - a.x) > q.x {
+                        c = !c;
+                    }
+                }
+            }
+            c
+        };
+        let steps: Vec<f64> = (0..=16).map(|i| i as f64 / 16.0).collect();
+        let us: Vec<f64> = steps.iter().map(|t| lo.x + (hi.x - lo.x) * t).collect();
+        let vs: Vec<f64> = steps.iter().map(|t| lo.y + (hi.y - lo.y) * t).collect();
+        let points = f.surface.points_on_grid(&us, &vs);
+        for (k, p) in points.into_iter().enumerate() {
+            if inside(DVec2::new(us[k / vs.len()], vs[k % vs.len()])) {
+                b.add_point(p);
+            }
+        }
+    }
+    b
+}
