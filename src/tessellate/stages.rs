@@ -165,3 +165,13 @@ impl FaceStages<'_> {
         (0..mesh.tris.len()).map(|t| (mesh.uv(t), mesh.inverted(self.surface(), t))).collect()
     }
 }
+
+/// Nanoseconds the mesher has spent measuring deviation (every triangle's
+/// samples projected on its surface) in this process, with the `timing`
+/// feature; `None` without it.
+pub fn measure_nanos() -> Option<u64> {
+    #[cfg(feature = "timing")]
+    return Some(super::measure::MEASURE_NANOS.load(core::sync::atomic::Ordering::Relaxed));
+    #[cfg(not(feature = "timing"))]
+    None
+}
