@@ -148,7 +148,7 @@ export function plateStep(nx, ny, { bodies = false } = {}) {
   ].join('\n');
 }
 
-if (import.meta.url === pathToFileURL(process.argv[1]).href) {
+if (process.argv[1] && import.meta.url === pathToFileURL(process.argv[1]).href) {
   const args = process.argv.slice(2);
   const [nx, ny] = args.filter((a) => a !== '--bodies').map(Number);
   if (!(nx >= 1 && ny >= 1 && Number.isInteger(nx) && Number.isInteger(ny))) {
