@@ -18,7 +18,7 @@
 // on one file (Node: above a bare Node's).
 //
 // npm run bench [-- --runs 5 --tols 1e-2,1e-3 --only NAME[,NAME...] --dir DIR --no-corpus --no-plates
-//                   --no-build --no-wasm --no-equal --out DIR --profile debug]
+//                   --no-build --no-wasm --no-equal --no-scaling --out DIR --profile debug]
 // Writes DIR/latest.json and DIR/latest.md (DIR: bench/results). Builds what it
 // needs first: the CLI and the two example runners (cargo, release unless
 // --profile debug), and the npm package when it is older than the sources.
@@ -30,6 +30,9 @@
 //     against OCCT's wasm.
 //   --no-equal: OCCT at surfmesh's deflection only (no rescaled runs): enough
 //     for the edge counts, which the report lists per file beside surfmesh's.
+//   --no-scaling: without the scaling section (bench/scaling.mjs: plates and
+//     parts of 10 to 4000 holes, wasm against OCCT), which runs last
+//     otherwise (not with --only or --no-wasm).
 
 import { spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, mkdtempSync, readdirSync, readFileSync, rmSync, statSync, writeFileSync } from 'node:fs';
@@ -37,6 +40,7 @@ import { cpus, loadavg, tmpdir } from 'node:os';
 import { dirname, extname, join, relative } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { plateStep } from './plate.mjs';
+import { scaling } from './scaling.mjs';
 
 const root = join(dirname(fileURLToPath(import.meta.url)), '..');
 const argv = process.argv.slice(2);
@@ -505,7 +509,12 @@ try {
       if (row.surfmesh_wasm?.run?.error) failed = `${row.surfmesh_wasm.run.error} (at ${rel}; not tried finer)`;
     }
   }
-  const md = markdown(rows, meta);
+  let md = markdown(rows, meta);
+  if (WASM && !ONLY && !argv.includes('--no-scaling')) {
+    const s = await scaling({ runs: Math.min(RUNS, 2), say });
+    md += `\n\n${s.markdown}`;
+    meta.scaling = s.rows;
+  }
   const dir = OUT_DIR;
   mkdirSync(dir, { recursive: true });
   writeFileSync(join(dir, 'latest.json'), `${JSON.stringify({ meta, rows, comparisons: rows.map((r) => PEERS.map((p) => compare(r, p)).filter(Boolean)) }, null, 1)}\n`);

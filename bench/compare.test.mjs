@@ -56,3 +56,17 @@ test('the benchmark meshes, measures and compares one small surface', { timeout:
     rmSync(out, { recursive: true, force: true });
   }
 });
+
+test('the scaling bench meshes a plate and a part of blocks, each within tolerance and sewn', { timeout: 300_000 }, async () => {
+  const { scaling } = await import('./scaling.mjs');
+  const { rows, markdown } = await scaling({ runs: 1, sizes: [10], occt: false });
+  assert.deepEqual(
+    rows.map((r) => [r.shape, r.holes, r.faces, r.bodies]),
+    [
+      ['plate', 10, 16, 1],
+      ['bodies', 10, 70, 10],
+    ],
+  );
+  for (const r of rows) assert.ok(r.ok && r.triangles > 0 && r.ms > 0, JSON.stringify(r));
+  assert.match(markdown, /\| plate \| 10 \| 16 \| 1 \| \d+ \|/);
+});

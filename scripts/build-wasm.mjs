@@ -4,8 +4,9 @@
 // full/) one cargo build of the cdylib for wasm32-unknown-unknown with that
 // build's Cargo features, then per target `wasm-bindgen` (the CLI version
 // pinned in Cargo.lock) and `wasm-opt` from the npm package `binaryen`
-// (Debian's binaryen writes modules that do not load). Ends with a size
-// report: every .wasm raw, gzip -9 and brotli, and per build the 20 largest
+// (Debian's binaryen writes modules that do not load); wasm features beyond
+// rustc's defaults (simd128) come from [build] target_features. Ends with a
+// size report: every .wasm raw, gzip -9 and brotli, and per build the 20 largest
 // functions and sections (`twiggy top`, on a copy optimized with its names
 // kept; scripts/setup.sh installs twiggy), also written to pkg/SIZES.md.
 // The plain-JS helpers in js/ (the three.js adapter and loader, and its
@@ -85,6 +86,7 @@ function readConfig() {
     profile: build.cargo_profile ?? 'release',
     optLevel: build.opt_level,
     stackSize: build.stack_size,
+    targetFeatures: build.target_features ?? [],
     outName: build.out_name ?? 'surfmesh',
     packageDir: join(root, build.package_dir ?? 'pkg'),
     opt: config.wasm_opt ?? { enabled: false },
@@ -181,10 +183,16 @@ function main() {
   const cargo = parseToml(readFileSync(join(root, 'Cargo.toml'), 'utf8')).package;
   const env = { ...process.env };
   const optLevelVar = `CARGO_PROFILE_${config.profile.toUpperCase().replace(/-/g, '_')}_OPT_LEVEL`;
+  const rustflags = [];
   if (config.stackSize !== undefined) {
     if (!Number.isInteger(config.stackSize) || config.stackSize % 65536 !== 0) fail('wasm-pack.toml stack_size: a whole number of 64 KiB pages');
-    env.CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUSTFLAGS = `-C link-arg=-zstack-size=${config.stackSize}`;
+    rustflags.push(`-C link-arg=-zstack-size=${config.stackSize}`);
   }
+  for (const f of config.targetFeatures) {
+    if (!/^[a-z0-9-]+$/.test(f)) fail(`wasm-pack.toml target_features: ${JSON.stringify(f)} is not a feature name`);
+    rustflags.push(`-C target-feature=+${f}`);
+  }
+  if (rustflags.length) env.CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUSTFLAGS = rustflags.join(' ');
   const meta = JSON.parse(capture('cargo', ['metadata', '--format-version', '1', '--no-deps']));
   const input = join(meta.target_directory, 'wasm32-unknown-unknown', config.profile, `${cargo.name.replace(/-/g, '_')}.wasm`);
 

@@ -28,9 +28,34 @@ pub(crate) fn measure_projection() -> ProjectionOptions {
     ProjectionOptions { max_iterations: 8, parameter_tolerance: 1e-9, search_samples: 8 }
 }
 
+/// Nanoseconds spent in [`measure_triangle`] since the process started: the
+/// scaling bench's share of the mesh time that measuring deviation takes.
+/// Only with the `timing` feature (native builds: it reads the clock).
+#[cfg(feature = "timing")]
+pub(crate) static MEASURE_NANOS: core::sync::atomic::AtomicU64 = core::sync::atomic::AtomicU64::new(0);
+
 /// Samples the barycentric grid with `steps` divisions per edge (corners skipped:
 /// they are surface points by construction) and measures their distance.
 pub(crate) fn measure_triangle(
+    surface: &dyn Surface,
+    p: &[DVec3; 3],
+    uv: &[DVec2; 3],
+    steps: usize,
+    opts: &ProjectionOptions,
+) -> TriMeasure {
+    #[cfg(feature = "timing")]
+    let started = std::time::Instant::now();
+    let m = sample_triangle(surface, p, uv, steps, opts);
+    #[cfg(feature = "timing")]
+    MEASURE_NANOS.fetch_add(
+        u64::try_from(started.elapsed().as_nanos()).unwrap_or(u64::MAX),
+        core::sync::atomic::Ordering::Relaxed,
+    );
+    m
+}
+
+/// [`measure_triangle`]'s work.
+fn sample_triangle(
     surface: &dyn Surface,
     p: &[DVec3; 3],
     uv: &[DVec2; 3],

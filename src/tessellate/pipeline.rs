@@ -570,3 +570,13 @@ fn grow<T>(v: &mut Vec<T>, extra: usize) {
         v.reserve_exact(v.len() / 8 + extra);
     }
 }
+
+/// Nanoseconds the mesher has spent measuring deviation (every triangle's
+/// samples projected on its surface) in this process, with the `timing`
+/// feature; `None` without it.
+pub fn measure_nanos() -> Option<u64> {
+    #[cfg(feature = "timing")]
+    return Some(super::measure::MEASURE_NANOS.load(core::sync::atomic::Ordering::Relaxed));
+    #[cfg(not(feature = "timing"))]
+    None
+}

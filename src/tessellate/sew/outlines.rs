@@ -254,7 +254,18 @@ fn insertions(
                     if !parallel {
                         continue;
                     }
-                    let (s, d) = nearest_fraction(&|s: f64| on_curve(s).distance(q), s0);
+                    // A node on an end of the segment, to a billionth of
+                    // its length, is that end: the search below (about 40
+                    // curve and surface evaluations) would only tell it
+                    // from the end by rounding, a fraction under its 1e-9.
+                    // Most nodes are such ends: the other face's copy of
+                    // this border's node.
+                    let at_end = q.distance(pa).min(q.distance(pb)) <= 1e-9 * ab.length();
+                    let (s, d) = if at_end {
+                        (0.0, f64::INFINITY)
+                    } else {
+                        nearest_fraction(&|s: f64| on_curve(s).distance(q), s0)
+                    };
                     if d <= limit && s > 1e-9 && s < 1.0 - 1e-9 {
                         note(na, s, d, qn);
                         cands.push((na, s, ta + (tb - ta) * s, d, qn));
