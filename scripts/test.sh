@@ -6,6 +6,10 @@
 # the first failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# No step reads input. cargo lets the rustc it runs to probe a target read
+# the caller's stdin; text waiting there became the probe's source and a
+# failure cargo then cached in target/.rustc_info.json.
+exec </dev/null
 export PATH="$HOME/.cargo/bin:$PATH"
 
 scripts/setup.sh
