@@ -4,7 +4,7 @@
 use alloc::vec::Vec;
 use glam::DVec2;
 
-use super::Model;
+use super::{Face, Model};
 use crate::nurbs::{Aabb, Surface};
 
 /// Box of the trimmed geometry, from a 17×17 sample of each face's surface over
@@ -18,7 +18,36 @@ pub(crate) fn trimmed_bbox(model: &Model) -> Aabb {
     }
     for f in &model.faces {
         let s: &dyn Surface = &f.surface;
-        let [mut lo, mut hi] = s.domain();
+        let region = LoopSample::of(f);
+        for &q in region.polys.iter().flatten() {
+            b.add_point(s.point(q));
+        }
+        let (lo, hi) = (region.lo, region.hi);
+        let steps: Vec<f64> = (0..=16).map(|i| i as f64 / 16.0).collect();
+        let us: Vec<f64> = steps.iter().map(|t| lo.x + (hi.x - lo.x) * t).collect();
+        let vs: Vec<f64> = steps.iter().map(|t| lo.y + (hi.y - lo.y) * t).collect();
+        let points = f.surface.points_on_grid(&us, &vs);
+        for (k, p) in points.into_iter().enumerate() {
+            if region.inside(DVec2::new(us[k / vs.len()], vs[k % vs.len()])) {
+                b.add_point(p);
+            }
+        }
+    }
+    b
+}
+
+/// A face's trim loops sampled in (u,v), 16 points per curve, and the part
+/// of its surface's domain their box covers (the whole domain when the face
+/// has no loops): what estimates of a face's extent or area sample over.
+pub(crate) struct LoopSample {
+    pub lo: DVec2,
+    pub hi: DVec2,
+    pub polys: Vec<Vec<DVec2>>,
+}
+
+impl LoopSample {
+    pub(crate) fn of(f: &Face) -> Self {
+        let [mut lo, mut hi] = f.surface.domain();
         let mut polys: Vec<Vec<DVec2>> = Vec::new();
         if !f.loops.is_empty() {
             let (mut llo, mut lhi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
@@ -30,7 +59,6 @@ pub(crate) fn trimmed_bbox(model: &Model) -> Aabb {
                         let q = c.point(a + (z - a) * k as f64 / 16.0).truncate();
                         llo = llo.min(q);
                         lhi = lhi.max(q);
-                        b.add_point(s.point(q));
                         poly.push(q);
                     }
                 }
@@ -39,31 +67,22 @@ pub(crate) fn trimmed_bbox(model: &Model) -> Aabb {
             lo = llo.max(lo);
             hi = lhi.min(hi);
         }
-        let inside = |q: DVec2| {
-            if polys.is_empty() {
-                return true;
-            }
-            let mut c = false;
-            for p in &polys {
-                let n = p.len();
-                for i in 0..n {
-                    let (a, z) = (p[i], p[(i + 1) % n]);
-                    if (a.y > q.y) != (z.y > q.y) && a.x + (q.y - a.y) / (z.y - a.y) * (z.x - a.x) > q.x {
-                        c = !c;
-                    }
+        LoopSample { lo, hi, polys }
+    }
+
+    /// Whether `q` lies inside the sampled loops (even-odd rule); always
+    /// for a face without loops.
+    pub(crate) fn inside(&self, q: DVec2) -> bool {
+        let mut c = self.polys.is_empty();
+        for p in &self.polys {
+            let n = p.len();
+            for i in 0..n {
+                let (a, z) = (p[i], p[(i + 1) % n]);
+                if (a.y > q.y) != (z.y > q.y) && a.x + (q.y - a.y) / (z.y - a.y) * (z.x - a.x) > q.x {
+                    c = !c;
                 }
             }
-            c
-        };
-        let steps: Vec<f64> = (0..=16).map(|i| i as f64 / 16.0).collect();
-        let us: Vec<f64> = steps.iter().map(|t| lo.x + (hi.x - lo.x) * t).collect();
-        let vs: Vec<f64> = steps.iter().map(|t| lo.y + (hi.y - lo.y) * t).collect();
-        let points = f.surface.points_on_grid(&us, &vs);
-        for (k, p) in points.into_iter().enumerate() {
-            if inside(DVec2::new(us[k / vs.len()], vs[k % vs.len()])) {
-                b.add_point(p);
-            }
         }
+        c
     }
-    b
 }

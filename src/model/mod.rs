@@ -13,7 +13,7 @@ mod extent;
 pub use assembly::{Assembly, AssemblyNode, PartInstance};
 pub(crate) use bodies::body_count;
 pub use bodies::share_of_faces;
-pub(crate) use extent::trimmed_bbox;
+pub(crate) use extent::{trimmed_bbox, LoopSample};
 
 /// Everything read from one input file.
 #[derive(Debug, Clone, Default)]

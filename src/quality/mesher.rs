@@ -13,6 +13,7 @@ use super::looping;
 use super::mapping::PlaneMap;
 use crate::mesh::{angle_stats, edge_counts_around_skipped, weld_positions, FaceRange};
 use crate::model::Face;
+use crate::model::LoopSample;
 use crate::nurbs::Surface;
 use crate::nurbs::{project_to_surface, ProjectionOptions};
 use crate::options::{ElementSize, MeshOptions, QualityMethod, Tolerance};
@@ -382,46 +383,15 @@ fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
 /// 24 × 24 grid of its loops' parameter box that lie inside the loops.
 fn estimate_area(f: &Face) -> f64 {
     let s: &dyn Surface = &f.surface;
-    let [mut lo, mut hi] = s.domain();
-    let mut polys: Vec<Vec<DVec2>> = Vec::new();
-    if !f.loops.is_empty() {
-        let (mut llo, mut lhi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-        for lp in &f.loops {
-            let mut poly = Vec::new();
-            for c in &lp.curves {
-                let (a, z) = c.domain();
-                for k in 0..16 {
-                    let q = c.point(a + (z - a) * k as f64 / 16.0).truncate();
-                    llo = llo.min(q);
-                    lhi = lhi.max(q);
-                    poly.push(q);
-                }
-            }
-            polys.push(poly);
-        }
-        lo = llo.max(lo);
-        hi = lhi.min(hi);
-    }
-    let inside = |q: DVec2| {
-        let mut c = polys.is_empty();
-        for p in &polys {
-            let n = p.len();
-            for i in 0..n {
-                let (a, z) = (p[i], p[(i + 1) % n]);
-                if (a.y > q.y) != (z.y > q.y) && a.x + (q.y - a.y) / (z.y - a.y) * (z.x - a.x) > q.x {
-                    c = !c;
-                }
-            }
-        }
-        c
-    };
+    let region = LoopSample::of(f);
+    let (lo, hi) = (region.lo, region.hi);
     const N: usize = 24;
     let cell = (hi - lo) / N as f64;
     let mut area = 0.0;
     for i in 0..N {
         for j in 0..N {
             let q = lo + cell * DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
-            if inside(q) {
+            if region.inside(q) {
                 let d = s.derivs(q);
                 let a = d.su.cross(d.sv).length() * cell.x * cell.y;
                 if a.is_finite() {
