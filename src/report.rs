@@ -7,7 +7,7 @@ use alloc::string::String;
 use alloc::vec::Vec;
 use serde::Serialize;
 
-use crate::mesh::Mesh;
+use crate::mesh::{angle_stats, EdgeCounts, Mesh};
 use crate::reparam::ReparamFace;
 
 /// A mesh and what was measured on it.
@@ -79,6 +79,18 @@ pub struct Report {
     /// Quality mode only: element size and how near the mesh comes to it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub quality: Option<QualityReport>,
+}
+
+impl Report {
+    /// Takes the edge census and the triangles' angles of the finished mesh.
+    pub(crate) fn take_edges_and_angles(&mut self, edges: &EdgeCounts, mesh: &Mesh) {
+        self.free_edges = edges.free_edges;
+        self.boundary_edges = edges.boundary_edges;
+        self.nonmanifold_edges = edges.nonmanifold_edges;
+        let angles = angle_stats(mesh);
+        self.min_angle_deg = angles.min_deg;
+        self.p1_angle_deg = angles.p1_deg;
+    }
 }
 
 /// Triangles whose smallest angle reaches this count as good, degrees.

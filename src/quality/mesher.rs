@@ -11,7 +11,7 @@ use super::delaunay;
 use super::improve::{self, min_angle, FaceMesh};
 use super::looping;
 use super::mapping::PlaneMap;
-use crate::mesh::{angle_stats, edge_counts_around_skipped, weld_positions, FaceRange};
+use crate::mesh::{edge_counts_around_skipped, weld_positions, FaceRange};
 use crate::model::Face;
 use crate::model::LoopSample;
 use crate::nurbs::Surface;
@@ -152,12 +152,7 @@ pub(crate) fn mesh_quality(
     report.vertices = mesh.positions.len();
     let edges = edge_counts_around_skipped(&mesh, &[], &model.skipped, (sew * 0.5).min(tol * 1e-3), tol.max(sew));
     crate::mesh::holes_warning(&model.skipped, edges.hole_edges, &mut report.warnings);
-    report.free_edges = edges.free_edges;
-    report.boundary_edges = edges.boundary_edges;
-    report.nonmanifold_edges = edges.nonmanifold_edges;
-    let angles = angle_stats(&mesh);
-    report.min_angle_deg = angles.min_deg;
-    report.p1_angle_deg = angles.p1_deg;
+    report.take_edges_and_angles(&edges, &mesh);
     fill_quality(&mesh, &mut qr, sew * 0.5);
     report.quality = Some(qr);
     Ok(MeshResult { mesh, report })

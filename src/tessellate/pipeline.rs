@@ -17,7 +17,7 @@ use super::sew::{self, FaceWork, Places};
 use super::variant::Chosen;
 use super::{collapse, empty_work, own_bodies, reparameterize, setup, tessellated, unify_outlines, Setup};
 use super::{face, params, refine};
-use crate::mesh::{angle_stats, edge_census, holes_warning, FaceRange};
+use crate::mesh::{edge_census, holes_warning, FaceRange};
 use crate::model::{body_count, share_of_faces};
 use crate::options::MeshOptions;
 use crate::reparam::Rebuilt;
@@ -497,12 +497,7 @@ impl<'m> Plan<'m> {
                 g.faces.0, g.faces.1, g.width
             ));
         }
-        report.free_edges = edges.free_edges;
-        report.boundary_edges = edges.boundary_edges;
-        report.nonmanifold_edges = edges.nonmanifold_edges;
-        let angles = angle_stats(&mesh);
-        report.min_angle_deg = angles.min_deg;
-        report.p1_angle_deg = angles.p1_deg;
+        report.take_edges_and_angles(&edges, &mesh);
         tessellated::finish_report(self.model, &self.mine, &mesh, dropped, &mut report);
         MeshResult { mesh, report }
     }
