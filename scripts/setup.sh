@@ -12,6 +12,21 @@ export PATH="$HOME/.cargo/bin:$PATH"
 
 say() { printf '== setup: %s\n' "$*"; }
 
+# cargo probes each target by running rustc with its input on /dev/null. A
+# /dev/null that some program renamed a plain file over holds whatever was
+# last written to it, the probe fails, and cargo caches that failure in
+# target/.rustc_info.json. Put the device back (as root) or stop and say so.
+if [ ! -c /dev/null ]; then
+  if [ "$(id -u)" = 0 ]; then
+    say "/dev/null is not the null device: recreating it"
+    rm -f /dev/null && mknod -m 666 /dev/null c 1 3
+    rm -f target/.rustc_info.json
+  else
+    echo "== setup: /dev/null is a plain file, not the null device; cargo's target probes will fail" >&2
+    exit 1
+  fi
+fi
+
 installed_targets=$(rustup target list --installed)
 for target in wasm32-unknown-unknown wasm32v1-none; do
   if ! grep -qx "$target" <<<"$installed_targets"; then

@@ -167,12 +167,26 @@ fn millis(start: Instant) -> f64 {
 
 /// Writes every file to a temporary name in its own directory, then renames
 /// them into place, so that a failure leaves no half-written output behind.
+/// A symbolic link is written through to its target. An output that exists
+/// and is not a regular file (`/dev/null`, a pipe, a terminal) is written to
+/// directly after the regular files are in place: renaming over it would
+/// replace the device with a plain file.
 fn write_all_or_nothing(files: &[(&Path, Vec<u8>)]) -> Result<(), String> {
-    let mut temps: Vec<PathBuf> = Vec::new();
+    // (temporary file, file it replaces, path as the user gave it)
+    let mut staged: Vec<(PathBuf, PathBuf, &Path)> = Vec::new();
+    let mut streams: Vec<(&Path, &[u8])> = Vec::new();
     let result = (|| {
         for (path, bytes) in files {
-            let temp = temp_path(path);
-            temps.push(temp.clone());
+            match fs::metadata(path) {
+                Ok(meta) if !meta.is_file() && !meta.is_dir() => {
+                    streams.push((path, bytes));
+                    continue;
+                }
+                _ => {}
+            }
+            let target = real_target(path);
+            let temp = temp_path(&target);
+            staged.push((temp.clone(), target, path));
             let mut file = fs::OpenOptions::new()
                 .write(true)
                 .create_new(true)
@@ -182,17 +196,34 @@ fn write_all_or_nothing(files: &[(&Path, Vec<u8>)]) -> Result<(), String> {
                 .and_then(|()| file.sync_all())
                 .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         }
-        for ((path, _), temp) in files.iter().zip(&temps) {
-            fs::rename(temp, path).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        for (temp, target, path) in &staged {
+            fs::rename(temp, target).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         }
         Ok(())
     })();
     if result.is_err() {
-        for temp in &temps {
+        for (temp, _, _) in &staged {
             let _ = fs::remove_file(temp);
         }
+        return result;
     }
-    result
+    for (path, bytes) in streams {
+        fs::OpenOptions::new()
+            .write(true)
+            .open(path)
+            .and_then(|mut out| out.write_all(bytes))
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// The file a path names: a symbolic link's target (so that writing keeps the
+/// link), or the path itself when it is no link or does not exist yet.
+fn real_target(path: &Path) -> PathBuf {
+    match fs::symlink_metadata(path) {
+        Ok(meta) if meta.file_type().is_symlink() => fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
+        _ => path.to_path_buf(),
+    }
 }
 
 /// `dir/.name.PID.tmp` next to `path`, so the final rename stays on one file system.

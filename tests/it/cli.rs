@@ -891,6 +891,46 @@ fn cli_writes_nothing_when_one_output_fails() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// An output that is a pipe (as `/dev/null` and `/dev/stdout` are devices)
+/// is written into, never renamed over: a rename would swap the device for a
+/// plain file, and a later reader of `/dev/null` would read text. A symbolic
+/// link stays a link and its target gets the mesh.
+#[cfg(unix)]
+#[test]
+fn cli_writes_into_pipes_and_through_links() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = scratch("special-outputs");
+    let fifo = dir.join("pipe.stl");
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read(fifo).unwrap())
+    };
+    let target = dir.join("target.obj");
+    std::fs::write(&target, b"old").unwrap();
+    let link = dir.join("link.obj");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+
+    let out = run(&["mesh".as_ref(), data("plane.json").as_os_str(), "-o".as_ref(), fifo.as_os_str()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
+    let bytes = reader.join().unwrap();
+    // Binary STL: an 80-byte header, a triangle count, 50 bytes per triangle.
+    assert!(bytes.len() > 84, "the pipe got {} bytes", bytes.len());
+    let count = u32::from_le_bytes(bytes[80..84].try_into().unwrap()) as usize;
+    assert!(count > 0 && bytes.len() == 84 + 50 * count, "the pipe got {} bytes", bytes.len());
+
+    let out = run(&["mesh".as_ref(), data("plane.json").as_os_str(), "-o".as_ref(), link.as_os_str()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    let obj = std::fs::read_to_string(&target).unwrap();
+    assert!(obj.lines().any(|l| l.starts_with("f ")), "the link's target holds no faces");
+    // Nothing but the three names: no temporary file left behind.
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 3);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 /// Whether `p` lies inside the closed polygon and farther than `margin` from its edges.
 fn strictly_inside(polygon: &[glam::DVec2], p: glam::DVec2, margin: f64) -> bool {
     let mut inside = false;
