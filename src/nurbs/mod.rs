@@ -19,6 +19,7 @@ pub use bbox::Aabb;
 pub use curve::{CurveDerivs, NurbsCurve};
 pub use error::NurbsError;
 pub use knots::{BasisDers, KnotVector};
+pub(crate) use project::project_until;
 pub use project::{project_to_surface, CurveProjection, Projection, ProjectionOptions};
 pub use surface::NurbsSurface;
 

@@ -74,6 +74,21 @@ pub fn project_to_surface(
     hint: Option<DVec2>,
     options: &ProjectionOptions,
 ) -> Projection {
+    project_until(surface, target, hint, options, f64::NEG_INFINITY)
+}
+
+/// As [`project_to_surface`], but it stops as soon as the point found is
+/// within `enough` of `target`: each step only brings the point closer, so a
+/// caller that needs only the largest distance over many points (above
+/// `enough`, the largest so far) loses nothing, and a point already as close
+/// as that takes one evaluation instead of a full Newton run.
+pub(crate) fn project_until(
+    surface: &dyn Surface,
+    target: DVec3,
+    hint: Option<DVec2>,
+    options: &ProjectionOptions,
+    enough: f64,
+) -> Projection {
     let [lo, hi] = surface.domain();
     let mut seams = Seams::default();
     let breaks = [surface.breaks(true), surface.breaks(false)];
@@ -83,9 +98,12 @@ pub fn project_to_surface(
     };
     let mut best: Option<Projection> = None;
     for &uv in &starts.uv[..starts.len] {
-        let pr = newton(surface, target, uv, options, &mut seams, &breaks);
+        let pr = newton(surface, target, uv, options, &mut seams, &breaks, enough);
         if best.is_none_or(|b| pr.distance < b.distance) {
             best = Some(pr);
+        }
+        if pr.distance <= enough {
+            break;
         }
     }
     let best = best.unwrap_or_else(|| {
@@ -93,12 +111,18 @@ pub fn project_to_surface(
         Projection { uv: lo, point, distance: point.distance(target) }
     });
     let mut best = best;
+    if best.distance <= enough {
+        return best;
+    }
     let retries =
         off_collapsed_edge(surface, target, best.uv).into_iter().chain(across_creases(surface, best.uv, &breaks));
     for uv in retries {
-        let pr = newton(surface, target, uv, options, &mut seams, &breaks);
+        let pr = newton(surface, target, uv, options, &mut seams, &breaks, enough);
         if pr.distance < best.distance {
             best = pr;
+        }
+        if best.distance <= enough {
+            break;
         }
     }
     best
@@ -204,6 +228,7 @@ fn newton(
     options: &ProjectionOptions,
     seams: &mut Seams,
     breaks: &[Vec<f64>; 2],
+    enough: f64,
 ) -> Projection {
     let [lo, hi] = surface.domain();
     let size = (hi - lo).max(DVec2::splat(1e-300));
@@ -212,6 +237,9 @@ fn newton(
     let mut point = d.point;
     let mut dist = point.distance(target);
     for it in 0..options.max_iterations {
+        if dist <= enough {
+            break;
+        }
         if it > 0 {
             d = surface.derivs(uv);
         }
@@ -475,4 +503,39 @@ fn coarse_search(surface: &dyn Surface, target: DVec3, n: usize) -> Starts {
 /// Grid parameter `(i, j)` of `n` steps; clamped, as `lo + (hi − lo)·1` may round past `hi`.
 fn param(lo: DVec2, hi: DVec2, n: usize, i: usize, j: usize) -> DVec2 {
     (lo + (hi - lo) * DVec2::new(i as f64 / n as f64, j as f64 / n as f64)).clamp(lo, hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nurbs::NurbsSurface;
+    use alloc::vec;
+
+    /// A bicubic hill over the unit square.
+    fn hill() -> NurbsSurface {
+        let pts: Vec<Vec<DVec3>> = (0..4)
+            .map(|i| (0..4).map(|j| DVec3::new(i as f64 / 3.0, j as f64 / 3.0, ((i * j) % 3) as f64 * 0.2)).collect())
+            .collect();
+        let k = vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        NurbsSurface::try_new([3, 3], k.clone(), k, &pts, None).unwrap()
+    }
+
+    /// Below `enough` nothing changes: the same point as a full projection.
+    /// Above it the search stops at the first point within `enough` (here
+    /// the start itself), still an upper bound of the true distance.
+    #[test]
+    fn projection_stops_once_within_enough() {
+        let s = hill();
+        let target = s.point(DVec2::new(0.7, 0.6)) + DVec3::new(0.0, 0.0, 0.05);
+        let start = DVec2::new(0.1, 0.1);
+        let opts = ProjectionOptions::default();
+        let full = project_to_surface(&s, target, Some(start), &opts);
+        assert!(full.distance < 0.06, "{full:?}");
+        let below = project_until(&s, target, Some(start), &opts, 0.5 * full.distance);
+        assert_eq!(below, full);
+        let from_start = s.point(start).distance(target);
+        let early = project_until(&s, target, Some(start), &opts, from_start);
+        assert_eq!(early.uv, start);
+        assert!(early.distance >= full.distance && early.distance <= from_start);
+    }
 }

@@ -11,7 +11,7 @@ use glam::{DVec2, DVec3};
 use super::interp::{self, chord_params, interpolate_surface};
 use super::{FIT_LIMIT, FIT_SHARE, MAX_SAMPLES};
 use crate::model::FaceSurface;
-use crate::nurbs::{project_to_surface, NurbsSurface, ProjectionOptions, Surface, SurfaceDerivs};
+use crate::nurbs::{project_to_surface, project_until, NurbsSurface, ProjectionOptions, Surface, SurfaceDerivs};
 
 /// Piecewise-linear monotone map between the original parameters of the
 /// grid nodes and the new ones (`s_i ↔ u_i`), both ascending.
@@ -413,14 +413,15 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Resu
     // original, so the smaller distance still bounds the true one (Newton
     // can stall where the original's parameter speed jumps). A point whose
     // start is no farther than the worst found so far cannot raise it, so
-    // the far starts go first and the rest are not projected.
+    // the far starts go first and the rest are not projected. For the same
+    // reason a projection stops once it is no farther than the worst.
     crate::sort::by_f64_desc(&mut checks, |c| c.0);
     let mut worst = [0.0f64; 3];
     for &(near, key) in &checks {
         let dir = key as usize % 3;
         let Some(st) = fit.check_point(key as usize).filter(|_| near > worst[dir]) else { continue };
         let (p, start) = point_and_start(st);
-        worst[dir] = worst[dir].max(project_to_surface(surface, p, Some(start), &opts).distance.min(near));
+        worst[dir] = worst[dir].max(project_until(surface, p, Some(start), &opts, worst[dir]).distance.min(near));
     }
     let (mut errors, centre) = ([worst[0], worst[1]], worst[2]);
     // A cell centre off the original is charged to the direction whose edges are worse.
