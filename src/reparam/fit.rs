@@ -246,48 +246,68 @@ const SPEED_FLOOR: f64 = 1e-3;
 const UNFOLD_STEPS: usize = 4;
 const UNFOLD_SAMPLES: usize = 4096;
 
+/// Along one direction of a fit, the new parameters its check visits (node
+/// `i` at `2i`, the mid-point after it at `2i + 1`) and the original's
+/// parameters each maps to: a line of checked points shares one parameter,
+/// so the map is read once per line instead of once per point.
+struct CheckLine {
+    new: Vec<f64>,
+    old: Vec<f64>,
+}
+
+impl CheckLine {
+    /// The check's parameters along `map`, mapped back along `arc` (the
+    /// arc-length table the samples were spaced by) when there is one.
+    fn new(map: &Map1, arc: Option<&ArcTable>) -> Self {
+        let mut new = Vec::with_capacity(2 * map.new.len());
+        for (i, &s) in map.new.iter().enumerate() {
+            new.push(s);
+            if let Some(&b) = map.new.get(i + 1) {
+                new.push(0.5 * (s + b));
+            }
+        }
+        let old = new
+            .iter()
+            .map(|&x| match arc {
+                Some(a) => map.to_old_along(a, x),
+                None => map.to_old(x),
+            })
+            .collect();
+        Self { new, old }
+    }
+}
+
 /// The rebuilt surface with its parameter maps and the largest distance
 /// found from it to the original, split by direction (`[along u, along v]`).
 pub(super) struct Fit {
     pub(super) surface: crate::nurbs::NurbsSurface,
     pub(super) map_u: Map1,
     pub(super) map_v: Map1,
-    /// The arc-length tables the samples were spaced by, per direction.
-    arc_u: Option<ArcTable>,
-    arc_v: Option<ArcTable>,
+    /// The checked parameters per direction, with the original's.
+    line_u: CheckLine,
+    line_v: CheckLine,
     pub(super) errors: [f64; 2],
 }
 
 impl Fit {
-    /// Checked point `key` in new parameters, by key `3 × node + direction`
-    /// (0: u-edge mid-points, 1: v-edge ones, 2: cell centres).
-    fn check_point(&self, key: usize) -> Option<DVec2> {
+    /// Checked point `key` by key `3 × node + direction` (0: u-edge
+    /// mid-points, 1: v-edge ones, 2: cell centres): its new parameters,
+    /// and the original's it maps to (where a projection onto the original starts).
+    fn check_point(&self, key: usize) -> Option<(DVec2, DVec2)> {
         let (nu, nv) = (self.map_u.new.len(), self.map_v.new.len());
         let (node, dir) = (key / 3, key % 3);
         if node >= nu * nv {
             return None;
         }
         let (i, j) = (node / nv, node % nv);
-        let (si, tj) = (*self.map_u.new.get(i)?, *self.map_v.new.get(j)?);
-        let s_mid = self.map_u.new.get(i + 1).map(|&b| 0.5 * (si + b));
-        let t_mid = self.map_v.new.get(j + 1).map(|&b| 0.5 * (tj + b));
-        let (s, t) = [(s_mid, Some(tj)), (Some(si), t_mid), (s_mid, t_mid)][dir];
-        Some(DVec2::new(s?, t?))
+        let (a, b) = [(2 * i + 1, 2 * j), (2 * i, 2 * j + 1), (2 * i + 1, 2 * j + 1)][dir];
+        let (u, v) = (&self.line_u, &self.line_v);
+        Some((DVec2::new(*u.new.get(a)?, *v.new.get(b)?), DVec2::new(*u.old.get(a)?, *v.old.get(b)?)))
     }
 
     /// The number of keys [`Fit::check_point`] takes.
     fn check_keys(&self) -> usize {
         3 * self.map_u.new.len() * self.map_v.new.len()
-    }
-
-    /// The original's parameters mapped from new ones `st` (where a
-    /// projection onto the original starts).
-    fn old_uv(&self, st: DVec2) -> DVec2 {
-        let old_of = |map: &Map1, arc: &Option<ArcTable>, x: f64| match arc {
-            Some(a) => map.to_old_along(a, x),
-            None => map.to_old(x),
-        };
-        DVec2::new(old_of(&self.map_u, &self.arc_u, st.x), old_of(&self.map_v, &self.arc_v, st.y))
     }
 
     /// Per direction (`[along u, along v]`), whether the new surface's
@@ -300,8 +320,7 @@ impl Fit {
         let mut out = [false; 2];
         for k in (0..self.check_keys()).filter(|k| k % 3 < 2) {
             let dir = k % 3;
-            let Some(st) = self.check_point(k).filter(|_| !out[dir]) else { continue };
-            let start = self.old_uv(st);
+            let Some((st, start)) = self.check_point(k).filter(|_| !out[dir]) else { continue };
             let n = self.surface.normal(st);
             if crate::math::angle_between(n, old.normal(start)) <= FOLD {
                 continue;
@@ -389,24 +408,16 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Resu
     if let Some(fixed) = unreverse_corners(&new, surface, &us, &vs) {
         new = fixed;
     }
-    let mut fit = Fit {
-        surface: new,
-        map_u: Map1 { old: us, new: s },
-        map_v: Map1 { old: vs, new: t },
-        arc_u,
-        arc_v,
-        errors: [0.0; 2],
-    };
+    let (map_u, map_v) = (Map1 { old: us, new: s }, Map1 { old: vs, new: t });
+    let (line_u, line_v) = (CheckLine::new(&map_u, arc_u.as_ref()), CheckLine::new(&map_v, arc_v.as_ref()));
+    let mut fit = Fit { surface: new, map_u, map_v, line_u, line_v, errors: [0.0; 2] };
     let opts = projection();
-    // The new surface's point there, and where its projection starts on the original.
-    let point_and_start = |st: DVec2| (fit.surface.point(st), fit.old_uv(st));
     // Each point with its distance to the original's point at the start
     // (kept small: a 400 × 400 rebuild checks half a million points).
     let mut checks: Vec<(f64, u32)> = Vec::with_capacity(fit.check_keys());
     for key in 0..fit.check_keys() {
-        if let Some(st) = fit.check_point(key) {
-            let (p, start) = point_and_start(st);
-            checks.push((p.distance(surface.point(start)), key as u32));
+        if let Some((st, start)) = fit.check_point(key) {
+            checks.push((fit.surface.point(st).distance(surface.point(start)), key as u32));
         }
     }
     // Both the projection and the start point are actual points of the
@@ -419,8 +430,8 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Resu
     let mut worst = [0.0f64; 3];
     for &(near, key) in &checks {
         let dir = key as usize % 3;
-        let Some(st) = fit.check_point(key as usize).filter(|_| near > worst[dir]) else { continue };
-        let (p, start) = point_and_start(st);
+        let Some((st, start)) = fit.check_point(key as usize).filter(|_| near > worst[dir]) else { continue };
+        let p = fit.surface.point(st);
         worst[dir] = worst[dir].max(project_until(surface, p, Some(start), &opts, worst[dir]).distance.min(near));
     }
     let (mut errors, centre) = ([worst[0], worst[1]], worst[2]);
