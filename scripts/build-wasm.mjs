@@ -5,7 +5,8 @@
 // build's Cargo features, then per target `wasm-bindgen` (the CLI version
 // pinned in Cargo.lock) and `wasm-opt` from the npm package `binaryen`
 // (Debian's binaryen writes modules that do not load); wasm features beyond
-// rustc's defaults (simd128) come from [build] target_features. Ends with a
+// rustc's defaults (simd128) come from [build] target_features, other rustc
+// codegen options (`-C NAME`) from [build] codegen. Ends with a
 // size report: every .wasm raw, gzip -9 and brotli, and per build the 20 largest
 // functions and sections (`twiggy top`, on a copy optimized with its names
 // kept; scripts/setup.sh installs twiggy), also written to pkg/SIZES.md.
@@ -87,6 +88,7 @@ function readConfig() {
     optLevel: build.opt_level,
     stackSize: build.stack_size,
     targetFeatures: build.target_features ?? [],
+    codegen: build.codegen ?? [],
     outName: build.out_name ?? 'surfmesh',
     packageDir: join(root, build.package_dir ?? 'pkg'),
     opt: config.wasm_opt ?? { enabled: false },
@@ -191,6 +193,10 @@ function main() {
   for (const f of config.targetFeatures) {
     if (!/^[a-z0-9-]+$/.test(f)) fail(`wasm-pack.toml target_features: ${JSON.stringify(f)} is not a feature name`);
     rustflags.push(`-C target-feature=+${f}`);
+  }
+  for (const c of config.codegen) {
+    if (typeof c !== 'string' || !/^[a-z0-9-]+(=[A-Za-z0-9_.-]+)?$/.test(c)) fail(`wasm-pack.toml codegen: ${JSON.stringify(c)} is not a rustc -C option`);
+    rustflags.push(`-C ${c}`);
   }
   if (rustflags.length) env.CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUSTFLAGS = rustflags.join(' ');
   const meta = JSON.parse(capture('cargo', ['metadata', '--format-version', '1', '--no-deps']));

@@ -1,10 +1,10 @@
 //! The JavaScript door (wasm-bindgen): JS values in, core types through
 //! [`crate::mesh_instanced`], typed arrays out. No algorithm lives here.
 //!
-//! Options arrive as `#[derive(Deserialize)]` structs through
-//! serde-wasm-bindgen (every key must be known, every value of its type);
-//! reports leave as JS objects serialized straight from the core's structs,
-//! the typed arrays beside them passed through as they are.
+//! Options are read key by key from the JS object (every key must be
+//! known, every value of its type); reports leave as JS objects serialized
+//! straight from the core's structs, the typed arrays beside them passed
+//! through as they are.
 //!
 //! Errors are thrown as JS `Error` objects whose message is the
 //! [`crate::Error`] `Display` text, the same line the command line prints.
@@ -18,8 +18,7 @@ use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 
 use js_sys::{Array, Float32Array, Function, Uint32Array};
-use serde::de::{self, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
 use crate::{edge_lines, flatten, mesh_instanced, mm_per_unit, read_model, read_step_parts, Assembly, EdgeLines};
@@ -448,9 +447,10 @@ export function fit(bytes: Uint8Array, format: string, options?: FitOptions): Fi
 "#;
 
 // ---------------------------------------------------------------------------
-// Option values: each type's Deserialize says what it expected and what it
-// found, in the words of the one-line errors; `options()` puts the option's
-// name in front.
+// Option values: read key by key from the options object, each getter saying
+// what it expected and what it found, in the words of the one-line errors,
+// after the option's name. (Hand-written rather than serde: the derive and
+// its path tracking were 20 KB of the viewer module, 8 KB gzipped.)
 
 /// A finite number.
 #[derive(Debug, Clone, Copy)]
@@ -471,193 +471,85 @@ enum Loose {
     Other,
 }
 
-/// `Err(found X)` for every kind of value but the ones a visitor accepts.
-macro_rules! wrong_kinds {
-    ($expected:expr) => {
-        fn visit_bool<E: de::Error>(self, _: bool) -> Result<Self::Value, E> {
-            Err(E::custom(format!("expected {}, found boolean", $expected)))
-        }
-        fn visit_str<E: de::Error>(self, _: &str) -> Result<Self::Value, E> {
-            Err(E::custom(format!("expected {}, found string", $expected)))
-        }
-        fn visit_unit<E: de::Error>(self) -> Result<Self::Value, E> {
-            Err(E::custom(format!("expected {}, found null", $expected)))
-        }
-        fn visit_seq<A: SeqAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
-            Err(de::Error::custom(format!("expected {}, found an array", $expected)))
-        }
-        fn visit_map<A: MapAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
-            Err(de::Error::custom(format!("expected {}, found object", $expected)))
-        }
-        fn visit_bytes<E: de::Error>(self, _: &[u8]) -> Result<Self::Value, E> {
-            Err(E::custom(format!("expected {}, found object", $expected)))
-        }
-    };
-}
-
-/// Numbers as f64, anything else an error.
-macro_rules! numbers {
-    ($map:expr) => {
-        fn visit_f64<E: de::Error>(self, x: f64) -> Result<Self::Value, E> {
-            $map(x)
-        }
-        fn visit_i64<E: de::Error>(self, x: i64) -> Result<Self::Value, E> {
-            $map(x as f64)
-        }
-        fn visit_u64<E: de::Error>(self, x: u64) -> Result<Self::Value, E> {
-            $map(x as f64)
-        }
-    };
-}
-
-impl<'de> Deserialize<'de> for Number {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct V;
-        impl<'de> Visitor<'de> for V {
-            type Value = Number;
-            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-                f.write_str("a number")
-            }
-            numbers!(|x: f64| if x.is_finite() {
-                Ok(Number(x))
-            } else {
-                Err(E::custom(format!("expected a finite number, found {x}")))
-            });
-            wrong_kinds!("a number");
-        }
-        d.deserialize_any(V)
-    }
-}
-
-impl<'de> Deserialize<'de> for Text {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct V;
-        impl<'de> Visitor<'de> for V {
-            type Value = Text;
-            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-                f.write_str("a string")
-            }
-            fn visit_str<E: de::Error>(self, s: &str) -> Result<Self::Value, E> {
-                Ok(Text(s.into()))
-            }
-            fn visit_string<E: de::Error>(self, s: String) -> Result<Self::Value, E> {
-                Ok(Text(s))
-            }
-            numbers!(|_: f64| Err(E::custom("expected a string, found number")));
-            fn visit_bool<E: de::Error>(self, _: bool) -> Result<Self::Value, E> {
-                Err(E::custom("expected a string, found boolean"))
-            }
-            fn visit_seq<A: SeqAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
-                Err(de::Error::custom("expected a string, found an array"))
-            }
-            fn visit_map<A: MapAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
-                Err(de::Error::custom("expected a string, found object"))
-            }
-        }
-        d.deserialize_any(V)
-    }
-}
-
-impl<'de> Deserialize<'de> for Flag {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct V;
-        impl<'de> Visitor<'de> for V {
-            type Value = Flag;
-            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-                f.write_str("a boolean")
-            }
-            fn visit_bool<E: de::Error>(self, b: bool) -> Result<Self::Value, E> {
-                Ok(Flag(b))
-            }
-            numbers!(|_: f64| Err(E::custom("expected a boolean, found number")));
-            fn visit_str<E: de::Error>(self, _: &str) -> Result<Self::Value, E> {
-                Err(E::custom("expected a boolean, found string"))
-            }
-            fn visit_seq<A: SeqAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
-                Err(de::Error::custom("expected a boolean, found an array"))
-            }
-            fn visit_map<A: MapAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
-                Err(de::Error::custom("expected a boolean, found object"))
-            }
-        }
-        d.deserialize_any(V)
-    }
-}
-
-/// What `share` holds: an array of any values, checked once read.
+/// What `share` holds: the first few values of an array, checked once read.
 #[derive(Debug, Clone)]
 struct List(Vec<Loose>);
 
 /// The message of a `share` that is not `[index, count]`.
 const SHARE_EXPECTED: &str = "expected [index, count] with whole numbers, index < count";
 
-impl<'de> Deserialize<'de> for List {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct V;
-        impl<'de> Visitor<'de> for V {
-            type Value = List;
-            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-                f.write_str("an array")
-            }
-            fn visit_seq<A: SeqAccess<'de>>(self, mut s: A) -> Result<Self::Value, A::Error> {
-                let mut items = Vec::new();
-                // Only the first few matter; the rest are counted, not kept.
-                while let Some(x) = s.next_element::<Loose>()? {
-                    if items.len() < 3 {
-                        items.push(x);
-                    }
-                }
-                Ok(List(items))
-            }
-            numbers!(|_: f64| Err(E::custom(SHARE_EXPECTED)));
-            fn visit_bool<E: de::Error>(self, _: bool) -> Result<Self::Value, E> {
-                Err(E::custom(SHARE_EXPECTED))
-            }
-            fn visit_str<E: de::Error>(self, _: &str) -> Result<Self::Value, E> {
-                Err(E::custom(SHARE_EXPECTED))
-            }
-            fn visit_map<A: MapAccess<'de>>(self, _: A) -> Result<Self::Value, A::Error> {
-                Err(de::Error::custom(SHARE_EXPECTED))
-            }
-        }
-        d.deserialize_any(V)
+/// The kind of a JS value, as the errors name it.
+fn kind(v: &JsValue) -> &'static str {
+    if v.as_bool().is_some() {
+        "boolean"
+    } else if v.as_f64().is_some() || v.is_bigint() {
+        "number"
+    } else if v.is_string() {
+        "string"
+    } else if Array::is_array(v) {
+        "an array"
+    } else if v.is_function() {
+        "function"
+    } else if v.is_symbol() {
+        "symbol"
+    } else {
+        "object"
     }
 }
 
-impl<'de> Deserialize<'de> for Loose {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct V;
-        impl<'de> Visitor<'de> for V {
-            type Value = Loose;
-            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-                f.write_str("any value")
-            }
-            numbers!(|x: f64| Ok(Loose::Number(x)));
-            fn visit_bool<E: de::Error>(self, _: bool) -> Result<Self::Value, E> {
-                Ok(Loose::Other)
-            }
-            fn visit_str<E: de::Error>(self, _: &str) -> Result<Self::Value, E> {
-                Ok(Loose::Other)
-            }
-            fn visit_unit<E: de::Error>(self) -> Result<Self::Value, E> {
-                Ok(Loose::Other)
-            }
-            fn visit_seq<A: SeqAccess<'de>>(self, mut s: A) -> Result<Self::Value, A::Error> {
-                while s.next_element::<IgnoredAny>()?.is_some() {}
-                Ok(Loose::Other)
-            }
-            fn visit_map<A: MapAccess<'de>>(self, mut m: A) -> Result<Self::Value, A::Error> {
-                while m.next_entry::<IgnoredAny, IgnoredAny>()?.is_some() {}
-                Ok(Loose::Other)
-            }
+/// A JS number as f64; a BigInt too (one beyond the i64 range is infinite).
+fn number_of(v: &JsValue) -> Option<f64> {
+    v.as_f64().or_else(|| v.is_bigint().then(|| i64::try_from(v.clone()).map_or(f64::INFINITY, |x| x as f64)))
+}
+
+/// The options object after `options()` checked it: each getter reads one
+/// key, `None` when it is absent, undefined or null.
+struct Fields(Option<js_sys::Object>);
+
+impl Fields {
+    fn get(&self, name: &str) -> Option<JsValue> {
+        let v = js_sys::Reflect::get(self.0.as_ref()?, &JsValue::from_str(name)).ok()?;
+        (!v.is_undefined() && !v.is_null()).then_some(v)
+    }
+
+    fn number(&self, name: &str) -> Result<Option<Number>, String> {
+        let Some(v) = self.get(name) else { return Ok(None) };
+        match number_of(&v) {
+            Some(x) if x.is_finite() => Ok(Some(Number(x))),
+            Some(x) => Err(format!("option {name}: expected a finite number, found {x}")),
+            None => Err(format!("option {name}: expected a number, found {}", kind(&v))),
         }
-        d.deserialize_any(V)
+    }
+
+    fn text(&self, name: &str) -> Result<Option<Text>, String> {
+        let Some(v) = self.get(name) else { return Ok(None) };
+        match v.as_string() {
+            Some(t) => Ok(Some(Text(t))),
+            None => Err(format!("option {name}: expected a string, found {}", kind(&v))),
+        }
+    }
+
+    fn flag(&self, name: &str) -> Result<Option<Flag>, String> {
+        let Some(v) = self.get(name) else { return Ok(None) };
+        match v.as_bool() {
+            Some(b) => Ok(Some(Flag(b))),
+            None => Err(format!("option {name}: expected a boolean, found {}", kind(&v))),
+        }
+    }
+
+    /// An array's first three values (enough to tell `[index, count]` from longer ones).
+    fn list(&self, name: &str) -> Result<Option<List>, String> {
+        let Some(v) = self.get(name) else { return Ok(None) };
+        if !Array::is_array(&v) {
+            return Err(format!("option {name}: {SHARE_EXPECTED}"));
+        }
+        let items = Array::from(&v).into_iter().take(3);
+        Ok(Some(List(items.map(|x| number_of(&x).map_or(Loose::Other, Loose::Number)).collect())))
     }
 }
 
 /// The options of `mesh` as JS gives them.
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields, rename_all = "camelCase")]
+#[derive(Debug, Default)]
 struct JsMeshOptions {
     tolerance: Option<Number>,
     tolerance_rel: Option<Number>,
@@ -674,6 +566,29 @@ struct JsMeshOptions {
     units: Option<Text>,
     flatten: Option<Flag>,
     console_warnings: Option<Flag>,
+}
+
+impl JsMeshOptions {
+    /// Reads every option in this order: the first bad one is the error.
+    fn read(f: &Fields) -> Result<Self, String> {
+        Ok(Self {
+            tolerance: f.number("tolerance")?,
+            tolerance_rel: f.number("toleranceRel")?,
+            angle: f.number("angle")?,
+            max_edge: f.number("maxEdge")?,
+            min_edge: f.number("minEdge")?,
+            max_triangles: f.number("maxTriangles")?,
+            reparam: f.text("reparam")?,
+            mode: f.text("mode")?,
+            size: f.number("size")?,
+            size_rel: f.number("sizeRel")?,
+            method: f.text("method")?,
+            share: f.list("share")?,
+            units: f.text("units")?,
+            flatten: f.flag("flatten")?,
+            console_warnings: f.flag("consoleWarnings")?,
+        })
+    }
 }
 
 /// Option names `mesh` accepts: every key of an options object must be one.
@@ -695,36 +610,26 @@ const OPTION_NAMES: &[&str] = &[
     "consoleWarnings",
 ];
 
-/// Reads an options object into `T`: undefined and null are the defaults
-/// (as is an option that is undefined or null); anything but an object, a
-/// key not in `known` or a value of the wrong kind is a one-line error
-/// naming the option.
-fn options<T: for<'de> Deserialize<'de> + Default>(value: JsValue, example: &str, known: &[&str]) -> Result<T, String> {
+/// Checks an options object: undefined and null are the defaults (as is an
+/// option that is undefined or null); anything but an object, or a key not
+/// in `known`, is a one-line error. The values are read by [`Fields`].
+fn options(value: JsValue, example: &str, known: &[&str]) -> Result<Fields, String> {
     if value.is_undefined() || value.is_null() {
-        return Ok(T::default());
+        return Ok(Fields(None));
     }
     if !value.is_object() || Array::is_array(&value) || value.is_function() {
         let found =
             if Array::is_array(&value) { "an array".into() } else { value.js_typeof().as_string().unwrap_or_default() };
         return Err(format!("options: expected an object like {{ {example} }}, found {found}"));
     }
-    // serde-wasm-bindgen reads a struct's own fields by name and never sees
-    // other keys, so `deny_unknown_fields` alone would let a typo pass.
-    for key in js_sys::Object::keys(value.unchecked_ref::<js_sys::Object>()).iter() {
+    let object: js_sys::Object = value.unchecked_into();
+    for key in js_sys::Object::keys(&object).iter() {
         let key = key.as_string().unwrap_or_default();
         if !known.contains(&key.as_str()) {
             return Err(format!("option {key}: unknown option (known: {})", known.join(", ")));
         }
     }
-    let d = serde_wasm_bindgen::Deserializer::from(value);
-    serde_path_to_error::deserialize(d).map_err(|e| {
-        // serde-wasm-bindgen's error is a JS Error, printed "Error: message".
-        let message = e.inner().to_string();
-        let message = message.strip_prefix("Error: ").unwrap_or(&message);
-        let path = e.path().to_string();
-        let name = path.split(['[', '.']).next().filter(|n| !n.is_empty() && *n != "?").unwrap_or("options");
-        format!("option {name}: {message}")
-    })
+    Ok(Fields(Some(object)))
 }
 
 /// One of `allowed`, by index; the message lists them as `expected`.
@@ -751,7 +656,7 @@ struct Output {
 
 /// The meshing options, the unit of the result and the output's shape.
 fn mesh_options(value: JsValue) -> Result<(MeshOptions, Output), String> {
-    let js: JsMeshOptions = options(value, "toleranceRel: 0.001", OPTION_NAMES)?;
+    let js = JsMeshOptions::read(&options(value, "toleranceRel: 0.001", OPTION_NAMES)?)?;
     let mut o = MeshOptions::default();
     match (js.tolerance, js.tolerance_rel) {
         (Some(_), Some(_)) => return Err("option tolerance: give tolerance or toleranceRel, not both".into()),
@@ -1196,14 +1101,27 @@ fn flat_to_js(result: &InstancedResult, read: &Read, faces: usize) -> Result<JsV
 
 /// The options of `repair` as JS gives them.
 #[cfg(feature = "repair")]
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields, rename_all = "camelCase")]
+#[derive(Debug, Default)]
 struct JsRepairOptions {
     bucketing: Option<Text>,
     bucket_capacity: Option<Number>,
     weld_tolerance: Option<Number>,
     perturbation: Option<Number>,
     verify: Option<Flag>,
+}
+
+#[cfg(feature = "repair")]
+impl JsRepairOptions {
+    /// Reads every option in this order: the first bad one is the error.
+    fn read(f: &Fields) -> Result<Self, String> {
+        Ok(Self {
+            bucketing: f.text("bucketing")?,
+            bucket_capacity: f.number("bucketCapacity")?,
+            weld_tolerance: f.number("weldTolerance")?,
+            perturbation: f.number("perturbation")?,
+            verify: f.flag("verify")?,
+        })
+    }
 }
 
 #[cfg(feature = "repair")]
@@ -1223,7 +1141,7 @@ pub fn repair(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, J
 
 #[cfg(feature = "repair")]
 fn repair_options(value: JsValue) -> Result<RepairOptions, String> {
-    let js: JsRepairOptions = options(value, "bucketing: \"kd\"", REPAIR_OPTION_NAMES)?;
+    let js = JsRepairOptions::read(&options(value, "bucketing: \"kd\"", REPAIR_OPTION_NAMES)?)?;
     let mut o = RepairOptions::default();
     if let Some(b) = word(&js.bucketing, "bucketing", &["kd", "bvh"], "\"kd\" or \"bvh\"")? {
         o = o.with_bucketing([Bucketing::KdTree, Bucketing::Bvh][b]);
@@ -1312,12 +1230,23 @@ fn run_repair(bytes: &[u8], format: &str, options: &RepairOptions) -> Result<JsV
 
 /// The options of `fit` as JS gives them.
 #[cfg(feature = "fit")]
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields, rename_all = "camelCase")]
+#[derive(Debug, Default)]
 struct JsFitOptions {
     tolerance: Option<Number>,
     tolerance_rel: Option<Number>,
     max_sides: Option<Number>,
+}
+
+#[cfg(feature = "fit")]
+impl JsFitOptions {
+    /// Reads every option in this order: the first bad one is the error.
+    fn read(f: &Fields) -> Result<Self, String> {
+        Ok(Self {
+            tolerance: f.number("tolerance")?,
+            tolerance_rel: f.number("toleranceRel")?,
+            max_sides: f.number("maxSides")?,
+        })
+    }
 }
 
 #[cfg(feature = "fit")]
@@ -1350,7 +1279,7 @@ pub fn fit(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsEr
 
 #[cfg(feature = "fit")]
 fn fit_options(value: JsValue) -> Result<FitOptions, String> {
-    let js: JsFitOptions = options(value, "toleranceRel: 0.001", FIT_OPTION_NAMES)?;
+    let js = JsFitOptions::read(&options(value, "toleranceRel: 0.001", FIT_OPTION_NAMES)?)?;
     let mut o = FitOptions::default();
     match (js.tolerance, js.tolerance_rel) {
         (Some(_), Some(_)) => return Err("option tolerance: give tolerance or toleranceRel, not both".into()),

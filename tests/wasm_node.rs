@@ -753,6 +753,8 @@ fn each_bad_mesh_option_throws_one_line_naming_it() {
         (options(&[("share", num(2.0))]), "option share: expected [index, count]"),
         (options(&[("share", array(&[num(0.0), "2".into()]))]), "option share: expected [index, count]"),
         (options(&[("share", array(&[num(1.0)]))]), "option share: expected [index, count]"),
+        (options(&[("share", array(&[num(0.0), num(1.0), num(2.0)]))]), "option share: expected [index, count]"),
+        (options(&[("share", "0/2".into())]), "option share: expected [index, count]"),
         (options(&[("units", num(25.4))]), "option units: expected a string, found number"),
         (options(&[("units", "yd".into())]), "option units: expected"),
         (options(&[("flatten", "yes".into())]), "option flatten: expected a boolean, found string"),
@@ -770,6 +772,12 @@ fn each_bad_mesh_option_throws_one_line_naming_it() {
     // Undefined and null are the defaults, for the whole object and for one option.
     assert!(binding::mesh(dome(), "json", JsValue::NULL).is_ok());
     assert!(binding::mesh(dome(), "json", options(&[("angle", JsValue::NULL)])).is_ok());
+    // A BigInt is a number too.
+    let big = js_sys::BigInt::from(100_000_u64);
+    assert!(binding::mesh(dome(), "json", options(&[("maxTriangles", big.into())])).is_ok());
+    // Of two bad options the error names the one first in OPTION_NAMES, whatever the object's key order.
+    let m = thrown(binding::mesh(dome(), "json", options(&[("units", num(1.0)), ("angle", "x".into())])));
+    assert!(m.starts_with("option angle: expected a number, found string"), "{m:?}");
 }
 
 /// The options of `repair` and `fit` are read the same way.
