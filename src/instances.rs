@@ -21,6 +21,7 @@ use crate::model::{body_of, SkippedFace};
 use crate::options::{ElementSize, MeshOptions, Tolerance};
 use crate::report::{MeshResult, QualityReport, Report};
 use crate::units::{mesh_model_in_units, mm_per_unit, Units};
+use crate::warning::WarningKind;
 use crate::{Assembly, Error, FaceRange, Mesh, Model};
 
 /// One shape's mesh, in the coordinates of its instances' node.
@@ -319,9 +320,18 @@ fn renumber_text(text: &str, faces: &[usize]) -> Option<String> {
 }
 
 fn renumber_report(report: &mut Report, faces: &[usize]) {
+    let renumber = |j: &mut usize| {
+        if let Some(&f) = faces.get(*j) {
+            *j = f;
+        }
+    };
     for w in &mut report.warnings {
-        if let Some(t) = renumber_text(w, faces) {
-            *w = t;
+        if let Some(j) = &mut w.face {
+            renumber(j);
+        }
+        if let WarningKind::FacesApart { faces: (a, b), .. } = &mut w.kind {
+            renumber(a);
+            renumber(b);
         }
     }
     for r in &mut report.reparameterized {

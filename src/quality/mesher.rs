@@ -18,6 +18,7 @@ use crate::nurbs::Surface;
 use crate::nurbs::{project_to_surface, ProjectionOptions};
 use crate::options::{ElementSize, MeshOptions, QualityMethod, Tolerance};
 use crate::report::{MeshResult, QualityReport, Report, EDGE_BAND, GOOD_ANGLE_DEG};
+use crate::warning::{Warning, WarningKind};
 use crate::{Error, Mesh, Model};
 
 /// Quality of one face's mesh: (good-angle fraction, edge-band fraction).
@@ -106,7 +107,7 @@ pub(crate) fn mesh_quality(
         match result {
             Ok((fm, looping, dropped)) => {
                 if dropped > 0 {
-                    report.warnings.push(format!("face {index}: {dropped} loops enclosing no area left unfilled"));
+                    report.warnings.push(Warning::face(index, WarningKind::QualityLoopsUnfilled { loops: dropped }));
                 }
                 if looping {
                     qr.faces_looping += 1;
@@ -139,7 +140,7 @@ pub(crate) fn mesh_quality(
             }
             Err(why) => {
                 report.faces_skipped += 1;
-                report.warnings.push(format!("face {index}: not meshed in quality mode: {why}"));
+                report.warnings.push(Warning::face(index, WarningKind::QualityNotMeshed(why)));
             }
         }
         mesh.face_ranges.push(FaceRange { first, count: mesh.triangle_count() as u32 - first });

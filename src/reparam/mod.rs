@@ -19,6 +19,7 @@ use serde::Serialize;
 use crate::model::{Face, FaceSurface, Model, TrimLoop};
 use crate::nurbs::{project_to_surface, NurbsCurve, ProjectionOptions, Surface};
 use crate::options::{Reparam, Tolerance};
+use crate::warning::{Reparameterized, Warning, WarningKind};
 use crate::Error;
 
 pub(crate) use interp::{chord_params, interpolate_curve};
@@ -119,7 +120,7 @@ pub struct ReparamModel {
     /// Every face the ratio test flagged (every face when forced), rebuilt or not.
     pub faces: Vec<ReparamFace>,
     /// Why a flagged face was left as it was, one line per face.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::Warning>,
     /// The absolute tolerance the rebuilt faces hold against the originals'
     /// [`FIT_LIMIT`] share of it (model units).
     pub tolerance: f64,
@@ -161,8 +162,8 @@ pub fn reparameterize_model(model: &Model, mode: Reparam, tolerance: Tolerance) 
                 *face = r.face;
             }
             Err(why) => {
-                out.warnings
-                    .push(format!("face {index}: poorly parameterized (step ratio {ratio:.1}), kept as it is: {why}"));
+                let outcome = Reparameterized::KeptAsIs(why.into());
+                out.warnings.push(Warning::face(index, WarningKind::PoorlyParameterized { ratio, outcome }));
                 out.faces.push(ReparamFace { face: index, ratio, rebuilt: false, samples: [0, 0], fit_error: 0.0 });
             }
         }

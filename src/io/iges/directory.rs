@@ -3,11 +3,12 @@
 //! the file is checked against the data actually present before anything is
 //! allocated from it.
 
-use alloc::string::{String, ToString};
+use alloc::string::String;
 use alloc::vec::Vec;
 
 use super::lexer::{Record, Tokenizer, Value};
 use super::{iges_error, Notes, Section, MAX_ENTITIES, MAX_PARAMS};
+use crate::warning::{Warning, WarningKind};
 use crate::Error;
 
 /// One entity: its directory entry fields and parameters.
@@ -40,7 +41,7 @@ pub(super) struct Entity {
 pub(super) struct Directory {
     pub entities: Vec<Entity>,
     /// What was forgiven or skipped, one warning per kind.
-    pub notes: Vec<String>,
+    pub notes: Vec<Warning>,
 }
 
 impl Directory {
@@ -57,7 +58,7 @@ impl Directory {
             notes.note("odd", 0, || {
                 let m = "odd number of directory records: the last entry's second line is missing \
                          (file truncated?); that entry is skipped";
-                iges_error(Section::Directory, line, d.len(), m).to_string()
+                Warning::new(WarningKind::Forgiven(iges_error(Section::Directory, line, d.len(), m)))
             });
             &d[..d.len() - 1]
         } else if d.len() % 2 != 0 {
@@ -136,7 +137,7 @@ impl Directory {
             let (pline, params, damage) = match parameters(p, de, kind, pstart, pcount, param, record, &mut notes) {
                 Ok((pline, params)) => (pline, params, None),
                 Err(err) => {
-                    notes.note(damage_kind(&err), de, || alloc::format!("{err}; the entity is skipped"));
+                    notes.note(damage_kind(&err), de, || Warning::new(WarningKind::EntityDamaged(err.clone())));
                     (0, alloc::vec![Value::Int(kind)], Some(err))
                 }
             };
@@ -241,7 +242,7 @@ fn parameters(
                  read up to the entity's ';'",
                 p.len()
             );
-            iges_error(Section::Directory, 0, de, m).to_string()
+            Warning::new(WarningKind::Forgiven(iges_error(Section::Directory, 0, de, m)))
         });
     }
     // Every entity's parameters are held until the faces are built: no

@@ -7,6 +7,7 @@ use alloc::string::String;
 use alloc::vec::Vec;
 
 use super::{iges_error, Section};
+use crate::warning::{Warning, WarningKind};
 use crate::Error;
 
 /// One 80-column record.
@@ -31,7 +32,7 @@ pub(super) struct Sections<'a> {
     /// truncated there, and the record was dropped.
     pub truncated: Option<usize>,
     /// What was forgiven in the record layout, one warning each.
-    pub notes: Vec<String>,
+    pub notes: Vec<Warning>,
 }
 
 /// Splits `bytes` into records. Accepts LF or CRLF line ends, a missing
@@ -63,11 +64,7 @@ pub(super) fn split_sections(bytes: &[u8]) -> Result<Sections<'_>, Error> {
             continue;
         }
         if let Some(n) = unbroken(text) {
-            sp.out.notes.push(alloc::format!(
-                "line {}: {n} records of 80 columns with no line breaks between them; read as lines {line}..{}",
-                i + 1,
-                line + n - 1
-            ));
+            sp.out.notes.push(Warning::new(WarningKind::UnbrokenRecords { line: i + 1, records: n, first: line }));
             for (k, chunk) in text.chunks(80).enumerate() {
                 if !chunk.iter().all(|b| b.is_ascii_whitespace()) && !sp.record(line + k, chunk, false)? {
                     break;
@@ -81,16 +78,10 @@ pub(super) fn split_sections(bytes: &[u8]) -> Result<Sections<'_>, Error> {
         }
     }
     if let Some((line, n)) = sp.shifted {
-        sp.out.notes.push(alloc::format!(
-            "line {line}: a record pushed past column 80 by blanks before it; read without them{}",
-            if n > 1 { alloc::format!(" (and {} more like it)", n - 1) } else { String::new() }
-        ));
+        sp.out.notes.push(Warning { more: n - 1, ..Warning::new(WarningKind::ShiftedRecord { line }) });
     }
     if let Some((line, n)) = sp.lowercase {
-        sp.out.notes.push(alloc::format!(
-            "line {line}: the section letter in lower case; read as upper case{}",
-            if n > 1 { alloc::format!(" (and {} more like it)", n - 1) } else { String::new() }
-        ));
+        sp.out.notes.push(Warning { more: n - 1, ..Warning::new(WarningKind::LowerCaseSection { line }) });
     }
     Ok(sp.out)
 }

@@ -16,6 +16,7 @@ use crate::model::{Face, FaceSurface, TrimLoop};
 use crate::nurbs::analytic::line;
 use crate::nurbs::reparam::{map_points, reversed, segment, with_end_points};
 use crate::nurbs::{Aabb, NurbsCurve, Surface};
+use crate::warning::WarningKind;
 
 /// One boundary loop as the file gives it.
 #[derive(Debug, Clone, Default)]
@@ -45,7 +46,7 @@ pub(in crate::io) struct FaceSrc {
 /// # Errors
 /// A message for the caller's "skipped" warning: loops that cannot be put in
 /// the surface's parameters, an unbounded surface without loops, bad geometry.
-pub(in crate::io) fn build_face(src: FaceSrc, warn: &mut Vec<String>) -> Result<Face, String> {
+pub(in crate::io) fn build_face(src: FaceSrc, warn: &mut Vec<WarningKind>) -> Result<Face, String> {
     build_face_oriented(src, None, warn)
 }
 
@@ -62,7 +63,7 @@ pub(in crate::io) fn build_face(src: FaceSrc, warn: &mut Vec<String>) -> Result<
 pub(in crate::io) fn build_face_oriented(
     src: FaceSrc,
     left: Option<bool>,
-    warn: &mut Vec<String>,
+    warn: &mut Vec<WarningKind>,
 ) -> Result<Face, String> {
     let mut def = src.def.clone();
     let periods = def.periods();
@@ -93,7 +94,7 @@ pub(in crate::io) fn build_face_oriented(
         loops_2d.push(pieces);
     }
     if unmet > 0 {
-        warn.push(alloc::format!("{unmet} trim curves fitted to within the sample limit only"));
+        warn.push(WarningKind::TrimFitLimit { curves: unmet });
     }
     let [lo, hi] = surface.domain();
     let mut loops: Vec<TrimLoop> = Vec::new();
@@ -126,7 +127,7 @@ pub(in crate::io) fn build_face_oriented(
 fn read_loops(
     src: &FaceSrc,
     def: &SurfDef,
-    warn: &mut Vec<String>,
+    warn: &mut Vec<WarningKind>,
 ) -> Result<(Vec<Vec<NurbsCurve>>, Vec<Vec<Track>>), String> {
     let periods = def.periods();
     // Parameter curves on a B-spline surface in its own parameters need no fitting.
@@ -164,7 +165,7 @@ fn read_loops(
             }
         }
         if bad {
-            warn.push("parameter-space trim curves disagree with the model-space ones; projected instead".into());
+            warn.push(WarningKind::TrimSpacesDisagree);
             loops_2d.clear();
             tracks.clear();
             for lp in &src.loops {
@@ -577,7 +578,7 @@ fn close_loop(
     lo: DVec2,
     hi: DVec2,
     tol: f64,
-    warn: &mut Vec<String>,
+    warn: &mut Vec<WarningKind>,
 ) -> Result<Option<TrimLoop>, String> {
     // Pieces and gaps below a millionth of the domain are noise in the
     // file (a degenerate edge overshooting a corner): dropped and closed.
@@ -613,7 +614,7 @@ fn close_loop(
         }
     }
     if worst_gap > 0.0 {
-        warn.push(alloc::format!("trim loop with a gap of {worst_gap:.3e} between curves, closed by a line"));
+        warn.push(WarningKind::TrimGapClosed { gap: worst_gap });
     }
     let mut curves = Vec::with_capacity(2 * n);
     for (i, c) in pieces.iter().enumerate() {
@@ -626,7 +627,7 @@ fn close_loop(
     }
     let crossings = untangle(&mut curves);
     if crossings > 0 {
-        warn.push(alloc::format!("trim loop crossed itself {crossings} times (edges meeting tangentially); cut there"));
+        warn.push(WarningKind::TrimSelfCrossing { crossings });
     }
     Ok(Some(TrimLoop { curves }))
 }
