@@ -136,8 +136,8 @@ impl Directory {
             let form = field(b, 4)?;
             let (pline, params, damage) = match parameters(p, de, kind, pstart, pcount, param, record, &mut notes) {
                 Ok((pline, params)) => (pline, params, None),
-                Err(err) => {
-                    notes.note(damage_kind(&err), de, || Warning::new(WarningKind::EntityDamaged(err.clone())));
+                Err((damage, err)) => {
+                    notes.note(damage.key(), de, || Warning::new(WarningKind::EntityDamaged(err.clone())));
                     (0, alloc::vec![Value::Int(kind)], Some(err))
                 }
             };
@@ -165,13 +165,28 @@ impl Directory {
     }
 }
 
-/// The kind of a damaged entity's error, so each kind is one warning.
-fn damage_kind(err: &Error) -> &'static str {
-    match err {
-        Error::Iges { message, .. } if message.contains("pointer") => "pointer",
-        Error::Iges { message, .. } if message.contains("directory entry says type") => "type",
-        Error::Iges { message, .. } if message.contains("';'") => "unended",
-        _ => "syntax",
+/// What is wrong with an entity's parameter data, so each kind is one warning.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Damage {
+    /// The pointer to its data is outside the Parameter section.
+    Pointer,
+    /// Its data names another entity type than its directory entry.
+    Type,
+    /// Its data ends without the record delimiter.
+    Unended,
+    /// A field that cannot be read.
+    Syntax,
+}
+
+impl Damage {
+    /// The key its warnings are gathered under.
+    fn key(self) -> &'static str {
+        match self {
+            Self::Pointer => "pointer",
+            Self::Type => "type",
+            Self::Unended => "unended",
+            Self::Syntax => "syntax",
+        }
     }
 }
 
@@ -191,8 +206,8 @@ fn parameters(
     param: u8,
     record: u8,
     notes: &mut Notes,
-) -> Result<(usize, Vec<Value>), Error> {
-    let bad = |message: String| iges_error(Section::Directory, 0, de, message);
+) -> Result<(usize, Vec<Value>), (Damage, Error)> {
+    let bad = |message: String| (Damage::Pointer, iges_error(Section::Directory, 0, de, message));
     let first = usize::try_from(pstart).ok().filter(|&s| s >= 1 && s <= p.len()).ok_or_else(|| {
         bad(alloc::format!(
             "parameter data pointer {pstart} is outside the Parameter section's {} lines (file truncated?)",
@@ -213,8 +228,9 @@ fn parameters(
             text.extend_from_slice(content(r));
         }
         let mut tok = Tokenizer::new(&text, param, record);
-        let params = tok.fields(MAX_PARAMS).map_err(|m| iges_error(Section::Parameter, pline, de, m))?;
-        Ok::<_, Error>((params, tok.ended))
+        let params =
+            tok.fields(MAX_PARAMS).map_err(|m| (Damage::Syntax, iges_error(Section::Parameter, pline, de, m)))?;
+        Ok::<_, (Damage, Error)>((params, tok.ended))
     };
     let (mut params, mut ended) = read(last)?;
     if !ended {
@@ -226,12 +242,15 @@ fn parameters(
         }
     }
     if !ended {
-        return Err(iges_error(
-            Section::Parameter,
-            pline,
-            de,
-            alloc::format!(
-                "parameter data on lines {first}..{last} end without the record delimiter ';' (file truncated?)"
+        return Err((
+            Damage::Unended,
+            iges_error(
+                Section::Parameter,
+                pline,
+                de,
+                alloc::format!(
+                    "parameter data on lines {first}..{last} end without the record delimiter ';' (file truncated?)"
+                ),
             ),
         ));
     }
@@ -250,16 +269,19 @@ fn parameters(
     params.shrink_to_fit();
     match params.first() {
         Some(Value::Int(k)) if *k == kind => Ok((pline, params)),
-        other => Err(iges_error(
-            Section::Parameter,
-            pline,
-            de,
-            alloc::format!(
-                "parameter data start with {} but the directory entry says type {kind} (bad pointer?)",
-                match other {
-                    Some(Value::Int(k)) => alloc::format!("type {k}"),
-                    _ => "no entity type".into(),
-                }
+        other => Err((
+            Damage::Type,
+            iges_error(
+                Section::Parameter,
+                pline,
+                de,
+                alloc::format!(
+                    "parameter data start with {} but the directory entry says type {kind} (bad pointer?)",
+                    match other {
+                        Some(Value::Int(k)) => alloc::format!("type {k}"),
+                        _ => "no entity type".into(),
+                    }
+                ),
             ),
         )),
     }
