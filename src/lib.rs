@@ -73,7 +73,7 @@ pub use nurbs::{
     NurbsSurface, Projection, ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
 };
 pub use options::{
-    ElementSize, MeshMode, MeshOptions, OptionsError, QualityMethod, QualityOptions, Reparam, Tolerance,
+    ElementSize, MeshMode, MeshOptions, OptionsError, QualityMethod, QualityOptions, Reparam, Tolerance, UnknownWord,
 };
 #[cfg(feature = "repair")]
 pub use repair::{
