@@ -292,7 +292,7 @@ pub enum WarningKind {
         loops: usize,
     },
     /// A face quality mode could not mesh.
-    QualityNotMeshed(String),
+    QualityNotMeshed(QualityError),
     /// A face the step-ratio test flagged (paper 001), and what became of it.
     PoorlyParameterized {
         /// The step ratio.
@@ -606,6 +606,76 @@ impl fmt::Display for WarningKind {
                 "tessellated faces: {count} triangles that name a point twice, one past the points or one not \
                  finite left out"
             ),
+        }
+    }
+}
+
+/// Why quality mode (paper 003) could not mesh a face, or the model.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum QualityError {
+    /// The boundary curves alone need more nodes than the budget at this size.
+    BoundaryBudget {
+        /// The node budget.
+        budget: usize,
+        /// The element size.
+        size: f64,
+    },
+    /// A loop divided into fewer than three nodes.
+    FewLoopNodes {
+        /// The loop.
+        lp: usize,
+        /// Its nodes.
+        nodes: usize,
+    },
+    /// A loop that encloses no area.
+    LoopNoArea {
+        /// The face.
+        face: usize,
+        /// The loop.
+        lp: usize,
+    },
+    /// The looping method split past its limit.
+    TooManySplits,
+    /// The looping method reached its node limit.
+    NodeLimit {
+        /// The limit.
+        max: usize,
+    },
+    /// A loop with no splitting line inside it.
+    NoSplit {
+        /// Its nodes.
+        nodes: usize,
+    },
+    /// No cut line joins a hole to the outer loop.
+    NoCut,
+    /// The triangulation library refused the boundary (its report).
+    Triangulation(String),
+    /// Boundary loops that cross.
+    LoopsCross,
+    /// Boundary nodes at one point.
+    NodesCoincide,
+    /// Delaunay refinement in a build without `std`.
+    NeedsStd,
+}
+
+impl fmt::Display for QualityError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::BoundaryBudget { budget, size } => write!(
+                f,
+                "the boundary curves alone need more than {budget} nodes at size {size:.4e}; choose a larger size"
+            ),
+            Self::FewLoopNodes { lp, nodes } => write!(f, "loop {lp} has {nodes} boundary nodes; it encloses no area"),
+            Self::LoopNoArea { face, lp } => write!(f, "face {face}: loop {lp} encloses no area"),
+            Self::TooManySplits => write!(f, "the looping method did not finish (too many splits)"),
+            Self::NodeLimit { max } => write!(f, "the looping method reached the limit of {max} nodes"),
+            Self::NoSplit { nodes } => write!(f, "a loop of {nodes} nodes has no splitting line inside it"),
+            Self::NoCut => write!(f, "no cut line joins a hole to the outer loop"),
+            Self::Triangulation(e) => write!(f, "triangulation failed: {e}"),
+            Self::LoopsCross => write!(f, "boundary loops cross"),
+            Self::NodesCoincide => write!(f, "boundary nodes coincide"),
+            Self::NeedsStd => write!(f, "Delaunay refinement needs the `std` feature"),
         }
     }
 }
