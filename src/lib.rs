@@ -89,7 +89,9 @@ pub use report::{MeshResult, QualityReport, Report, EDGE_BAND, GOOD_ANGLE_DEG};
 #[doc(hidden)]
 pub use tessellate::pipeline;
 pub use units::{mesh_model_in_units, mm_per_unit, Units};
-pub use warning::{Entity, Mended, QualityError, RebuildLoss, Reparameterized, Warning, WarningKind};
+pub use warning::{
+    Entity, InterpError, Mended, QualityError, RebuildError, RebuildLoss, Reparameterized, Warning, WarningKind,
+};
 
 /// Reads `bytes` in `format` and meshes the model: the one call both doors use.
 ///

@@ -368,9 +368,9 @@ pub enum Reparameterized {
         fit_error: f64,
     },
     /// Not rebuilt; meshed as it is (why).
-    MeshedAsIs(Box<str>),
+    MeshedAsIs(RebuildError),
     /// Not rebuilt; kept as it is (why).
-    KeptAsIs(Box<str>),
+    KeptAsIs(RebuildError),
 }
 
 /// Why a rebuilt face lost to its original.
@@ -677,5 +677,92 @@ impl fmt::Display for QualityError {
             Self::NodesCoincide => write!(f, "boundary nodes coincide"),
             Self::NeedsStd => write!(f, "Delaunay refinement needs the `std` feature"),
         }
+    }
+}
+
+/// Why an interpolation could not be built.
+#[derive(Debug, Clone, PartialEq)]
+pub enum InterpError {
+    /// Fewer than two points.
+    TooFewPoints,
+    /// Parameters not strictly increasing (coincident points along every row).
+    Degenerate,
+    /// A zero pivot: the collocation matrix is singular.
+    Singular,
+}
+
+impl fmt::Display for InterpError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::TooFewPoints => "fewer than two interpolation points",
+            Self::Degenerate => "interpolation points coincide (no parameter spacing)",
+            Self::Singular => "the interpolation system is singular",
+        })
+    }
+}
+
+/// Why paper 001's rebuild of a face failed (the face is then meshed or kept as it is).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum RebuildError {
+    /// The interpolation could not be built.
+    Interp(InterpError),
+    /// The rebuilt surface has points that are not finite.
+    NotFinite,
+    /// The rebuilt surface stays too far from the original at the sample limit.
+    TooFar {
+        /// Its distance.
+        error: f64,
+        /// Samples along u.
+        n: usize,
+        /// Samples along v.
+        m: usize,
+        /// The limit.
+        limit: f64,
+    },
+    /// A trim curve's rebuild stays too far from the original curve.
+    CurveTooFar {
+        /// Its distance.
+        error: f64,
+        /// The goal.
+        goal: f64,
+    },
+    /// In trim loop `index`.
+    Loop {
+        /// The loop.
+        index: usize,
+        /// What failed.
+        why: Box<RebuildError>,
+    },
+    /// In trim curve `index` of a loop.
+    Curve {
+        /// The curve.
+        index: usize,
+        /// What failed.
+        why: Box<RebuildError>,
+    },
+}
+
+impl fmt::Display for RebuildError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Interp(e) => write!(f, "{e}"),
+            Self::NotFinite => write!(f, "the rebuilt surface is not finite"),
+            Self::TooFar { error, n, m, limit } => write!(
+                f,
+                "the rebuilt surface stays {error:.3e} from the original at {n} × {m} samples (limit {limit:.3e})"
+            ),
+            Self::CurveTooFar { error, goal } => {
+                write!(f, "stays {error:.3e} from the original trim curve (goal {goal:.3e})")
+            }
+            Self::Loop { index, why } => write!(f, "loop {index}: {why}"),
+            Self::Curve { index, why } => write!(f, "curve {index}: {why}"),
+        }
+    }
+}
+
+impl From<InterpError> for RebuildError {
+    fn from(e: InterpError) -> Self {
+        Self::Interp(e)
     }
 }

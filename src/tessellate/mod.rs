@@ -123,7 +123,7 @@ fn reparameterize(model: &Model, mine: &[bool], mode: Reparam, tol: f64, report:
                 out.push(Some(r));
             }
             Err(why) => {
-                let outcome = Reparameterized::MeshedAsIs(why.into());
+                let outcome = Reparameterized::MeshedAsIs(why);
                 report.warnings.push(Warning::face(index, WarningKind::PoorlyParameterized { ratio, outcome }));
                 report.reparameterized.push(ReparamFace {
                     face: index,
