@@ -4,12 +4,10 @@
 //! read once and shared by the faces that use it.
 
 use crate::collections::HashMap;
-use alloc::format;
-use alloc::string::String;
 use alloc::vec::Vec;
 use glam::DVec3;
 
-use super::curves::{move_ends, param_of, period, pieces_between, rev_all, Curve3, CurveDef, Geo};
+use super::curves::{move_ends, param_of, period, pieces_between, rev_all, Curve3, CurveDef, CurveError, Geo};
 use super::graph::Ent;
 use crate::nurbs::NurbsCurve;
 use crate::warning::WarningKind;
@@ -231,7 +229,7 @@ fn cut(
     same_sense: bool,
     closed: bool,
     uncertainty: f64,
-) -> Result<(Vec<NurbsCurve>, Option<WarningKind>), String> {
+) -> Result<(Vec<NurbsCurve>, Option<WarningKind>), CurveError> {
     let (ps, pe) = (verts.ps, verts.pe);
     let forward = same_sense != def.reversed;
     let (a, b) = if forward { (ps, pe) } else { (pe, ps) };
@@ -242,7 +240,7 @@ fn cut(
             if size == 0.0 {
                 return Ok((Vec::new(), None));
             }
-            alloc::vec![crate::nurbs::analytic::line(a, b, 0.0, 1.0).map_err(|x| format!("{x}"))?]
+            alloc::vec![crate::nurbs::analytic::line(a, b, 0.0, 1.0)?]
         }
         c => {
             let mut ta = param_of(c, a);

@@ -313,9 +313,8 @@ impl<'g> Ent<'g> {
     }
 
     /// An error about this instance.
-    pub fn error(&self, message: impl Into<String>) -> Error {
-        let m: String = message.into();
-        step_error(self.id(), self.line(), format!("{}: {m}", self.type_name()))
+    pub fn error(&self, message: impl core::fmt::Display) -> Error {
+        step_error(self.id(), self.line(), format!("{}: {message}", self.type_name()))
     }
 }
 

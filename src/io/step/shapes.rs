@@ -577,7 +577,7 @@ fn pcurve_2d(geo: &Geo<'_>, e: Ent<'_>) -> Result<super::curves::CurveDef, Error
 /// Joins consecutive curves of a loop whose ends are apart (a file whose
 /// loop skips from one vertex to another) by straight model-space pieces,
 /// which are then projected like the edges.
-fn bridge_gaps(model: &mut Vec<NurbsCurve>, lp: Ent<'_>, warnings: &mut Vec<Warning>) -> Result<(), String> {
+fn bridge_gaps(model: &mut Vec<NurbsCurve>, lp: Ent<'_>, warnings: &mut Vec<Warning>) -> Result<(), NurbsError> {
     let mut bb = crate::nurbs::Aabb::EMPTY;
     for c in model.iter() {
         bb.union(&c.bbox());
@@ -598,7 +598,7 @@ fn bridge_gaps(model: &mut Vec<NurbsCurve>, lp: Ent<'_>, warnings: &mut Vec<Warn
         let gap = e.distance(s);
         if gap > hair {
             worst = worst.max(gap);
-            out.push(line(e, s, 0.0, 1.0).map_err(|x| format!("{x}"))?);
+            out.push(line(e, s, 0.0, 1.0)?);
         }
     }
     if worst > 0.0 {
