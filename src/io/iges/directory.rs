@@ -317,8 +317,8 @@ fn back_pointer(r: &Record<'_>) -> Option<usize> {
 
 impl Entity {
     /// An error about this entity's parameter data.
-    pub fn error(&self, message: impl Into<String>) -> Error {
-        iges_error(Section::Parameter, self.pline, self.de, message.into())
+    pub fn error(&self, message: impl core::fmt::Display) -> Error {
+        iges_error(Section::Parameter, self.pline, self.de, message)
     }
 
     fn value(&self, i: usize) -> &Value {

@@ -75,8 +75,8 @@ impl Section {
 }
 
 /// An [`Error::Iges`].
-fn iges_error(section: Section, line: usize, entity: usize, message: impl Into<String>) -> Error {
-    Error::Iges { section: section.name(), line, entity, message: message.into() }
+fn iges_error(section: Section, line: usize, entity: usize, message: impl core::fmt::Display) -> Error {
+    Error::Iges { section: section.name(), line, entity, message: alloc::format!("{message}") }
 }
 
 /// What the reader forgave, one warning per kind: the first occurrence's
