@@ -355,6 +355,92 @@ pub enum WarningKind {
         /// How many.
         count: usize,
     },
+
+    // Mesh repair (paper 002).
+    /// Welding would make the mesh non-manifold (the error); not welded.
+    NotWelded {
+        /// The weld tolerance, relative to the diagonal.
+        tolerance: f64,
+        /// Why welding fails.
+        why: Error,
+    },
+    /// Degenerate triangles left in place.
+    DegenerateLeft {
+        /// How many.
+        count: usize,
+    },
+    /// An open input, whose boundary stays open.
+    OpenInput {
+        /// Its free edges.
+        free_edges: usize,
+    },
+    /// Components turned outward.
+    InsideOut {
+        /// How many.
+        count: usize,
+        /// Of how many components.
+        components: usize,
+    },
+    /// Vertices moved to resolve coincidences.
+    Perturbed {
+        /// By up to this share of the diagonal.
+        size: f64,
+    },
+    /// Triangle pairs touching in a way not handled.
+    UnhandledContacts {
+        /// How many pairs.
+        pairs: usize,
+    },
+    /// Components with no triangle on the outside, left out.
+    Unseeded {
+        /// How many.
+        components: usize,
+    },
+    /// Triangles kept or dropped whole (not split along their segments).
+    SplitFallbacks {
+        /// How many.
+        triangles: usize,
+    },
+    /// Nothing valid was found.
+    EmptyResult,
+    /// The result is not a clean 2-manifold.
+    NotManifold {
+        /// Edges of more than two triangles.
+        nonmanifold: usize,
+        /// Edges whose triangles disagree.
+        misoriented: usize,
+    },
+
+    // Surface fitting (paper 004).
+    /// Duplicate points merged.
+    DuplicatesMerged {
+        /// How many.
+        count: usize,
+        /// Closer than this.
+        distance: f64,
+    },
+    /// The points lie on one plane.
+    Planar,
+    /// Gaps of the triangle net left open.
+    NetGaps {
+        /// How many.
+        count: usize,
+    },
+    /// Points in no triangle of the net.
+    PointsUnused {
+        /// How many.
+        count: usize,
+    },
+    /// Polygons that could not be filled.
+    PolygonsUnfilled {
+        /// How many.
+        count: usize,
+    },
+    /// Patches at the split limit.
+    SplitLimit {
+        /// The limit.
+        level: usize,
+    },
 }
 
 /// What paper 001's rebuild of a flagged face came to.
@@ -606,6 +692,54 @@ impl fmt::Display for WarningKind {
                 "tessellated faces: {count} triangles that name a point twice, one past the points or one not \
                  finite left out"
             ),
+            Self::NotWelded { tolerance, why } => write!(
+                f,
+                "welding within {tolerance:e} of the diagonal would make the mesh non-manifold ({why}); vertices were not welded"
+            ),
+            Self::DegenerateLeft { count } => {
+                write!(f, "{count} degenerate triangles could not be removed without breaking the manifold")
+            }
+            Self::OpenInput { free_edges } => write!(
+                f,
+                "the input is open ({free_edges} free edges): its boundary stays open and growth stops there"
+            ),
+            Self::InsideOut { count, components } => write!(
+                f,
+                "{count} of {components} components enclosed a negative volume (inside out) and were turned outward"
+            ),
+            Self::Perturbed { size } => write!(
+                f,
+                "the arrangement had unresolved coincidences; vertices were moved by up to {size:e} of the diagonal"
+            ),
+            Self::UnhandledContacts { pairs } => write!(
+                f,
+                "{pairs} triangle pairs touch or overlap in a way not handled (coplanar, or a vertex exactly on another triangle); left as they are"
+            ),
+            Self::Unseeded { components } => write!(
+                f,
+                "{components} components had no triangle on the outside of the enclosed space and were left out"
+            ),
+            Self::SplitFallbacks { triangles } => write!(
+                f,
+                "{triangles} triangles could not be split along their segments (points closer than rounding separates) and were kept or dropped whole"
+            ),
+            Self::EmptyResult => write!(f, "nothing valid was found: the result is empty"),
+            Self::NotManifold { nonmanifold, misoriented } => write!(
+                f,
+                "the result is not a clean 2-manifold: {nonmanifold} edges of more than two triangles, {misoriented} edges whose triangles disagree"
+            ),
+            Self::DuplicatesMerged { count, distance } => {
+                write!(f, "{count} duplicate point(s) merged (closer than {distance:.3e})")
+            }
+            Self::Planar => write!(f, "the points lie on one plane: the fit is the flat region of that plane they span"),
+            Self::NetGaps { count } => write!(f, "{count} gap(s) of the triangle net left open"),
+            Self::PointsUnused { count } => {
+                write!(f, "{count} point(s) are in no triangle of the net and are not interpolated")
+            }
+            Self::PolygonsUnfilled { count } => write!(f, "{count} polygon(s) could not be filled and leave holes"),
+            Self::SplitLimit { level } => {
+                write!(f, "some patches hit the split limit of {level} and may exceed the tolerance")
+            }
         }
     }
 }
