@@ -85,7 +85,7 @@ fn main() {
                     rep.boundary_edges,
                     rep.nonmanifold_edges,
                     f.loops.len(),
-                    rep.warnings.join(" | ")
+                    rep.warnings.iter().map(ToString::to_string).collect::<Vec<_>>().join(" | ")
                 );
                 (rep.inverted_triangles, ms, row)
             }

@@ -11,8 +11,6 @@
 //! instance holds, so it describes the whole model as one merged mesh
 //! ([`flatten`]) would.
 
-use alloc::format;
-use alloc::string::String;
 use alloc::vec::Vec;
 use glam::DAffine3;
 
@@ -21,6 +19,7 @@ use crate::model::{body_of, SkippedFace};
 use crate::options::{ElementSize, MeshOptions, Tolerance};
 use crate::report::{MeshResult, QualityReport, Report};
 use crate::units::{mesh_model_in_units, mm_per_unit, Units};
+use crate::warning::WarningKind;
 use crate::{Assembly, Error, FaceRange, Mesh, Model};
 
 /// One shape's mesh, in the coordinates of its instances' node.
@@ -309,19 +308,19 @@ fn move_mesh(mesh: &mut Mesh, m: &DAffine3) {
     }
 }
 
-/// `"face J: ..."` of a part's model as `"face F: ..."` of the whole model.
-fn renumber_text(text: &str, faces: &[usize]) -> Option<String> {
-    let rest = text.strip_prefix("face ")?;
-    let digits = rest.bytes().take_while(u8::is_ascii_digit).count();
-    let j: usize = rest[..digits].parse().ok()?;
-    let f = faces.get(j)?;
-    Some(format!("face {f}{}", &rest[digits..]))
-}
-
 fn renumber_report(report: &mut Report, faces: &[usize]) {
+    let renumber = |j: &mut usize| {
+        if let Some(&f) = faces.get(*j) {
+            *j = f;
+        }
+    };
     for w in &mut report.warnings {
-        if let Some(t) = renumber_text(w, faces) {
-            *w = t;
+        if let Some(j) = &mut w.face {
+            renumber(j);
+        }
+        if let WarningKind::FacesApart { faces: (a, b), .. } = &mut w.kind {
+            renumber(a);
+            renumber(b);
         }
     }
     for r in &mut report.reparameterized {
@@ -331,13 +330,10 @@ fn renumber_report(report: &mut Report, faces: &[usize]) {
     }
 }
 
+/// A part's meshing error with the whole model's face number.
 fn renumber_error(e: Error, faces: &[usize]) -> Error {
     match e {
         Error::Mesh { face, message } => Error::Mesh { face: faces.get(face).copied().unwrap_or(face), message },
-        Error::Model { location, message } => {
-            let location = renumber_text(&location, faces).unwrap_or(location);
-            Error::Model { location, message }
-        }
         e => e,
     }
 }

@@ -37,6 +37,7 @@ mod tessellate;
 #[cfg(test)]
 mod testing;
 mod units;
+mod warning;
 #[cfg(all(target_arch = "wasm32", target_os = "unknown"))]
 mod wasm;
 
@@ -72,7 +73,7 @@ pub use nurbs::{
     NurbsSurface, Projection, ProjectionOptions, Surface, SurfaceDerivs, MAX_DEGREE,
 };
 pub use options::{
-    ElementSize, MeshMode, MeshOptions, OptionsError, QualityMethod, QualityOptions, Reparam, Tolerance,
+    ElementSize, MeshMode, MeshOptions, OptionsError, QualityMethod, QualityOptions, Reparam, Tolerance, UnknownWord,
 };
 #[cfg(feature = "repair")]
 pub use repair::{
@@ -88,6 +89,9 @@ pub use report::{MeshResult, QualityReport, Report, EDGE_BAND, GOOD_ANGLE_DEG};
 #[doc(hidden)]
 pub use tessellate::pipeline;
 pub use units::{mesh_model_in_units, mm_per_unit, Units};
+pub use warning::{
+    Entity, InterpError, Mended, QualityError, RebuildError, RebuildLoss, Reparameterized, Warning, WarningKind,
+};
 
 /// Reads `bytes` in `format` and meshes the model: the one call both doors use.
 ///

@@ -73,7 +73,7 @@ pub struct Report {
     /// Parse time in milliseconds (filled by the caller).
     pub parse_ms: f64,
     /// Skipped entities, repaired surfaces, incomplete refinement.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::Warning>,
     /// Faces the parameterization test flagged (paper 001), rebuilt or not.
     pub reparameterized: Vec<ReparamFace>,
     /// Quality mode only: element size and how near the mesh comes to it.

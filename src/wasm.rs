@@ -877,7 +877,7 @@ fn run(
     result.report.time_ms = now_ms() - t1;
     if output.console_warnings {
         for w in &result.report.warnings {
-            web_sys::console::warn_1(&JsValue::from_str(w));
+            web_sys::console::warn_1(&JsValue::from_str(&w.to_string()));
         }
     }
     if output.flatten {

@@ -95,7 +95,8 @@ fn mesh(m: &MeshArgs) -> Result<(), String> {
     report.time_ms = millis(start);
     report.parse_ms = parse_ms;
     // Reader warnings first, unless the mesher already copied them.
-    let missing: Vec<String> = model.warnings.iter().filter(|w| !report.warnings.contains(w)).cloned().collect();
+    let missing: Vec<surfmesh::Warning> =
+        model.warnings.iter().filter(|w| !report.warnings.contains(w)).cloned().collect();
     report.warnings.splice(0..0, missing);
 
     let report_json = serde_json::to_string_pretty(&result.report)

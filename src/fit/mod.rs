@@ -22,6 +22,7 @@ mod tessellate;
 mod trinet;
 
 use crate::collections::HashMap;
+use crate::warning::{Warning, WarningKind};
 use alloc::format;
 use alloc::string::String;
 use alloc::vec;
@@ -294,7 +295,7 @@ pub struct FitReport {
     /// Core time in milliseconds (filled by the caller: the core has no clock).
     pub time_ms: f64,
     /// Merged duplicates, polygons that could not be filled, open gaps.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Warning>,
 }
 
 /// Everything [`fit_points`] made.
@@ -382,7 +383,7 @@ struct Distinct {
 ///
 /// # Errors
 /// As [`fit_points`] for the points themselves.
-fn distinct_points(points: &[DVec3], options: &FitOptions, warnings: &mut Vec<String>) -> Result<Distinct, Error> {
+fn distinct_points(points: &[DVec3], options: &FitOptions, warnings: &mut Vec<Warning>) -> Result<Distinct, Error> {
     if points.len() > options.max_points {
         return Err(Error::Limit(format!("{} points; at most {} are accepted", points.len(), options.max_points)));
     }
@@ -399,8 +400,8 @@ fn distinct_points(points: &[DVec3], options: &FitOptions, warnings: &mut Vec<St
     let (verts, point_index) = merge_duplicates(points, options.merge_distance * diag);
     let merged = points.len() - verts.len();
     if merged > 0 {
-        warnings
-            .push(format!("{merged} duplicate point(s) merged (closer than {:.3e})", options.merge_distance * diag));
+        let distance = options.merge_distance * diag;
+        warnings.push(Warning::new(WarningKind::DuplicatesMerged { count: merged, distance }));
     }
     if verts.len() < 4 {
         return Err(Error::Fit(format!("at least 4 distinct points are needed, found {}", verts.len())));
@@ -415,7 +416,7 @@ fn distinct_points(points: &[DVec3], options: &FitOptions, warnings: &mut Vec<St
         )));
     }
     if !(ev[0] > 1e-14 * ev[2]) {
-        warnings.push("the points lie on one plane: the fit is the flat region of that plane they span".into());
+        warnings.push(Warning::new(WarningKind::Planar));
     }
     Ok(Distinct { verts, point_index, merged, diag })
 }
@@ -428,7 +429,7 @@ fn distinct_points(points: &[DVec3], options: &FitOptions, warnings: &mut Vec<St
 fn triangle_net(
     verts: &[DVec3],
     options: &FitOptions,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Warning>,
 ) -> Result<(Vec<DVec3>, trinet::TriNet), Error> {
     let k = options.normal_neighbours.max(options.net_neighbours).min(verts.len() - 1);
     let tree = KdTree::new(verts);
@@ -464,7 +465,7 @@ fn triangle_net(
         }
     }
     if net.holes_open > 0 {
-        warnings.push(format!("{} gap(s) of the triangle net left open", net.holes_open));
+        warnings.push(Warning::new(WarningKind::NetGaps { count: net.holes_open }));
     }
     let used: usize = {
         let mut u = vec![false; verts.len()];
@@ -472,7 +473,7 @@ fn triangle_net(
         u.iter().filter(|x| !**x).count()
     };
     if used > 0 {
-        warnings.push(format!("{used} point(s) are in no triangle of the net and are not interpolated"));
+        warnings.push(Warning::new(WarningKind::PointsUnused { count: used }));
     }
     Ok((normals, net))
 }
@@ -485,7 +486,7 @@ fn polygons(
     normals: Vec<DVec3>,
     tris: &[[u32; 3]],
     options: &FitOptions,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Warning>,
 ) -> FitSurface {
     let poly_opt = polynet::PolyOptions {
         max_angle: options.max_polygon_angle,
@@ -502,7 +503,7 @@ fn polygons(
         }
     }
     if failed > 0 {
-        warnings.push(format!("{failed} polygon(s) could not be filled and leave holes"));
+        warnings.push(Warning::new(WarningKind::PolygonsUnfilled { count: failed }));
     }
     FitSurface { points: verts, normals, polygons }
 }
@@ -516,7 +517,7 @@ fn tessellated(
     surface: &FitSurface,
     options: &FitOptions,
     diag: f64,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Warning>,
 ) -> Result<(f64, Mesh), Error> {
     let tol = match options.tolerance {
         Tolerance::Absolute(t) => t,
@@ -537,8 +538,7 @@ fn tessellated(
         surface.polygons.iter().map(|p| tessellate::PolyPatches { corners: &p.corners, patches: &p.patches }).collect();
     let tess = tessellate::tessellate(&surface.points, &surface.normals, &polys, tol, options.max_level);
     if tess.levels.iter().any(|&l| l >= options.max_level) {
-        warnings
-            .push(format!("some patches hit the split limit of {} and may exceed the tolerance", options.max_level));
+        warnings.push(Warning::new(WarningKind::SplitLimit { level: options.max_level }));
     }
     Ok((tol, tess.mesh))
 }

@@ -4,7 +4,6 @@
 //! a separate step ([`crate::weld_mesh`]).
 
 use alloc::format;
-use alloc::string::String;
 use alloc::vec::Vec;
 use glam::DVec3;
 
@@ -89,13 +88,13 @@ pub(crate) struct MeshBuilder {
 
 impl MeshBuilder {
     /// The id of a vertex at `p` (new or existing). `p` must be finite.
-    pub(crate) fn vertex(&mut self, p: DVec3) -> Result<u32, String> {
+    pub(crate) fn vertex(&mut self, p: DVec3) -> Result<u32, PointError> {
         // +0.0 and -0.0 are one point.
         let k = [p.x, p.y, p.z].map(|x| (x + 0.0).to_bits());
         if let Some(&i) = self.ids.get(&k) {
             return Ok(i);
         }
-        let i = u32::try_from(self.positions.len()).map_err(|_| String::from("more than 2^32 vertices"))?;
+        let i = u32::try_from(self.positions.len()).map_err(|_| PointError::TooManyVertices)?;
         self.positions.push(p);
         self.ids.insert(k, i);
         Ok(i)
@@ -112,13 +111,36 @@ impl MeshBuilder {
     }
 }
 
+/// What is wrong with a point of a mesh file.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum PointError {
+    /// A coordinate that is not a finite number.
+    NotFinite([f64; 3]),
+    /// A coordinate past [`MAX_COORDINATE`].
+    TooLarge([f64; 3]),
+    /// More vertices than 32-bit indices reach.
+    TooManyVertices,
+}
+
+impl core::fmt::Display for PointError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::NotFinite(p) => write!(f, "coordinate {} {} {} is not a finite number", p[0], p[1], p[2]),
+            Self::TooLarge(p) => {
+                write!(f, "coordinate {} {} {} is larger than {MAX_COORDINATE:e} in magnitude", p[0], p[1], p[2])
+            }
+            Self::TooManyVertices => write!(f, "more than 2^32 vertices"),
+        }
+    }
+}
+
 /// Checks one coordinate triple: finite and within [`MAX_COORDINATE`].
-pub(crate) fn check_point(p: [f64; 3]) -> Result<DVec3, String> {
+pub(crate) fn check_point(p: [f64; 3]) -> Result<DVec3, PointError> {
     if p.iter().any(|x| !x.is_finite()) {
-        return Err(format!("coordinate {} {} {} is not a finite number", p[0], p[1], p[2]));
+        return Err(PointError::NotFinite(p));
     }
     if p.iter().any(|x| x.abs() > MAX_COORDINATE) {
-        return Err(format!("coordinate {} {} {} is larger than {MAX_COORDINATE:e} in magnitude", p[0], p[1], p[2]));
+        return Err(PointError::TooLarge(p));
     }
     Ok(DVec3::from_array(p))
 }

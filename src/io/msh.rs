@@ -16,7 +16,7 @@
 //! ```
 
 use alloc::format;
-use alloc::string::String;
+use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 use core::fmt::Write;
 use glam::DVec3;
@@ -307,7 +307,7 @@ fn read_nodes(
             for _ in 0..extra {
                 w.number("a parametric coordinate")?;
             }
-            let p = check_point(xyz).map_err(|m| w.error(m))?;
+            let p = check_point(xyz).map_err(|m| w.error(m.to_string()))?;
             let index = u32::try_from(mesh.positions.len()).map_err(|_| w.error("more than 2^32 nodes".into()))?;
             if tags.insert(t, index).is_some() {
                 return Err(w.error(format!("node tag {t} is defined twice")));

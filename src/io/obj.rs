@@ -1,7 +1,7 @@
 //! Wavefront OBJ: writer and reader.
 
 use alloc::format;
-use alloc::string::String;
+use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 use core::fmt::Write;
 use core::ops::Range;
@@ -87,7 +87,7 @@ pub(super) fn read_obj(bytes: &[u8]) -> Result<Mesh, Error> {
                     let w = words.next().ok_or_else(|| at(line, "'v' needs three coordinates".into()))?;
                     *x = w.parse::<f64>().map_err(|_| at(line, format!("'{w}' is not a number")))?;
                 }
-                positions.push(check_point(xyz).map_err(|m| at(line, m))?);
+                positions.push(check_point(xyz).map_err(|m| at(line, m.to_string()))?);
                 if positions.len() > u32::MAX as usize {
                     return Err(at(line, "more than 2^32 vertices".into()));
                 }

@@ -1,6 +1,6 @@
 //! STL: binary writer, binary and ASCII reader.
 
-use alloc::string::String;
+use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 use glam::DVec3;
 
@@ -108,8 +108,8 @@ fn read_binary(bytes: &[u8]) -> Result<Mesh, Error> {
                 location: alloc::format!("binary STL triangle {}", t + 1),
                 message: alloc::format!("vertex {}: {message}", k + 1),
             };
-            let p = check_point([f(0), f(4), f(8)]).map_err(bad)?;
-            *id = b.vertex(p).map_err(|m| Error::MeshFile { location: "binary STL".into(), message: m })?;
+            let p = check_point([f(0), f(4), f(8)]).map_err(|m| bad(m.to_string()))?;
+            *id = b.vertex(p).map_err(|m| Error::MeshFile { location: "binary STL".into(), message: m.to_string() })?;
         }
         b.triangle(ids);
     }
@@ -149,8 +149,8 @@ fn read_ascii(bytes: &[u8]) -> Result<Mesh, Error> {
                     let w = words.next().ok_or_else(|| at(line, "'vertex' needs three coordinates".into()))?;
                     *x = w.parse::<f64>().map_err(|_| at(line, alloc::format!("'{w}' is not a number")))?;
                 }
-                let p = check_point(xyz).map_err(|m| at(line, m))?;
-                corners.push(b.vertex(p).map_err(|m| at(line, m))?);
+                let p = check_point(xyz).map_err(|m| at(line, m.to_string()))?;
+                corners.push(b.vertex(p).map_err(|m| at(line, m.to_string()))?);
             }
             "endfacet" => {
                 let Some((start, corners)) = facet.take() else {

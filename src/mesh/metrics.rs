@@ -1,5 +1,6 @@
 //! Topology and shape measures of a mesh: free, crack and non-manifold edges; angles.
 
+use crate::warning::{Warning, WarningKind};
 use alloc::vec::Vec;
 use glam::DVec3;
 
@@ -202,19 +203,11 @@ fn split_by_body(
 
 /// The report's line about faces the reader skipped, if any: how many, and
 /// how many edges of the mesh run open along them (`holes`).
-pub(crate) fn holes_warning(skipped: &[SkippedFace], holes: usize, warnings: &mut Vec<alloc::string::String>) {
+pub(crate) fn holes_warning(skipped: &[SkippedFace], holes: usize, warnings: &mut Vec<Warning>) {
     if skipped.is_empty() {
         return;
     }
-    let n = skipped.len();
-    warnings.push(if holes > 0 {
-        alloc::format!(
-            "{n} face(s) of the file could not be read: the mesh has holes there, \
-             {holes} open edges along their borders (counted as cracks)"
-        )
-    } else {
-        alloc::format!("{n} face(s) of the file could not be read: the mesh lacks them")
-    });
+    warnings.push(Warning::new(WarningKind::UnreadFaces { count: skipped.len(), holes }));
 }
 
 /// Face index of each triangle, from the mesh's face ranges (0 when absent).

@@ -23,7 +23,7 @@ pub struct Model {
     /// The faces, in file order.
     pub faces: Vec<Face>,
     /// Things the reader skipped or repaired, for the report.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::Warning>,
     /// The file's own modelling tolerance, model units (IGES global section:
     /// minimum resolution), when it states one: the gaps its author accepted
     /// between faces, so sewing reaches at least that far.

@@ -128,6 +128,68 @@ impl fmt::Display for OptionsError {
 
 impl core::error::Error for OptionsError {}
 
+/// A word that names none of an option's values (the error of the option
+/// enums' `FromStr`, which the CLI and the JS binding both parse with).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnknownWord {
+    /// Option name, without dashes: `mode`, `reparam`, `method`.
+    pub option: &'static str,
+    /// The words it takes.
+    pub allowed: &'static [&'static str],
+}
+
+impl fmt::Display for UnknownWord {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} must be ", self.option)?;
+        let n = self.allowed.len();
+        for (i, w) in self.allowed.iter().enumerate() {
+            let sep = match i {
+                0 => "",
+                i if i + 1 == n => " or ",
+                _ => ", ",
+            };
+            write!(f, "{sep}{w}")?;
+        }
+        Ok(())
+    }
+}
+
+impl core::error::Error for UnknownWord {}
+
+/// The value of `option` whose word (in `allowed`, in the order of `values`) is `s`.
+pub(crate) fn parse_word<T: Copy>(
+    s: &str,
+    option: &'static str,
+    allowed: &'static [&'static str],
+    values: &[T],
+) -> Result<T, UnknownWord> {
+    allowed.iter().position(|w| *w == s).and_then(|i| values.get(i).copied()).ok_or(UnknownWord { option, allowed })
+}
+
+impl Reparam {
+    /// The words `FromStr` takes, in declaration order.
+    pub const WORDS: &'static [&'static str] = &["auto", "off", "force"];
+}
+
+impl core::str::FromStr for Reparam {
+    type Err = UnknownWord;
+    fn from_str(s: &str) -> Result<Self, UnknownWord> {
+        parse_word(s, "reparam", Self::WORDS, &[Self::Auto, Self::Off, Self::Force])
+    }
+}
+
+impl MeshMode {
+    /// The words `FromStr` takes, in declaration order.
+    pub const WORDS: &'static [&'static str] = &["fast", "quality"];
+}
+
+impl core::str::FromStr for MeshMode {
+    type Err = UnknownWord;
+    fn from_str(s: &str) -> Result<Self, UnknownWord> {
+        parse_word(s, "mode", Self::WORDS, &[Self::Fast, Self::Quality])
+    }
+}
+
 impl MeshOptions {
     /// Sets an absolute chordal tolerance.
     pub fn with_tolerance(mut self, tol: f64) -> Self {
@@ -250,5 +312,26 @@ impl MeshOptions {
             return Err(OptionsError { option: "safety", message: "must be in (0.1, 1]" });
         }
         self.quality.validate()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alloc::string::ToString;
+
+    /// Every word parses to its own value, and a word of none says which it takes.
+    #[test]
+    fn option_words_parse_to_their_values() {
+        let modes: alloc::vec::Vec<MeshMode> = MeshMode::WORDS.iter().map(|w| w.parse().unwrap()).collect();
+        assert_eq!(modes, [MeshMode::Fast, MeshMode::Quality]);
+        let reparams: alloc::vec::Vec<Reparam> = Reparam::WORDS.iter().map(|w| w.parse().unwrap()).collect();
+        assert_eq!(reparams, [Reparam::Auto, Reparam::Off, Reparam::Force]);
+        let methods: alloc::vec::Vec<QualityMethod> = QualityMethod::WORDS.iter().map(|w| w.parse().unwrap()).collect();
+        assert_eq!(methods, [QualityMethod::Looping, QualityMethod::Delaunay, QualityMethod::Best]);
+        let e = "Fast".parse::<MeshMode>().unwrap_err();
+        assert_eq!(e, UnknownWord { option: "mode", allowed: MeshMode::WORDS });
+        assert_eq!(e.to_string(), "mode must be fast or quality");
+        assert_eq!("x".parse::<QualityMethod>().unwrap_err().to_string(), "method must be looping, delaunay or best");
     }
 }

@@ -1,7 +1,7 @@
 //! Options of the quality mesher (paper 003): element size, method, the
 //! splitting function's weights, and the improvement passes.
 
-use super::OptionsError;
+use super::{parse_word, OptionsError, UnknownWord};
 
 /// The wanted element size H (edge length), in model units or relative to the model.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -24,6 +24,18 @@ pub enum QualityMethod {
     Delaunay,
     /// Both per face; the mesh whose triangles and edges score better is kept.
     Best,
+}
+
+impl QualityMethod {
+    /// The words `FromStr` takes, in declaration order.
+    pub const WORDS: &'static [&'static str] = &["looping", "delaunay", "best"];
+}
+
+impl core::str::FromStr for QualityMethod {
+    type Err = UnknownWord;
+    fn from_str(s: &str) -> Result<Self, UnknownWord> {
+        parse_word(s, "method", Self::WORDS, &[Self::Looping, Self::Delaunay, Self::Best])
+    }
 }
 
 /// Options for [`crate::MeshOptions::quality`], used when the mode is

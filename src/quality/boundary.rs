@@ -10,14 +10,13 @@
 //! equal parts, and every face using it gets the same 3-D points (at its own
 //! curve parameters), so the faces' meshes meet node to node.
 
-use alloc::format;
-use alloc::string::String;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
 use crate::mesh::weld_positions;
 use crate::model::Face;
 use crate::nurbs::{NurbsCurve, Surface};
+use crate::warning::QualityError;
 
 /// Samples of a piece of curve never exceed this (memory bound per curve).
 const MAX_SAMPLES: usize = 200_000;
@@ -174,7 +173,7 @@ pub(crate) fn discretize(
     h: f64,
     sew: f64,
     budget: usize,
-) -> Result<Vec<Result<FaceBoundary, String>>, String> {
+) -> Result<Vec<Result<FaceBoundary, QualityError>>, QualityError> {
     let (loops_of, traces) = collect_traces(faces);
     let samples = sample_traces(faces, &traces, h, budget)?;
     // Vertices: curve ends welded.
@@ -230,8 +229,8 @@ struct Divider<'a, 'f> {
 /// first), numbered across the model: per face, its loops as trace numbers
 /// (or why it has none), and each trace with its face.
 #[allow(clippy::type_complexity)]
-fn collect_traces(faces: &[Face]) -> (Vec<Result<Vec<Vec<usize>>, String>>, Vec<(usize, Trace<'_>)>) {
-    let mut loops_of: Vec<Result<Vec<Vec<usize>>, String>> = Vec::with_capacity(faces.len());
+fn collect_traces(faces: &[Face]) -> (Vec<Result<Vec<Vec<usize>>, QualityError>>, Vec<(usize, Trace<'_>)>) {
+    let mut loops_of: Vec<Result<Vec<Vec<usize>>, QualityError>> = Vec::with_capacity(faces.len());
     let mut traces: Vec<(usize, Trace<'_>)> = Vec::new();
     for (fi, f) in faces.iter().enumerate() {
         loops_of.push(face_traces(fi, f).map(|loops| {
@@ -255,7 +254,12 @@ fn collect_traces(faces: &[Face]) -> (Vec<Result<Vec<Vec<usize>>, String>>, Vec<
 ///
 /// # Errors
 /// A message when the boundary alone needs more than `budget` nodes.
-fn sample_traces(faces: &[Face], traces: &[(usize, Trace<'_>)], h: f64, budget: usize) -> Result<Vec<Samples>, String> {
+fn sample_traces(
+    faces: &[Face],
+    traces: &[(usize, Trace<'_>)],
+    h: f64,
+    budget: usize,
+) -> Result<Vec<Samples>, QualityError> {
     let mut samples: Vec<Samples> = Vec::with_capacity(traces.len());
     let mut total_nodes = 0usize;
     for (fi, tr) in traces {
@@ -267,9 +271,7 @@ fn sample_traces(faces: &[Face], traces: &[(usize, Trace<'_>)], h: f64, budget: 
         }
         total_nodes = total_nodes.saturating_add(crate::math::ceil(sm.length() / h).min(1e15) as usize);
         if total_nodes > budget {
-            return Err(format!(
-                "the boundary curves alone need more than {budget} nodes at size {h:.4e}; choose a larger size"
-            ));
+            return Err(QualityError::BoundaryBudget { budget, size: h });
         }
         samples.push(sm);
     }
@@ -386,7 +388,7 @@ fn face_boundary(
     pieces_of_trace: &[Vec<usize>],
     pieces: &[Piece],
     h: f64,
-) -> Result<FaceBoundary, String> {
+) -> Result<FaceBoundary, QualityError> {
     let mut fb = FaceBoundary::default();
     for (li, lp) in loops.iter().enumerate() {
         let mut nodes: Vec<BNode> = Vec::new();
@@ -403,7 +405,7 @@ fn face_boundary(
             nodes.pop();
         }
         if nodes.len() < 3 {
-            return Err(format!("loop {li} has {} boundary nodes; it encloses no area", nodes.len()));
+            return Err(QualityError::FewLoopNodes { lp: li, nodes: nodes.len() });
         }
         set_sizes(&mut nodes, h);
         fb.loops.push(nodes);
@@ -413,7 +415,7 @@ fn face_boundary(
 
 /// The face's boundary traces by loop, oriented: outer loop (largest area in
 /// (u,v)) first and counter-clockwise, holes clockwise.
-fn face_traces(fi: usize, f: &Face) -> Result<Vec<Vec<Trace<'_>>>, String> {
+fn face_traces(fi: usize, f: &Face) -> Result<Vec<Vec<Trace<'_>>>, QualityError> {
     let mut loops: Vec<Vec<Trace<'_>>> = Vec::new();
     if f.loops.is_empty() {
         let [lo, hi] = f.surface.domain();
@@ -443,7 +445,7 @@ fn face_traces(fi: usize, f: &Face) -> Result<Vec<Vec<Trace<'_>>>, String> {
         })
         .collect();
     if let Some(li) = areas.iter().position(|a| *a == 0.0 || !a.is_finite()) {
-        return Err(format!("face {fi}: loop {li} encloses no area"));
+        return Err(QualityError::LoopNoArea { face: fi, lp: li });
     }
     let outer = (0..areas.len()).max_by(|&i, &j| areas[i].abs().total_cmp(&areas[j].abs())).unwrap_or(0);
     loops.swap(0, outer);

@@ -3,8 +3,8 @@
 //! area) of the same boundary nodes in the same plane. Boundary segments are
 //! kept whole, so the faces still meet node to node.
 
+use crate::warning::QualityError;
 use alloc::format;
-use alloc::string::String;
 use alloc::vec::Vec;
 use glam::DVec2;
 use spade::{AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};
@@ -21,7 +21,7 @@ pub(crate) const ANGLE_LIMIT_DEG: f64 = 30.0;
 ///
 /// # Errors
 /// A message when the loops cross or nodes coincide.
-pub(crate) fn fill(pos: &[DVec2], h: &[f64], loops: &[Vec<u32>], max_nodes: usize) -> Result<Filled, String> {
+pub(crate) fn fill(pos: &[DVec2], h: &[f64], loops: &[Vec<u32>], max_nodes: usize) -> Result<Filled, QualityError> {
     let verts: Vec<Point2<f64>> = pos.iter().map(|p| Point2::new(p.x, p.y)).collect();
     let mut edges: Vec<[usize; 2]> = Vec::new();
     for lp in loops {
@@ -32,12 +32,12 @@ pub(crate) fn fill(pos: &[DVec2], h: &[f64], loops: &[Vec<u32>], max_nodes: usiz
     }
     let mut conflict = false;
     let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(verts, edges, |_| conflict = true)
-        .map_err(|e| format!("triangulation failed: {e:?}"))?;
+        .map_err(|e| QualityError::Triangulation(format!("{e:?}")))?;
     if conflict {
-        return Err("boundary loops cross".into());
+        return Err(QualityError::LoopsCross);
     }
     if cdt.num_vertices() != pos.len() {
-        return Err("boundary nodes coincide".into());
+        return Err(QualityError::NodesCoincide);
     }
     let mut sizes: Vec<f64> = h.to_vec();
     sizes.sort_unstable_by(f64::total_cmp);

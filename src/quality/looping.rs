@@ -28,8 +28,7 @@
 //! a clearance of a fifth of the local size from other nodes (dropped when no
 //! line qualifies); and the node count is bounded.
 
-use alloc::format;
-use alloc::string::String;
+use crate::warning::QualityError;
 use alloc::vec::Vec;
 use core::f64::consts::{FRAC_PI_2, FRAC_PI_3, PI, TAU};
 use glam::DVec2;
@@ -86,7 +85,7 @@ pub(crate) fn fill(
     loops: Vec<Vec<u32>>,
     weights: Weights,
     max_nodes: usize,
-) -> Result<Filled, String> {
+) -> Result<Filled, QualityError> {
     let mut m = Mesher { pos, h, tris: Vec::new(), w: weights.c, max_nodes, dropped: 0 };
     let mut loops = loops.into_iter();
     let Some(mut outer) = loops.next() else { return Ok(Filled::default()) };
@@ -99,7 +98,7 @@ pub(crate) fn fill(
     while let Some(lp) = stack.pop() {
         rounds += 1;
         if rounds > 4 * m.max_nodes + 16 {
-            return Err("the looping method did not finish (too many splits)".into());
+            return Err(QualityError::TooManySplits);
         }
         match lp.len() {
             0..=2 => {}
@@ -269,9 +268,9 @@ impl Mesher {
         }
     }
 
-    fn add_node(&mut self, p: DVec2, h: f64) -> Result<u32, String> {
+    fn add_node(&mut self, p: DVec2, h: f64) -> Result<u32, QualityError> {
         if self.pos.len() >= self.max_nodes {
-            return Err(format!("the looping method reached the limit of {} nodes", self.max_nodes));
+            return Err(QualityError::NodeLimit { max: self.max_nodes });
         }
         self.pos.push(p);
         self.h.push(h);
@@ -279,7 +278,7 @@ impl Mesher {
     }
 
     /// The nodes dividing the line from node `a` to node `b` into `n` segments.
-    fn divide(&mut self, a: u32, b: u32, n: usize) -> Result<Vec<u32>, String> {
+    fn divide(&mut self, a: u32, b: u32, n: usize) -> Result<Vec<u32>, QualityError> {
         let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
         let (ha, hb) = (self.h[a as usize], self.h[b as usize]);
         let mut out = Vec::with_capacity(n.saturating_sub(1));
@@ -319,7 +318,7 @@ impl Mesher {
     }
 
     /// The best line of the loop and the two loops it leaves.
-    fn split(&mut self, lp: &[u32]) -> Result<(Vec<u32>, Vec<u32>), String> {
+    fn split(&mut self, lp: &[u32]) -> Result<(Vec<u32>, Vec<u32>), QualityError> {
         let m = lp.len();
         let (theta, base) = angles(&self.pos, lp);
         let concave = theta.iter().any(|&t| t > PI + 1e-9);
@@ -385,7 +384,7 @@ impl Mesher {
             Some(c) => c,
             None => match self.any_line(lp, tiny) {
                 Some(c) => c,
-                None => return Err(format!("a loop of {m} nodes has no splitting line inside it")),
+                None => return Err(QualityError::NoSplit { nodes: m }),
             },
         };
         let (i, j) = (c.i as usize, c.j as usize);
@@ -423,7 +422,7 @@ impl Mesher {
     /// Joins the hole with the shortest valid cut line (length over the
     /// ends' mean size) to `outer`; the cut is divided by the density and
     /// run both ways, so the result is one closed loop (paper 003 Fig. 2).
-    fn join_hole(&mut self, outer: Vec<u32>, holes: &mut Vec<Vec<u32>>) -> Result<Vec<u32>, String> {
+    fn join_hole(&mut self, outer: Vec<u32>, holes: &mut Vec<Vec<u32>>) -> Result<Vec<u32>, QualityError> {
         let mut cands: Vec<(f64, usize, usize, usize)> = Vec::new();
         let (to, bo) = angles(&self.pos, &outer);
         let hole_angles: Vec<(Vec<f64>, Vec<f64>)> = holes.iter().map(|h| angles(&self.pos, h)).collect();
@@ -467,7 +466,7 @@ impl Mesher {
             }
         }
         let Some((hi, ia, ib)) = found else {
-            return Err("no cut line joins a hole to the outer loop".into());
+            return Err(QualityError::NoCut);
         };
         let hole = holes.swap_remove(hi);
         let (a, b) = (outer[ia], hole[ib]);
@@ -549,7 +548,7 @@ mod tests {
         let (pos, lp) = square(100, 100.0);
         let h = alloc::vec![1.0; pos.len()];
         let e = fill(pos, h, alloc::vec![lp], weights(), 1000).unwrap_err();
-        assert!(e.contains("limit of 1000 nodes"), "{e}");
+        assert_eq!(e, QualityError::NodeLimit { max: 1000 }, "{e}");
     }
 
     #[test]

@@ -1,7 +1,6 @@
 //! The quality mesher (paper 003): boundary, mapping, filling, improvement.
 
 use alloc::format;
-use alloc::string::String;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
@@ -18,6 +17,7 @@ use crate::nurbs::Surface;
 use crate::nurbs::{project_to_surface, ProjectionOptions};
 use crate::options::{ElementSize, MeshOptions, QualityMethod, Tolerance};
 use crate::report::{MeshResult, QualityReport, Report, EDGE_BAND, GOOD_ANGLE_DEG};
+use crate::warning::{QualityError, Warning, WarningKind};
 use crate::{Error, Mesh, Model};
 
 /// Quality of one face's mesh: (good-angle fraction, edge-band fraction).
@@ -92,7 +92,8 @@ pub(crate) fn mesh_quality(
             model.tolerance.filter(|t| t.is_finite() && *t > 0.0).map_or(sew_auto, |t| sew_auto.max(t.min(0.5 * tol)))
         })
         .min(0.05 * size);
-    let boundaries = boundary::discretize(&model.faces, size, sew, q.max_triangles).map_err(Error::Limit)?;
+    let boundaries =
+        boundary::discretize(&model.faces, size, sew, q.max_triangles).map_err(|e| Error::Limit(format!("{e}")))?;
 
     let mut report = Report { tolerance: tol, angle: options.angle, faces: model.faces.len(), ..Report::default() };
     report.warnings.extend(model.warnings.iter().cloned());
@@ -106,7 +107,7 @@ pub(crate) fn mesh_quality(
         match result {
             Ok((fm, looping, dropped)) => {
                 if dropped > 0 {
-                    report.warnings.push(format!("face {index}: {dropped} loops enclosing no area left unfilled"));
+                    report.warnings.push(Warning::face(index, WarningKind::QualityLoopsUnfilled { loops: dropped }));
                 }
                 if looping {
                     qr.faces_looping += 1;
@@ -139,7 +140,7 @@ pub(crate) fn mesh_quality(
             }
             Err(why) => {
                 report.faces_skipped += 1;
-                report.warnings.push(format!("face {index}: not meshed in quality mode: {why}"));
+                report.warnings.push(Warning::face(index, WarningKind::QualityNotMeshed(why)));
             }
         }
         mesh.face_ranges.push(FaceRange { first, count: mesh.triangle_count() as u32 - first });
@@ -247,7 +248,7 @@ fn mesh_face(
     options: &MeshOptions,
     size: f64,
     max_nodes: usize,
-) -> Result<(FaceMesh, bool, usize), String> {
+) -> Result<(FaceMesh, bool, usize), QualityError> {
     let q = &options.quality;
     let s: &dyn Surface = &face.surface;
     let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
@@ -301,8 +302,7 @@ fn mesh_face(
     #[cfg(feature = "std")]
     let by_delaunay = || delaunay::fill(&pos, &hp, &loops, max_nodes).map(&build);
     #[cfg(not(feature = "std"))]
-    let by_delaunay =
-        || -> Result<(FaceMesh, usize), String> { Err("Delaunay refinement needs the `std` feature".into()) };
+    let by_delaunay = || -> Result<(FaceMesh, usize), QualityError> { Err(QualityError::NeedsStd) };
     match q.method {
         QualityMethod::Looping => by_looping().map(|(m, d)| (m, true, d)),
         QualityMethod::Delaunay => by_delaunay().map(|(m, d)| (m, false, d)),

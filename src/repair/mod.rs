@@ -229,7 +229,7 @@ pub struct RepairReport {
     /// Time per stage.
     pub time_ms: StageTimes,
     /// What was assumed or left undone.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::Warning>,
 }
 
 /// A repaired mesh and its report.

@@ -13,6 +13,7 @@ use super::region::Grown;
 use super::{arrange, check, degenerate, intersect, region, topology, RepairOptions, RepairReport};
 use crate::io::MAX_COORDINATE;
 use crate::nurbs::Aabb;
+use crate::warning::{Warning, WarningKind};
 use crate::{weld_positions, Error, Mesh};
 
 /// A welded, consistently oriented mesh with its adjacency.
@@ -90,10 +91,8 @@ pub(super) fn weld_and_orient(
                 // Non-manifold as given too: say so in the input's own vertex numbers.
                 let mut own = drop_collapsed_and_duplicates(tris_in.clone());
                 topology::orient_consistently(&mut own)?;
-                report.warnings.push(format!(
-                    "welding within {:e} of the diagonal would make the mesh non-manifold ({e}); vertices were not welded",
-                    options.weld_tolerance
-                ));
+                let kind = WarningKind::NotWelded { tolerance: options.weld_tolerance, why: e };
+                report.warnings.push(Warning::new(kind));
             }
         }
     }
@@ -120,10 +119,7 @@ pub(super) fn weld_and_orient(
     let mut nbr = topology::adjacency(&tris);
     report.free_edges_in = nbr.iter().flatten().filter(|&&u| u == topology::NONE).count();
     if report.free_edges_in > 0 {
-        report.warnings.push(format!(
-            "the input is open ({} free edges): its boundary stays open and growth stops there",
-            report.free_edges_in
-        ));
+        report.warnings.push(Warning::new(WarningKind::OpenInput { free_edges: report.free_edges_in }));
     }
     let (comp, ncomp) = topology::components(&nbr);
     report.components = ncomp;
@@ -158,10 +154,8 @@ fn turn_inside_out_outward(
         }
     }
     report.triangles_reoriented += flipped;
-    report.warnings.push(format!(
-        "{} of {ncomp} components enclosed a negative volume (inside out) and were turned outward",
-        inside_out.iter().filter(|&&b| b).count()
-    ));
+    let count = inside_out.iter().filter(|&&b| b).count();
+    report.warnings.push(Warning::new(WarningKind::InsideOut { count, components: ncomp }));
     true
 }
 
@@ -189,9 +183,7 @@ pub(super) fn remove_degenerate(
     report.degenerate_swapped = stats.swaps;
     report.degenerate_left = stats.left;
     if stats.left > 0 {
-        report
-            .warnings
-            .push(format!("{} degenerate triangles could not be removed without breaking the manifold", stats.left));
+        report.warnings.push(Warning::new(WarningKind::DegenerateLeft { count: stats.left }));
     }
     let tris: Vec<[u32; 3]> = tris.iter().zip(&alive).filter(|(_, &a)| a).map(|(t, _)| *t).collect();
     let nbr = topology::adjacency(&tris);
@@ -240,9 +232,7 @@ pub(super) fn intersect_and_grow(
         let resolved = x.degenerate == 0 && grown.fallbacks == 0 && grown.stitch_misses == 0 && grown.closed;
         if resolved || attempt + 1 == sizes.len() {
             if attempt > 0 {
-                report.warnings.push(format!(
-                    "the arrangement had unresolved coincidences; vertices were moved by up to {size:e} of the diagonal"
-                ));
+                report.warnings.push(Warning::new(WarningKind::Perturbed { size }));
             }
             report.perturbation = size;
             break (x, grown);
@@ -255,10 +245,7 @@ pub(super) fn intersect_and_grow(
     report.segments = x.segments.len();
     report.degenerate_contacts = x.degenerate;
     if x.degenerate > 0 {
-        report.warnings.push(format!(
-            "{} triangle pairs touch or overlap in a way not handled (coplanar, or a vertex exactly on another triangle); left as they are",
-            x.degenerate
-        ));
+        report.warnings.push(Warning::new(WarningKind::UnhandledContacts { pairs: x.degenerate }));
     }
     Ok((x, grown))
 }
@@ -270,16 +257,10 @@ pub(super) fn report_regions(grown: &Grown, report: &mut RepairReport) {
     report.subdivision_fallbacks = grown.fallbacks;
     report.stitch_misses = grown.stitch_misses;
     if grown.unseeded > 0 {
-        report.warnings.push(format!(
-            "{} components had no triangle on the outside of the enclosed space and were left out",
-            grown.unseeded
-        ));
+        report.warnings.push(Warning::new(WarningKind::Unseeded { components: grown.unseeded }));
     }
     if grown.fallbacks > 0 {
-        report.warnings.push(format!(
-            "{} triangles could not be split along their segments (points closer than rounding separates) and were kept or dropped whole",
-            grown.fallbacks
-        ));
+        report.warnings.push(Warning::new(WarningKind::SplitFallbacks { triangles: grown.fallbacks }));
     }
 }
 
@@ -293,15 +274,13 @@ pub(super) fn output(grown: &Grown, report: &mut RepairReport) -> (Vec<DVec3>, V
     report.census_out = check::census(&out_tris);
     report.volume_out = topology::signed_volume(&out_pos, out_tris.iter().copied());
     if out_tris.is_empty() {
-        report.warnings.push("nothing valid was found: the result is empty".into());
+        report.warnings.push(Warning::new(WarningKind::EmptyResult));
     }
     let c = report.census_out;
     if c.nonmanifold_edges > 0 || c.misoriented_edges > 0 {
         // Seen only from open input, where growth can pass round the border.
-        report.warnings.push(format!(
-            "the result is not a clean 2-manifold: {} edges of more than two triangles, {} edges whose triangles disagree",
-            c.nonmanifold_edges, c.misoriented_edges
-        ));
+        let kind = WarningKind::NotManifold { nonmanifold: c.nonmanifold_edges, misoriented: c.misoriented_edges };
+        report.warnings.push(Warning::new(kind));
     }
     (out_pos, out_idx, out_tris)
 }

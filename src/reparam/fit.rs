@@ -2,8 +2,6 @@
 //! spaced evenly in model space, the bicubic interpolation, and its check
 //! against the original (distance, folds), grown until it holds.
 
-use alloc::format;
-use alloc::string::String;
 use alloc::vec;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
@@ -12,6 +10,7 @@ use super::interp::{self, chord_params, interpolate_surface};
 use super::{FIT_LIMIT, FIT_SHARE, MAX_SAMPLES};
 use crate::model::FaceSurface;
 use crate::nurbs::{project_to_surface, project_until, NurbsSurface, ProjectionOptions, Surface, SurfaceDerivs};
+use crate::warning::RebuildError;
 
 /// Piecewise-linear monotone map between the original parameters of the
 /// grid nodes and the new ones (`s_i ↔ u_i`), both ascending.
@@ -396,7 +395,7 @@ fn unreverse_corners(new: &NurbsSurface, old: &FaceSurface, us: &[f64], vs: &[f6
 /// Samples, interpolates (paper 001 steps 3–4) and checks one rebuild at
 /// `n × m` intervals: the new surface at mid-points of grid edges and cells
 /// is projected onto the original from the mapped parameters.
-fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Result<Fit, String> {
+fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Result<Fit, RebuildError> {
     let (us, arc_u) = even_params(surface, true, n, spacing);
     let (vs, arc_v) = even_params(surface, false, m, spacing);
     let grid: Vec<Vec<DVec3>> =
@@ -404,7 +403,7 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Resu
     let cols: Vec<Vec<DVec3>> = (0..vs.len()).map(|j| grid.iter().map(|r| r[j]).collect()).collect();
     let s = interp::averaged_params(cols.iter().map(Vec::as_slice), us.len());
     let t = interp::averaged_params(grid.iter().map(Vec::as_slice), vs.len());
-    let mut new = interpolate_surface(&grid, &s, &t).map_err(|e| format!("{e}"))?;
+    let mut new = interpolate_surface(&grid, &s, &t)?;
     if let Some(fixed) = unreverse_corners(&new, surface, &us, &vs) {
         new = fixed;
     }
@@ -442,7 +441,7 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Resu
         errors[1] = errors[1].max(centre);
     }
     if !(errors[0].is_finite() && errors[1].is_finite()) {
-        return Err("the rebuilt surface is not finite".into());
+        return Err(RebuildError::NotFinite);
     }
     fit.errors = errors;
     Ok(fit)
@@ -450,7 +449,7 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Resu
 
 /// Paper 001 steps 3–4 with `spacing`, sampled until the fit is within
 /// `tol · FIT_SHARE` of `surface` (see [`super::rebuild_face`]).
-pub(super) fn fit_within(surface: &FaceSurface, tol: f64, spacing: Spacing) -> Result<Fit, String> {
+pub(super) fn fit_within(surface: &FaceSurface, tol: f64, spacing: Spacing) -> Result<Fit, RebuildError> {
     let goal = FIT_SHARE * tol;
     let limit = FIT_LIMIT * tol;
     let mut n = sample_count(surface, true, tol);
@@ -506,11 +505,7 @@ pub(super) fn fit_within(surface: &FaceSurface, tol: f64, spacing: Spacing) -> R
             match (folded, best) {
                 (Some(f), _) => break f,
                 (None, Some(b)) if b.errors[0].max(b.errors[1]) <= limit => break b,
-                _ => {
-                    return Err(format!(
-                        "the rebuilt surface stays {err:.3e} from the original at {n} × {m} samples (limit {limit:.3e})"
-                    ))
-                }
+                _ => return Err(RebuildError::TooFar { error: err, n, m, limit }),
             }
         }
         // Interpolation error falls as h⁴: grow by the fourth root of the excess, at least 1.25×.

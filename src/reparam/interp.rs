@@ -8,26 +8,7 @@ use glam::{DVec2, DVec3};
 
 use crate::nurbs::{KnotVector, NurbsCurve, NurbsSurface};
 
-/// Why an interpolation could not be built.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum InterpError {
-    /// Fewer than two points.
-    TooFewPoints,
-    /// Parameters not strictly increasing (coincident points along every row).
-    Degenerate,
-    /// A zero pivot: the collocation matrix is singular.
-    Singular,
-}
-
-impl core::fmt::Display for InterpError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(match self {
-            Self::TooFewPoints => "fewer than two interpolation points",
-            Self::Degenerate => "interpolation points coincide (no parameter spacing)",
-            Self::Singular => "the interpolation system is singular",
-        })
-    }
-}
+pub(crate) use crate::warning::InterpError;
 
 /// A factored collocation system: degree, knots and the banded LU of
 /// `N_i(t_k)` for the given parameters `t_k`.

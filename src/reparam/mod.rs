@@ -9,8 +9,7 @@ mod interp;
 
 use fit::{fit_within, iso_line, projection, Fit, Map1, Spacing};
 
-use alloc::format;
-use alloc::string::String;
+use alloc::boxed::Box;
 use alloc::vec;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
@@ -19,6 +18,7 @@ use serde::Serialize;
 use crate::model::{Face, FaceSurface, Model, TrimLoop};
 use crate::nurbs::{project_to_surface, NurbsCurve, ProjectionOptions, Surface};
 use crate::options::{Reparam, Tolerance};
+use crate::warning::{RebuildError, Reparameterized, Warning, WarningKind};
 use crate::Error;
 
 pub(crate) use interp::{chord_params, interpolate_curve};
@@ -119,7 +119,7 @@ pub struct ReparamModel {
     /// Every face the ratio test flagged (every face when forced), rebuilt or not.
     pub faces: Vec<ReparamFace>,
     /// Why a flagged face was left as it was, one line per face.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::Warning>,
     /// The absolute tolerance the rebuilt faces hold against the originals'
     /// [`FIT_LIMIT`] share of it (model units).
     pub tolerance: f64,
@@ -161,8 +161,8 @@ pub fn reparameterize_model(model: &Model, mode: Reparam, tolerance: Tolerance) 
                 *face = r.face;
             }
             Err(why) => {
-                out.warnings
-                    .push(format!("face {index}: poorly parameterized (step ratio {ratio:.1}), kept as it is: {why}"));
+                let outcome = Reparameterized::KeptAsIs(why);
+                out.warnings.push(Warning::face(index, WarningKind::PoorlyParameterized { ratio, outcome }));
                 out.faces.push(ReparamFace { face: index, ratio, rebuilt: false, samples: [0, 0], fit_error: 0.0 });
             }
         }
@@ -194,7 +194,7 @@ pub struct Rebuilt {
 /// A reason (for the report's warning) when the interpolation is singular,
 /// the check cannot be met within the sample limits, or a trim curve cannot be
 /// re-expressed; the caller then meshes the original face.
-pub fn rebuild_face(face: &Face, tol: f64) -> Result<Rebuilt, String> {
+pub fn rebuild_face(face: &Face, tol: f64) -> Result<Rebuilt, RebuildError> {
     let limit = FIT_LIMIT * tol;
     let mut fit = fit_within(&face.surface, tol, Spacing::Mean)?;
     // Beyond the paper: a rebuild that is itself poorly parameterized, and
@@ -215,8 +215,8 @@ pub fn rebuild_face(face: &Face, tol: f64) -> Result<Rebuilt, String> {
     let mut loops = Vec::with_capacity(face.loops.len());
     for (li, lp) in face.loops.iter().enumerate() {
         let lp = split_at_corners(&face.surface, lp);
-        let (curves, err) =
-            rebuild_loop(&face.surface, &new_surface, &fit, &lp, limit).map_err(|e| format!("loop {li}: {e}"))?;
+        let (curves, err) = rebuild_loop(&face.surface, &new_surface, &fit, &lp, limit)
+            .map_err(|e| RebuildError::Loop { index: li, why: Box::new(e) })?;
         fit_error = fit_error.max(err);
         loops.push(TrimLoop { curves });
     }
@@ -314,7 +314,7 @@ fn rebuild_loop(
     fit: &Fit,
     lp: &TrimLoop,
     goal: f64,
-) -> Result<(Vec<NurbsCurve>, f64), String> {
+) -> Result<(Vec<NurbsCurve>, f64), RebuildError> {
     let lander = Lander::new(old, new, fit);
     // Loop vertices landed once, so curves meet exactly.
     let mut ends: Vec<DVec2> = lp.curves.iter().map(|c| lander.land(c.point(c.domain().0).truncate())).collect();
@@ -329,15 +329,17 @@ fn rebuild_loop(
         let end = ends[(ci + 1) % ends.len()];
         let mut samples = STEPS;
         loop {
-            let (curve, err) =
-                lander.curve_through(c, samples, (start, end), goal).map_err(|e| format!("curve {ci}: {e}"))?;
+            let (curve, err) = lander
+                .curve_through(c, samples, (start, end), goal)
+                .map_err(|e| RebuildError::Curve { index: ci, why: Box::new(e) })?;
             if err <= goal {
                 worst = worst.max(err);
                 out.push(curve);
                 break;
             }
             if samples * 2 > MAX_CURVE_SAMPLES {
-                return Err(format!("curve {ci}: stays {err:.3e} from the original trim curve (goal {goal:.3e})"));
+                let why = Box::new(RebuildError::CurveTooFar { error: err, goal });
+                return Err(RebuildError::Curve { index: ci, why });
             }
             samples *= 2;
         }
@@ -428,7 +430,7 @@ impl<'a> Lander<'a> {
         samples: usize,
         (start, end): (DVec2, DVec2),
         goal: f64,
-    ) -> Result<(NurbsCurve, f64), String> {
+    ) -> Result<(NurbsCurve, f64), RebuildError> {
         let (old, new) = (self.old, self.new);
         let (a, b) = c.domain();
         // Dense model-space polyline of the old curve, 8 points per sample interval.
@@ -475,7 +477,7 @@ impl<'a> Lander<'a> {
         // The samples are equally spaced in model space: equal parameter steps keep the
         // curve from curling where (u,v) speed varies along it.
         let params: Vec<f64> = (0..=samples).map(|i| i as f64 / samples as f64).collect();
-        let curve = interpolate_curve(&st, &params).map_err(|e| format!("{e}"))?;
+        let curve = interpolate_curve(&st, &params)?;
         // Check: mid-points of the new curve against the old polyline nearby.
         let mut err = 0.0f64;
         if !degenerate {

@@ -18,23 +18,8 @@ use glam::DVec2;
 use super::trim::{signed_area, CurveRef, Loops, Polyline};
 use crate::collections::HashMap;
 
-/// What mending changed, for the face's warning.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub(crate) struct Mended {
-    /// Points where two segments crossed, touched or overlapped.
-    pub crossings: usize,
-    /// Loops of the input that came out changed or were merged.
-    pub loops_before: usize,
-    /// Loops after mending.
-    pub loops_after: usize,
-    /// Pieces dropped for enclosing no area.
-    pub dropped: usize,
-    /// Whether the loops were cut and rejoined (false when only whole
-    /// loops of no area were dropped).
-    pub rejoined: bool,
-    /// Whole loops of the file dropped before mending for enclosing no area.
-    pub flat: usize,
-}
+/// What mending changed, for the face's warning (a warning's payload).
+pub(crate) use crate::warning::Mended;
 
 /// Most segments mended at once: the work grows with their square in the
 /// worst case, and a face with more is skipped as before.
@@ -99,32 +84,6 @@ impl Points {
 enum Cut {
     Node(u32),
     At(DVec2),
-}
-
-impl core::fmt::Display for Mended {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        let plural = |n: usize| if n == 1 { "" } else { "s" };
-        if self.rejoined {
-            if self.crossings > 0 {
-                write!(f, "trim loops crossed or touched at {} places", self.crossings)?;
-            } else {
-                write!(f, "trim loops folded back on themselves or lay outside the outer loop")?;
-            }
-            let (before, after) = (self.loops_before, self.loops_after);
-            write!(f, "; mended to the region they wind round ({before} loop{} became {after}", plural(before))?;
-            if self.dropped > 0 {
-                write!(f, ", {} piece{} of no area dropped", self.dropped, plural(self.dropped))?;
-            }
-            write!(f, ")")?;
-            if self.flat > 0 {
-                write!(f, "; ")?;
-            }
-        }
-        if self.flat > 0 {
-            write!(f, "{} trim loop{} enclosing no area dropped", self.flat, plural(self.flat))?;
-        }
-        Ok(())
-    }
 }
 
 /// Mends `loops` in place so that they neither cross nor touch: returns

@@ -24,7 +24,6 @@ mod trial;
 mod trim;
 mod variant;
 
-use alloc::format;
 use alloc::vec::Vec;
 
 use crate::mesh::FaceRange;
@@ -34,6 +33,7 @@ use crate::nurbs::Surface;
 use crate::options::{MeshOptions, Reparam, Tolerance};
 use crate::reparam::{rebuild_face, step_ratio, Rebuilt, ReparamFace, RATIO_LIMIT};
 use crate::report::{MeshResult, Report};
+use crate::warning::{Reparameterized, Warning, WarningKind};
 use crate::{Error, Mesh, Model};
 use pipeline::{faces_of_share, Plan};
 pub(crate) use tessellated::append_unsewn;
@@ -111,11 +111,8 @@ fn reparameterize(model: &Model, mine: &[bool], mode: Reparam, tol: f64, report:
         }
         match rebuild_face(f, tol) {
             Ok(r) => {
-                report.warnings.push(format!(
-                    "face {index}: poorly parameterized (step ratio {ratio:.1}), rebuilt from {} x {} points \
-                     within {:.2e} of the original",
-                    r.samples[0], r.samples[1], r.fit_error
-                ));
+                let outcome = Reparameterized::Rebuilt { samples: r.samples, fit_error: r.fit_error };
+                report.warnings.push(Warning::face(index, WarningKind::PoorlyParameterized { ratio, outcome }));
                 report.reparameterized.push(ReparamFace {
                     face: index,
                     ratio,
@@ -126,9 +123,8 @@ fn reparameterize(model: &Model, mine: &[bool], mode: Reparam, tol: f64, report:
                 out.push(Some(r));
             }
             Err(why) => {
-                report.warnings.push(format!(
-                    "face {index}: poorly parameterized (step ratio {ratio:.1}), meshed as it is: {why}"
-                ));
+                let outcome = Reparameterized::MeshedAsIs(why);
+                report.warnings.push(Warning::face(index, WarningKind::PoorlyParameterized { ratio, outcome }));
                 report.reparameterized.push(ReparamFace {
                     face: index,
                     ratio,

@@ -7,7 +7,6 @@
 //! benches time the same stages (`surfmesh::pipeline`, hidden from the docs;
 //! not a stable API).
 
-use alloc::format;
 use alloc::vec::Vec;
 
 #[cfg(feature = "std")]
@@ -22,6 +21,7 @@ use crate::model::{body_count, share_of_faces};
 use crate::options::MeshOptions;
 use crate::reparam::Rebuilt;
 use crate::report::{MeshResult, Report};
+use crate::warning::{Warning, WarningKind};
 use crate::{Error, Mesh, Model, TrimLoop};
 
 /// What every stage reads: the model, the options and the limits they come
@@ -241,7 +241,7 @@ impl<'m> Plan<'m> {
                 // model where none can is the first face's error.
                 Err(Error::Mesh { face, message }) if self.model.faces.len() > 1 => {
                     run.report.faces_skipped += 1;
-                    run.report.warnings.push(format!("face {index}: skipped: {message}"));
+                    run.report.warnings.push(Warning::face(index, WarningKind::FaceSkipped(message.clone())));
                     run.first_failure.get_or_insert(Error::Mesh { face, message });
                     None
                 }
@@ -297,17 +297,15 @@ impl<'m> Plan<'m> {
                     continue;
                 }
                 Err(Error::Mesh { face, message }) if n > 1 => {
-                    let why = format!("face {index}: skipped: {message}");
+                    let why = WarningKind::FaceSkipped(message.clone());
                     run.first_failure.get_or_insert(Error::Mesh { face, message });
                     why
                 }
-                Err(Error::Limit(m)) if n > 1 && budget < self.options.max_triangles => {
-                    format!("face {index}: skipped, the triangle budget is spent ({m})")
-                }
+                Err(Error::Limit(m)) if n > 1 && budget < self.options.max_triangles => WarningKind::BudgetSpent(m),
                 Err(e) => return Err(e),
             };
             run.report.faces_skipped += 1;
-            run.report.warnings.push(why);
+            run.report.warnings.push(Warning::face(index, why));
             works.faces.push(empty_work(f, self.crit));
             works.fit_errors.push(0.0);
         }
@@ -432,24 +430,17 @@ impl<'m> Plan<'m> {
             report.inverted_triangles +=
                 (0..w.mesh.tris.len()).filter(|&t| w.mesh.folded_beyond(w.surface, t, 1e-6 * self.tol)).count();
             if w.mesh.tris.is_empty() {
-                if self.mine[index] && !report.warnings.iter().any(|x| x.starts_with(&format!("face {index}: "))) {
+                if self.mine[index] && !report.warnings.iter().any(|x| x.face == Some(index)) {
                     report.faces_skipped += 1;
-                    report.warnings.push(empty_face_warning(index, works.pinched[index]));
+                    let pinched = works.pinched[index];
+                    report.warnings.push(Warning::face(index, WarningKind::NoTriangles { pinched }));
                 }
             } else if out.unproven > 0 {
-                report.warnings.push(format!(
-                    "face {index}: {} triangles still exceed the limits ({})",
-                    out.unproven,
-                    if works.budget_hit { "triangle budget reached" } else { "edges at the minimum length" }
-                ));
+                let kind = WarningKind::Unproven { count: out.unproven, budget: works.budget_hit };
+                report.warnings.push(Warning::face(index, kind));
             }
             if out.creased > 0 {
-                report.warnings.push(format!(
-                    "face {index}: {} triangles turn more than the angle limit where the surface folds or \
-                     creases; not split below a tenth of the tolerance (below the tolerance where it turns \
-                     past a right angle)",
-                    out.creased
-                ));
+                report.warnings.push(Warning::face(index, WarningKind::Creased { count: out.creased }));
             }
         }
     }
@@ -491,11 +482,12 @@ impl<'m> Plan<'m> {
         // A crack wider than sewing reaches is the file's own gap: say where.
         let sew_tol = self.sew_tol;
         for g in gaps.iter().filter(|g| g.width > sew_tol) {
-            report.warnings.push(format!(
-                "faces {} and {}: their borders lie {:.3e} apart where they meet, farther than sewing closes \
-                 ({sew_tol:.3e}); the crack between them is left open",
-                g.faces.0, g.faces.1, g.width
-            ));
+            let kind = WarningKind::FacesApart {
+                faces: (g.faces.0 as usize, g.faces.1 as usize),
+                width: g.width,
+                sewing: sew_tol,
+            };
+            report.warnings.push(Warning::new(kind));
         }
         report.take_edges_and_angles(&edges, &mesh);
         tessellated::finish_report(self.model, &self.mine, &mesh, dropped, &mut report);
@@ -508,20 +500,6 @@ pub(super) fn faces_of_share(model: &Model, options: &MeshOptions) -> Vec<bool> 
     match options.share {
         Some((index, count)) => share_of_faces(&model.bodies, model.face_count(), index, count),
         None => alloc::vec![true; model.face_count()],
-    }
-}
-
-/// Why face `index` has no triangles; `pinched`: a loop of its sewn outline
-/// passes one node twice.
-fn empty_face_warning(index: usize, pinched: bool) -> alloc::string::String {
-    if pinched {
-        // A strip narrower than the sewing distance, its two sides sewn into one border.
-        format!(
-            "face {index}: produced no triangles: a strip narrower than the sewing distance, \
-             its sides sewn into one border by its neighbours"
-        )
-    } else {
-        format!("face {index}: produced no triangles")
     }
 }
 

@@ -17,7 +17,6 @@
 //! vertices, so welding leaves no crack.
 
 use crate::collections::{CellGrid, HashMap};
-use alloc::string::String;
 use alloc::vec::Vec;
 use glam::DVec3;
 
@@ -26,6 +25,7 @@ use super::sew::FaceWork;
 use crate::mesh::{FaceRange, Mesh};
 use crate::model::{body_of, Model, TessellatedFace};
 use crate::report::Report;
+use crate::warning::{Warning, WarningKind};
 
 const NONE: u32 = u32::MAX;
 
@@ -267,18 +267,10 @@ pub(crate) fn finish_report(model: &Model, mine: &[bool], mesh: &Mesh, dropped: 
     report.vertices = mesh.positions.len();
     if count > 0 {
         let triangles: usize = mesh.face_ranges.get(first..).map_or(0, |r| r.iter().map(|r| r.count as usize).sum());
-        let faces = if count == 1 { "1 tessellated face" } else { "tessellated faces" };
-        let n = if count == 1 { String::new() } else { alloc::format!("{count} ") };
-        report.warnings.push(alloc::format!(
-            "{n}{faces} ({triangles} triangles) without an exact surface: their triangles are the file's, and \
-             the deviation figures cover the other faces only"
-        ));
+        report.warnings.push(Warning::new(WarningKind::TessellatedFaces { count, triangles }));
     }
     if dropped > 0 {
-        report.warnings.push(alloc::format!(
-            "tessellated faces: {dropped} triangles that name a point twice, one past the points or one not \
-             finite left out"
-        ));
+        report.warnings.push(Warning::new(WarningKind::TessellatedDropped { count: dropped }));
     }
 }
 

@@ -2,10 +2,10 @@
 //! original, how the rebuild may spend the triangles it saves (shorter
 //! edges, needles mended), and the judge that keeps one of the two.
 
-use alloc::format;
 use alloc::vec::Vec;
 
 use super::{collapse, face, params, refine};
+use crate::warning::RebuildLoss;
 use crate::Error;
 
 /// The unsewn outline a trial mesh made, taken out of it.
@@ -134,24 +134,20 @@ pub(super) fn p1(m: &refine::WorkMesh) -> f64 {
 pub(super) fn rebuild_loses(
     rebuilt: &Result<face::FaceResult<'_>, Error>,
     original: &Result<face::FaceResult<'_>, Error>,
-) -> Option<alloc::string::String> {
+) -> Option<RebuildLoss> {
     let new = match rebuilt {
         Ok(r) if !r.mesh.tris.is_empty() => r,
-        Ok(_) => return Some("the rebuilt face gave no triangles".into()),
-        Err(e) => return Some(format!("the rebuilt face did not mesh ({e})")),
+        Ok(_) => return Some(RebuildLoss::NoTriangles),
+        Err(e) => return Some(RebuildLoss::DidNotMesh(e.clone())),
     };
     let old = original.as_ref().ok()?;
     let (nt, ot) = (new.mesh.tris.len(), old.mesh.tris.len());
     if new.outcome.unproven > old.outcome.unproven {
-        Some(format!("the rebuilt face left {} triangles unproven", new.outcome.unproven))
+        Some(RebuildLoss::Unproven(new.outcome.unproven))
     } else if nt > ot {
-        Some(format!("the rebuilt face took more triangles ({nt} against {ot})"))
+        Some(RebuildLoss::MoreTriangles(nt, ot))
     } else if p1(&new.mesh) < p1(&old.mesh) {
-        Some(format!(
-            "the rebuilt face's triangles were worse shaped (1st-percentile angle {:.1}° against {:.1}°)",
-            p1(&new.mesh),
-            p1(&old.mesh)
-        ))
+        Some(RebuildLoss::WorseShaped(p1(&new.mesh), p1(&old.mesh)))
     } else {
         None
     }

@@ -2,7 +2,6 @@
 //! with the limits it is meshed within and (with `std`) its outline, the
 //! loops discretized and the grid inside them (paper 000 §1–§3, §5).
 
-use alloc::format;
 use alloc::vec::Vec;
 
 #[cfg(feature = "std")]
@@ -12,6 +11,7 @@ use super::trial::{lift_needles, outline_of, rebuild_loses, shorter_edges, tris_
 use super::{face, face_loops, params, refine};
 use crate::options::Reparam;
 use crate::report::Report;
+use crate::warning::{Warning, WarningKind};
 use crate::{Error, Face};
 
 /// A face as it will be meshed: the variant chosen (the original or paper
@@ -80,7 +80,7 @@ impl<'a> Chosen<'a> {
 
     /// Without the trimmed mesher there are no loops to mend.
     #[cfg(not(feature = "std"))]
-    fn mended(&self) -> Option<&'static str> {
+    fn mended(&self) -> Option<crate::warning::Mended> {
         None
     }
 
@@ -166,7 +166,7 @@ impl<'m> Plan<'m> {
         };
         if !super::face_is_supported(v.face) {
             report.faces_skipped += 1;
-            report.warnings.push(format!("face {index}: trimmed faces need the default `std` feature (CDT); skipped"));
+            report.warnings.push(Warning::face(index, WarningKind::NeedsStd));
             return Ok(None);
         }
         let mut made: Made<'p> = Vec::new();
@@ -179,14 +179,11 @@ impl<'m> Plan<'m> {
             made.into_iter().find(|(g, l, _)| core::ptr::eq(*g, v.face) && l.same_as(&v.lim)).map(|(_, _, o)| o);
         let c = Chosen::new(index, v.face, loops, (v.lim, v.crit), v.fit_error, ready)?;
         if let Some(m) = c.mended() {
-            report.warnings.push(format!("face {index}: {m}"));
+            report.warnings.push(Warning::face(index, WarningKind::LoopsMended(m)));
         }
         if let Some(along) = c.capped_grid() {
-            report.warnings.push(format!(
-                "face {index}: the grid along {along} stopped at its cap of {} lines (the surface's \
-                 normals or sag never settle there); refinement still holds the tolerance",
-                params::MAX_PARAMS
-            ));
+            let kind = WarningKind::GridCapped { along, cap: params::MAX_PARAMS };
+            report.warnings.push(Warning::face(index, kind));
         }
         Ok(Some(c))
     }
@@ -239,7 +236,7 @@ impl<'m> Plan<'m> {
             }
         }
         if let Some(why) = why {
-            report.warnings.push(format!("face {index}: {why}; meshed the original"));
+            report.warnings.push(Warning::face(index, WarningKind::RebuildLost(why)));
             if let Some(r) = report.reparameterized.iter_mut().find(|r| r.face == index) {
                 r.rebuilt = false;
             }

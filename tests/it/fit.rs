@@ -6,7 +6,7 @@
 use glam::{DVec2, DVec3};
 use surfmesh::{
     edge_counts, fit_points, project_to_surface, read_iges, read_points, Error, FitOptions, FitResult, PointFormat,
-    ProjectionOptions, Surface,
+    ProjectionOptions, Surface, WarningKind,
 };
 
 /// Deterministic uniform numbers in [0, 1) (xorshift64*), fixed seeds.
@@ -330,7 +330,7 @@ fn points_on_one_plane_give_the_flat_region_they_span() {
     let f = measure("plane", &pts, &fit, 6, |p| (p - o).dot(normal).abs());
     assert!(f.max_distance < 1e-12);
     assert!(fit.mesh.positions.iter().all(|p| (*p - o).dot(normal).abs() < 1e-12));
-    assert!(fit.report.warnings.iter().any(|w| w.contains("one plane")), "{:?}", fit.report.warnings);
+    assert!(fit.report.warnings.iter().any(|w| w.kind == WarningKind::Planar), "{:?}", fit.report.warnings);
 }
 
 #[test]
@@ -357,7 +357,11 @@ fn duplicate_points_merge_with_a_warning_and_are_still_interpolated() {
     let fit = fit_points(&pts, &FitOptions::default()).unwrap();
     assert_eq!(fit.report.duplicates_merged, 2);
     assert_eq!(fit.point_index[60], fit.point_index[7]);
-    assert!(fit.report.warnings.iter().any(|w| w.starts_with("2 duplicate point(s) merged")));
+    let merged = |w: &&surfmesh::Warning| matches!(w.kind, WarningKind::DuplicatesMerged { count: 2, .. });
+    assert!(fit.report.warnings.iter().any(|w| merged(&w)), "{:?}", fit.report.warnings);
+    // The warning's text, as the report shows it.
+    let text = fit.report.warnings.iter().find(merged).unwrap().to_string();
+    assert!(text.starts_with("2 duplicate point(s) merged (closer than "), "{text}");
     measure("sphere with duplicates", &pts, &fit, 6, |p| ((p - c).length() - r).abs());
 }
 

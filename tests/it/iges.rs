@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use glam::DVec3;
-use surfmesh::{mesh_model, read_iges, read_model, Error, Format, Mesh, MeshOptions};
+use surfmesh::{mesh_model, read_iges, read_model, Entity, Error, Format, Mesh, MeshOptions, WarningKind};
 
 fn data(name: &str) -> Vec<u8> {
     std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)).unwrap()
@@ -119,9 +119,17 @@ fn truncated_file_reads_what_is_there() {
     let m = read_iges(&data("iges_truncated.igs")).unwrap();
     assert_eq!(m.faces.len(), 1, "{:?}", m.warnings);
     assert_eq!(m.faces[0].loops.len(), 2, "outer rectangle and circular hole");
-    let skipped: Vec<&String> = m.warnings.iter().filter(|w| w.contains("the entity is skipped")).collect();
+    let skipped: Vec<&Error> = m
+        .warnings
+        .iter()
+        .filter_map(|w| match &w.kind {
+            WarningKind::EntityDamaged(e) => Some(e),
+            _ => None,
+        })
+        .collect();
     assert_eq!(skipped.len(), 1, "{:?}", m.warnings);
-    assert!(skipped[0].contains("entity DE 31") && skipped[0].contains("(file truncated?)"), "{}", skipped[0]);
+    assert!(matches!(skipped[0], Error::Iges { entity: 31, .. }), "{}", skipped[0]);
+    assert!(skipped[0].to_string().contains("(file truncated?)"), "{}", skipped[0]);
     let text = String::from_utf8(data("iges_truncated.igs")).unwrap();
     let cut: String = text.lines().take(53).map(|l| format!("{l}\n")).collect();
     let (section, _, entity, message) = match read_iges(cut.as_bytes()) {
@@ -141,8 +149,9 @@ fn bad_parameter_pointer_skips_its_entity() {
     let m = read_iges(&data("iges_bad_pointer.igs")).unwrap();
     assert_eq!(m.faces.len(), 1);
     assert_eq!(m.faces[0].name.as_deref(), Some("FLANGE"));
+    // The warning's text, as the report shows it.
     assert_eq!(
-        m.warnings,
+        m.warnings.iter().map(ToString::to_string).collect::<Vec<_>>(),
         ["IGES Directory section, entity DE 19: parameter data pointer 999 is outside the Parameter section's \
           26 lines (file truncated?); the entity is skipped"]
     );
@@ -166,10 +175,9 @@ fn shifted_columns_are_read_when_blanks_shifted_them() {
     let shifted = text.lines().position(|l| l.len() > 80).unwrap() + 1;
     let m = read_iges(text.as_bytes()).unwrap();
     assert_eq!(m.faces.len(), 2, "{:?}", m.warnings);
-    assert_eq!(
-        m.warnings,
-        [format!("line {shifted}: a record pushed past column 80 by blanks before it; read without them")]
-    );
+    assert_eq!(m.warnings.len(), 1, "{:?}", m.warnings);
+    assert_eq!(m.warnings[0].kind, WarningKind::ShiftedRecord { line: shifted });
+    assert_eq!(m.warnings[0].more, 0);
     let junk: String = text
         .lines()
         .enumerate()
@@ -188,10 +196,12 @@ fn shifted_columns_are_read_when_blanks_shifted_them() {
 fn huge_counts_and_reference_cycles_skip_the_face_with_a_reason() {
     let m = read_iges(&data("iges_huge_count.igs")).unwrap();
     assert_eq!(m.faces.len(), 1, "the other face still reads");
-    assert!(m.warnings.iter().any(|w| w.contains("skipped") && w.contains("999999999")), "{:?}", m.warnings);
+    let skipped =
+        |w: &surfmesh::Warning, why: &str| matches!(&w.kind, WarningKind::Skipped(e) if e.to_string().contains(why));
+    assert!(m.warnings.iter().any(|w| skipped(w, "999999999")), "{:?}", m.warnings);
     let m = read_iges(&data("iges_cycle.igs")).unwrap();
     assert_eq!(m.faces.len(), 1);
-    assert!(m.warnings.iter().any(|w| w.contains("skipped") && w.contains("cycle")), "{:?}", m.warnings);
+    assert!(m.warnings.iter().any(|w| skipped(w, "cycle")), "{:?}", m.warnings);
 }
 
 /// The corpus cube (a B-rep solid: 186, 514, six 510 faces) with its first
@@ -207,7 +217,12 @@ fn a_skipped_brep_face_leaves_free_edges_along_its_border() {
     let broken = text.replace(record, "510,67,1,1,17;");
     let model = read_iges(broken.as_bytes()).unwrap();
     assert_eq!((model.faces.len(), model.skipped.len()), (5, 1));
-    assert!(model.warnings.iter().any(|w| w.starts_with("DE 5 (type 510): skipped")), "{:?}", model.warnings);
+    let de5 = Some(Entity::Iges { de: 5, kind: 510 });
+    assert!(
+        model.warnings.iter().any(|w| w.entity == de5 && matches!(w.kind, WarningKind::Skipped(_))),
+        "{:?}",
+        model.warnings
+    );
     // Its border: the face's loop, four straight edges 10 mm long.
     let border = &model.skipped[0].border;
     assert_eq!(border.len(), 4);
@@ -222,7 +237,7 @@ fn a_skipped_brep_face_leaves_free_edges_along_its_border() {
     assert_eq!((rep.faces, rep.faces_unread), (5, 1));
     assert!(rep.boundary_edges >= 4, "{} boundary edges", rep.boundary_edges);
     assert_eq!(rep.free_edges, rep.boundary_edges, "every open edge runs round the hole");
-    assert!(rep.warnings.iter().any(|w| w.starts_with("1 face(s) of the file could not be read: the mesh has holes")));
+    assert!(rep.warnings.iter().any(|w| matches!(w.kind, WarningKind::UnreadFaces { count: 1, holes } if holes > 0)));
 }
 
 /// An 80-column record: `data` in columns 1-72, the section letter, the sequence number.
@@ -300,7 +315,8 @@ fn fuzz_timeout_off_surface_trim_curve_reads_and_fails_cleanly() {
     let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(0.05)).expect("the other faces mesh");
     assert_eq!(r.report.faces_skipped, 0, "{:?}", r.report.warnings);
     let w = &r.report.warnings;
-    assert!(w.iter().any(|w| w.starts_with("face 1: trim loops crossed") && w.contains("mended")), "{w:?}");
+    let mended = |w: &surfmesh::Warning| matches!(w.kind, WarningKind::LoopsMended(m) if m.crossings > 0 && m.rejoined);
+    assert!(w.iter().any(|w| w.face == Some(1) && mended(w)), "{w:?}");
     assert_eq!(r.mesh.face_ranges.len(), 5);
     assert!(r.report.max_deviation <= r.report.tolerance, "{} > {}", r.report.max_deviation, r.report.tolerance);
     assert!(r.mesh.face_ranges.iter().enumerate().all(|(i, f)| i == 1 || f.count > 0));

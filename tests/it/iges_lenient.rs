@@ -4,7 +4,7 @@
 //! What no tolerance reads stays an error naming its place.
 
 use super::data;
-use surfmesh::{mesh_model, read_iges, Error, MeshOptions, Model};
+use surfmesh::{mesh_model, read_iges, Entity, Error, MeshOptions, Model, Warning, WarningKind};
 
 /// Area of the model's mesh at a relative tolerance of 1e-3.
 fn meshed_area(model: &Model) -> f64 {
@@ -19,17 +19,22 @@ fn meshed_area(model: &Model) -> f64 {
 }
 
 /// Reads `bytes`, checks it is the square, and returns its warnings.
-fn square_warnings(name: &str, bytes: &[u8]) -> Vec<String> {
+fn square_warnings(name: &str, bytes: &[u8]) -> Vec<Warning> {
     one_face_warnings(name, bytes, 100.0)
 }
 
 /// Reads `bytes`, checks it is one face of area `area`, and returns its warnings.
-fn one_face_warnings(name: &str, bytes: &[u8], area: f64) -> Vec<String> {
+fn one_face_warnings(name: &str, bytes: &[u8], area: f64) -> Vec<Warning> {
     let model = read_iges(bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
     assert_eq!(model.faces.len(), 1, "{name}: {:?}", model.warnings);
     let meshed = meshed_area(&model);
     assert!((meshed - area).abs() < 1e-9, "{name}: area {meshed}, {area} expected");
     model.warnings
+}
+
+/// The warnings' text, as the report shows them.
+fn texts(w: &[Warning]) -> Vec<String> {
+    w.iter().map(ToString::to_string).collect()
 }
 
 #[test]
@@ -43,7 +48,7 @@ fn the_square_itself_reads_without_warnings() {
 fn a_parameter_count_past_the_section_reads_what_is_there() {
     let w = square_warnings("overrun", &data("iges_lenient_overrun.igs"));
     assert_eq!(
-        w,
+        texts(&w),
         ["IGES Directory section, entity DE 1: parameter data lines 1..20 run past the Parameter section's 2 lines; \
           read up to the entity's ';'"]
     );
@@ -63,22 +68,24 @@ fn a_parameter_count_past_the_section_reads_what_is_there() {
 #[test]
 fn records_without_line_breaks_are_split_at_80_columns() {
     let w = square_warnings("unbroken", &data("iges_lenient_unbroken.igs"));
-    assert_eq!(w, ["line 1: 9 records of 80 columns with no line breaks between them; read as lines 1..9"]);
+    assert_eq!(texts(&w), ["line 1: 9 records of 80 columns with no line breaks between them; read as lines 1..9"]);
+    assert_eq!(w[0].kind, WarningKind::UnbrokenRecords { line: 1, records: 9, first: 1 });
 }
 
 #[test]
 fn a_missing_global_section_takes_the_defaults() {
     let w = square_warnings("no global", &data("iges_lenient_no_global.igs"));
-    assert_eq!(w, ["no Global section: the default delimiters, scale and unit are used"]);
+    assert_eq!(w.iter().map(|w| &w.kind).collect::<Vec<_>>(), [&WarningKind::NoGlobal]);
     // A Global section that cannot be read: the same, naming what is wrong.
     let text = String::from_utf8(data("iges_square.igs")).unwrap().replacen("1H,,1H;,", "2H,,1H;,", 1);
     let w = square_warnings("bad global", text.as_bytes());
     assert_eq!(w.len(), 1, "{w:?}");
-    assert!(
-        w[0].starts_with("IGES Global section line 2: field 1")
-            && w[0].ends_with("the default delimiters, scale and unit are used"),
-        "{w:?}"
-    );
+    match &w[0].kind {
+        WarningKind::BadGlobal(Error::Iges { section: "Global", line: 2, message, .. }) => {
+            assert!(message.starts_with("field 1"), "{message}")
+        }
+        other => panic!("expected the Global section's error, got {other:?}"),
+    }
 }
 
 /// Section letters in lower case: read as upper case.
@@ -90,7 +97,8 @@ fn lower_case_section_letters_are_read() {
         .map(|l| format!("{}{}{}\n", &l[..72], l[72..73].to_ascii_lowercase(), &l[73..]))
         .collect();
     let w = square_warnings("lower case", text.as_bytes());
-    assert_eq!(w, ["line 1: the section letter in lower case; read as upper case (and 8 more like it)"]);
+    assert_eq!(texts(&w), ["line 1: the section letter in lower case; read as upper case (and 8 more like it)"]);
+    assert_eq!((&w[0].kind, w[0].more), (&WarningKind::LowerCaseSection { line: 1 }, 8));
 }
 
 /// The square trimmed to [2, 8]² by four 126 lines whose parameter ranges
@@ -100,7 +108,7 @@ fn lower_case_section_letters_are_read() {
 fn an_empty_curve_range_is_read_as_the_whole_curve() {
     let w = one_face_warnings("empty range", &data("iges_lenient_empty_range.igs"), 36.0);
     assert_eq!(
-        w,
+        texts(&w),
         ["IGES Parameter section line 23, entity DE 3: B-spline curve's parameter range [0, 0] holds none of the \
           curve; its whole domain [0, 1] is used (and 3 more like it)"]
     );
@@ -108,7 +116,9 @@ fn an_empty_curve_range_is_read_as_the_whole_curve() {
     let text = String::from_utf8(data("iges_lenient_empty_range.igs")).unwrap().replace(",0,0,0,0,1;", ",1,0,0,0,1;");
     let w = one_face_warnings("inverted range", text.as_bytes(), 36.0);
     assert_eq!(w.len(), 1, "{w:?}");
-    assert!(w[0].contains("range [1, 0] is inverted; read as [0, 1] (and 3 more like it)"), "{w:?}");
+    assert!(matches!(&w[0].kind, WarningKind::Forgiven(Error::Iges { entity: 3, .. })), "{w:?}");
+    assert_eq!(w[0].more, 3, "{w:?}");
+    assert!(w[0].to_string().contains("range [1, 0] is inverted; read as [0, 1] (and 3 more like it)"), "{w:?}");
 }
 
 /// A 308 definition holding the 10 × 10 square, placed by three 408
@@ -157,5 +167,7 @@ fn subfigure_instances_place_their_definitions() {
     let model = read_iges(text.as_bytes()).unwrap();
     assert_eq!(model.faces.len(), 2, "{:?}", model.warnings);
     assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
-    assert!(model.warnings[0].starts_with("DE 15 (type 408): skipped") && model.warnings[0].contains("(a cycle?)"));
+    let w = &model.warnings[0];
+    assert_eq!(w.entity, Some(Entity::Iges { de: 15, kind: 408 }), "{w:?}");
+    assert!(matches!(&w.kind, WarningKind::Skipped(e) if e.to_string().contains("(a cycle?)")), "{w:?}");
 }

@@ -6,7 +6,7 @@
 use glam::{DVec2, DVec3};
 use surfmesh::{
     mesh_model, project_to_surface, Error, Face, FaceSurface, Mesh, MeshOptions, MeshResult, Model, NurbsCurve,
-    NurbsSurface, ProjectionOptions, Surface, TrimLoop,
+    NurbsSurface, ProjectionOptions, Surface, TrimLoop, Warning, WarningKind,
 };
 
 use crate::shapes;
@@ -271,7 +271,8 @@ fn mesh_mends_crossing_loops_to_the_region_they_wind_round() {
     let b = uv_polygon(&[(0.5, 0.5), (0.5, 0.8), (0.8, 0.8), (0.8, 0.5)]);
     let r = mesh_model(&flat_face_with_loops(vec![outer.clone(), a, b]), &MeshOptions::default()).expect("mended");
     let w = &r.report.warnings;
-    assert!(w.iter().any(|w| w.starts_with("face 0: trim loops crossed") && w.contains("mended")), "{w:?}");
+    let crossed = |w: &Warning| matches!(w.kind, WarningKind::LoopsMended(m) if m.crossings > 0 && m.rejoined);
+    assert!(w.iter().any(|w| w.face == Some(0) && crossed(w)), "{w:?}");
     // The square less the union of the two holes (0.09 + 0.09 - 0.01).
     let area = mesh_area(&r.mesh);
     assert!((area - 100.0 * (0.64 - 0.17)).abs() < 1e-6, "area {area}");
@@ -285,7 +286,8 @@ fn mesh_mends_crossing_loops_to_the_region_they_wind_round() {
     // A bow tie: the lobe that runs counter-clockwise is the region.
     let bow = uv_polygon(&[(0.1, 0.1), (0.9, 0.9), (0.9, 0.1), (0.1, 0.9)]);
     let r = mesh_model(&flat_face_with_loops(vec![bow]), &MeshOptions::default()).expect("one lobe");
-    assert!(r.report.warnings.iter().any(|w| w.contains("mended")), "{:?}", r.report.warnings);
+    let mended = |w: &Warning| matches!(w.kind, WarningKind::LoopsMended(m) if m.rejoined);
+    assert!(r.report.warnings.iter().any(mended), "{:?}", r.report.warnings);
     let area = mesh_area(&r.mesh);
     assert!((area - 16.0).abs() < 1e-6, "one lobe of 0.16 in (u,v): area {area}");
 
@@ -293,7 +295,10 @@ fn mesh_mends_crossing_loops_to_the_region_they_wind_round() {
     let flat = uv_polygon(&[(0.3, 0.3), (0.6, 0.6), (0.45, 0.45)]);
     let r = mesh_model(&flat_face_with_loops(vec![outer.clone(), flat]), &MeshOptions::default()).expect("meshes");
     let w = &r.report.warnings;
-    assert!(w.iter().any(|w| w == "face 0: 1 trim loop enclosing no area dropped"), "{w:?}");
+    // The warning's text, as the report shows it.
+    assert!(w.iter().any(|w| w.to_string() == "face 0: 1 trim loop enclosing no area dropped"), "{w:?}");
+    let flat = |w: &Warning| matches!(w.kind, WarningKind::LoopsMended(m) if m.flat == 1 && !m.rejoined);
+    assert!(w.iter().any(|w| w.face == Some(0) && flat(w)), "{w:?}");
     assert!((mesh_area(&r.mesh) - 64.0).abs() < 1e-6);
 
     // A clockwise loop beside the outer loop is a hole of nothing; a
@@ -303,7 +308,7 @@ fn mesh_mends_crossing_loops_to_the_region_they_wind_round() {
     for (beside, want) in [(cw.to_vec(), 64.0), (ccw, 64.0 + 1.8)] {
         let loops = vec![outer.clone(), uv_polygon(&beside)];
         let r = mesh_model(&flat_face_with_loops(loops), &MeshOptions::default()).expect("meshes");
-        assert!(r.report.warnings.iter().any(|w| w.contains("mended")), "{:?}", r.report.warnings);
+        assert!(r.report.warnings.iter().any(mended), "{:?}", r.report.warnings);
         let area = mesh_area(&r.mesh);
         assert!((area - want).abs() < 1e-6, "area {area}, want {want}");
     }
@@ -324,7 +329,10 @@ fn mesh_skips_a_bad_face_among_good_ones() {
     let r = mesh_model(&model, &MeshOptions::default()).expect("the good faces mesh");
     assert_eq!(r.report.faces_skipped, 1);
     assert!(
-        r.report.warnings.iter().any(|w| w.starts_with("face 1: skipped") && w.contains("area")),
+        r.report
+            .warnings
+            .iter()
+            .any(|w| w.face == Some(1) && matches!(&w.kind, WarningKind::FaceSkipped(why) if why.contains("area"))),
         "{:?}",
         r.report.warnings
     );
@@ -356,7 +364,11 @@ fn mesh_cone_apex_meets_the_angle_limit() {
     for rel in RELS {
         let r = mesh(&model, rel);
         let rep = &r.report;
-        assert!(rep.warnings.iter().all(|w| !w.contains("exceed")), "{rel}: {:?}", rep.warnings);
+        assert!(
+            rep.warnings.iter().all(|w| !matches!(w.kind, WarningKind::Unproven { .. })),
+            "{rel}: {:?}",
+            rep.warnings
+        );
         assert!(rep.max_deviation <= rep.tolerance, "{rel}: {} > {}", rep.max_deviation, rep.tolerance);
         assert_eq!(rep.inverted_triangles, 0);
         // A cone is flat along its rulings: a fan of a few dozen to a few hundred triangles, not thousands.
@@ -587,14 +599,26 @@ fn mesh_names_a_gap_wider_than_sewing_and_its_width() {
     let tol = 1.0;
     let r = mesh_model(&row_with_one_gap(0.7 * tol), &MeshOptions::default().with_tolerance(tol)).expect("meshes");
     assert!(r.report.free_edges > 0, "the gap is a crack");
-    let gaps: Vec<&String> = r.report.warnings.iter().filter(|w| w.contains("apart where they meet")).collect();
+    let gaps: Vec<(usize, usize, f64)> = r
+        .report
+        .warnings
+        .iter()
+        .filter_map(|w| match w.kind {
+            WarningKind::FacesApart { faces: (a, b), width, .. } => Some((a, b, width)),
+            _ => None,
+        })
+        .collect();
     assert_eq!(gaps.len(), 1, "{:?}", r.report.warnings);
-    assert!(gaps[0].starts_with("faces 29 and 30: their borders lie "), "{}", gaps[0]);
-    let width: f64 = gaps[0]["faces 29 and 30: their borders lie ".len()..].split(' ').next().unwrap().parse().unwrap();
+    let (a, b, width) = gaps[0];
+    assert_eq!((a, b), (29, 30));
     assert!(width >= 0.7 * tol - 1e-9 && width < tol, "{width}");
+    // The text names both faces and the width, rounded as the report shows it.
+    let text = r.report.warnings.iter().find(|w| matches!(w.kind, WarningKind::FacesApart { .. })).unwrap().to_string();
+    assert!(text.starts_with(&format!("faces 29 and 30: their borders lie {width:.3e} apart")), "{text}");
     // Sewn gaps leave no such warning.
     let sewn = mesh_model(&row_with_one_gap(0.3 * tol), &MeshOptions::default().with_tolerance(tol)).expect("meshes");
-    assert!(sewn.report.warnings.iter().all(|w| !w.contains("apart where they meet")), "{:?}", sewn.report.warnings);
+    let apart = |w: &Warning| matches!(w.kind, WarningKind::FacesApart { .. });
+    assert!(!sewn.report.warnings.iter().any(apart), "{:?}", sewn.report.warnings);
 }
 
 /// Three flat faces round a corner that misses: the right face's corner
@@ -788,8 +812,10 @@ fn mesh_warns_when_a_grid_direction_reaches_its_cap() {
     // the border's 40 000 nodes at a time, not at thousands.
     let opts = MeshOptions::default().with_relative_tolerance(1e-6).with_max_edge(Some(1e-5)).with_max_triangles(1000);
     let r = mesh_model(&model, &opts).expect("meshes");
-    let capped: Vec<&String> = r.report.warnings.iter().filter(|w| w.contains("stopped at its cap")).collect();
+    let capped: Vec<&Warning> =
+        r.report.warnings.iter().filter(|w| matches!(w.kind, WarningKind::GridCapped { .. })).collect();
     assert_eq!(capped.len(), 1, "{:?}", r.report.warnings);
-    assert!(capped[0].starts_with("face 1: the grid along u"), "{}", capped[0]);
+    assert!(matches!(capped[0].kind, WarningKind::GridCapped { along: "u", .. }), "{:?}", capped[0]);
+    assert_eq!(capped[0].face, Some(1));
     assert_eq!(r.report.faces_skipped, 1, "{:?}", r.report.warnings);
 }

@@ -8,7 +8,7 @@ use std::path::Path;
 use glam::DVec3;
 use surfmesh::{
     find_self_intersections, mesh_model, offset_mesh, read_iges, read_json, read_mesh, repair_mesh, weld_mesh,
-    write_obj, write_stl, Bucketing, Error, Mesh, MeshFormat, MeshOptions, RepairOptions, RepairResult,
+    write_obj, write_stl, Bucketing, Error, Mesh, MeshFormat, MeshOptions, RepairOptions, RepairResult, WarningKind,
 };
 
 fn data(name: &str) -> Vec<u8> {
@@ -481,7 +481,11 @@ fn repair_of_an_open_corpus_part_keeps_its_border_and_crosses_nothing() {
     assert!(!find_self_intersections(&off).unwrap().is_empty());
     let r = repair_mesh(&off, &RepairOptions::default()).unwrap();
     eprintln!("bearing: {:?}", r.report);
-    assert!(r.report.warnings.iter().any(|w| w.contains("open")), "{:?}", r.report.warnings);
+    assert!(
+        r.report.warnings.iter().any(|w| matches!(w.kind, WarningKind::OpenInput { .. })),
+        "{:?}",
+        r.report.warnings
+    );
     let (free_out, nonmanifold_out, flipped) = census(&r.mesh);
     assert!(free_out > 0);
     assert_eq!((nonmanifold_out, flipped), (0, 0));
@@ -494,7 +498,7 @@ fn repair_of_an_open_corpus_part_keeps_its_border_and_crosses_nothing() {
     let nonmanifold = census(&r.mesh).1;
     eprintln!("bearing deeper: {nonmanifold} non-manifold edges, warnings {:?}", r.report.warnings);
     assert_eq!(nonmanifold, r.report.census_out.nonmanifold_edges);
-    assert_eq!(nonmanifold > 0, r.report.warnings.iter().any(|w| w.contains("not a clean 2-manifold")));
+    assert_eq!(nonmanifold > 0, r.report.warnings.iter().any(|w| matches!(w.kind, WarningKind::NotManifold { .. })));
 }
 
 // ------------------------------------------------------------ bad input
@@ -537,7 +541,11 @@ fn repair_keeps_an_open_mesh_open_and_says_so() {
     m.indices.truncate(m.indices.len() - 9);
     let r = repair_mesh(&m, &RepairOptions::default()).unwrap();
     assert!(r.report.free_edges_in > 0);
-    assert!(r.report.warnings.iter().any(|w| w.contains("open")), "{:?}", r.report.warnings);
+    assert!(
+        r.report.warnings.iter().any(|w| matches!(w.kind, WarningKind::OpenInput { .. })),
+        "{:?}",
+        r.report.warnings
+    );
     assert_eq!(r.mesh.triangle_count(), m.triangle_count());
     assert_eq!(census(&r.mesh).0, r.report.free_edges_in);
 }
@@ -551,7 +559,11 @@ fn repair_turns_an_inside_out_mesh_outward() {
     assert!(volume(&m) < 0.0);
     let r = repair_mesh(&m, &RepairOptions::default()).unwrap();
     assert!(volume(&r.mesh) > 0.0);
-    assert!(r.report.warnings.iter().any(|w| w.contains("inside out")), "{:?}", r.report.warnings);
+    assert!(
+        r.report.warnings.iter().any(|w| matches!(w.kind, WarningKind::InsideOut { .. })),
+        "{:?}",
+        r.report.warnings
+    );
 }
 
 mod random_input {

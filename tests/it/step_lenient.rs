@@ -4,7 +4,7 @@
 //! flaw's line and instance.
 
 use super::data;
-use surfmesh::{mesh_model, read_step, MeshOptions, Model};
+use surfmesh::{mesh_model, read_step, Entity, MeshOptions, Model, Warning, WarningKind};
 
 /// Area of the model's mesh at a relative tolerance of 1e-3.
 fn meshed_area(model: &Model) -> f64 {
@@ -19,12 +19,17 @@ fn meshed_area(model: &Model) -> f64 {
 }
 
 /// Reads `name`, checks it is the square, and returns its warnings.
-fn square_warnings(name: &str) -> Vec<String> {
+fn square_warnings(name: &str) -> Vec<Warning> {
     let model = read_step(&data(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
     assert_eq!(model.faces.len(), 1, "{name}: {:?}", model.warnings);
     let area = meshed_area(&model);
     assert!((area - 100.0).abs() < 1e-9, "{name}: area {area}");
     model.warnings
+}
+
+/// The warnings' text, as the report shows them.
+fn texts(w: &[Warning]) -> Vec<String> {
+    w.iter().map(ToString::to_string).collect()
 }
 
 #[test]
@@ -37,7 +42,7 @@ fn the_square_itself_reads_without_warnings() {
 #[test]
 fn a_duplicate_instance_number_keeps_the_first_definition() {
     let w = square_warnings("step_lenient_duplicate.stp");
-    assert_eq!(w, ["STEP line 21, #31: instance number defined twice; the first definition (line 20) is kept"]);
+    assert_eq!(texts(&w), ["STEP line 21, #31: instance number defined twice; the first definition (line 20) is kept"]);
 }
 
 /// The face's name ends inside a `\X2\` run, and so does its shell's: what
@@ -48,7 +53,7 @@ fn escapes_left_open_keep_their_text() {
     assert_eq!(model.faces[0].name.as_deref(), Some("Expression: \u{3b1}*\u{3b2}\u{f7}\u{3b3}"));
     let w = square_warnings("step_lenient_escapes.stp");
     assert_eq!(
-        w,
+        texts(&w),
         ["STEP line 40, #74: \\X2\\ or \\X4\\ escape not closed by \\X0\\; kept as raw text (and 1 more like it)"]
     );
 }
@@ -59,8 +64,9 @@ fn escapes_left_open_keep_their_text() {
 fn a_damaged_header_is_read_past() {
     let w = square_warnings("step_lenient_header.stp");
     assert_eq!(w.len(), 1, "{w:?}");
+    assert!(matches!(w[0].kind, WarningKind::Forgiven(_)), "{w:?}");
     assert_eq!(
-        w[0],
+        w[0].to_string(),
         "STEP line 2: HEADER section: line 5: a value is missing before ','; no FILE_NAME; no FILE_SCHEMA; \
          unknown header entity SOME_WRITER_STAMP; the DATA section is read anyway"
     );
@@ -79,8 +85,11 @@ fn a_string_that_never_closes_is_still_an_error() {
 #[test]
 fn a_missing_vertex_is_taken_from_the_next_edge_of_its_loop() {
     let w = square_warnings("step_lenient_dangling_vertex.stp");
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert_eq!(w[0].entity, Some(Entity::step(51, "EDGE_CURVE")));
+    assert_eq!(w[0].kind, WarningKind::VertexFromNeighbour { end: true, vertex: u64::MAX, lp: 70 });
     assert_eq!(
-        w,
+        texts(&w),
         ["#51 EDGE_CURVE: its end vertex #18446744073709551615 is not defined; \
           the point its neighbour in loop #70 gives is used"]
     );

@@ -155,33 +155,13 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
             "--max-edge" => options = options.with_max_edge(Some(number(&name, value()?)?)),
             "--min-edge" => options = options.with_min_edge(Some(number(&name, value()?)?)),
             "--max-triangles" => options = options.with_max_triangles(count(&name, value()?)?),
-            "--mode" => match value()?.to_str() {
-                Some("fast") => options = options.with_mode(MeshMode::Fast),
-                Some("quality") => options = options.with_mode(MeshMode::Quality),
-                _ => return Err("--mode must be fast or quality".into()),
-            },
+            "--mode" => options = options.with_mode(word::<MeshMode>(value()?)?),
             "--size" => size = Some(number(&name, value()?)?),
             "--size-rel" => size_rel = Some(number(&name, value()?)?),
-            "--method" => {
-                let method = match value()?.to_str() {
-                    Some("looping") => QualityMethod::Looping,
-                    Some("delaunay") => QualityMethod::Delaunay,
-                    Some("best") => QualityMethod::Best,
-                    _ => return Err("--method must be looping, delaunay or best".into()),
-                };
-                quality = quality.with_method(method);
-            }
+            "--method" => quality = quality.with_method(word::<QualityMethod>(value()?)?),
             "--weights" => quality = quality.with_weights(weights(&name, value()?)?),
             "--passes" => quality = quality.with_passes(count(&name, value()?)?),
-            "--reparam" => {
-                let mode = match value()?.to_str() {
-                    Some("auto") => Reparam::Auto,
-                    Some("off") => Reparam::Off,
-                    Some("force") => Reparam::Force,
-                    _ => return Err("--reparam must be auto, off or force".into()),
-                };
-                options = options.with_reparam(mode);
-            }
+            "--reparam" => options = options.with_reparam(word::<Reparam>(value()?)?),
             "--format" => {
                 let v = value()?;
                 format = Some(Format::from_name(&v.to_string_lossy()).map_err(|e| format!("--format: {e}"))?);
@@ -241,6 +221,12 @@ fn weights(name: &str, value: OsString) -> Result<[f64; 4], String> {
         .collect::<Result<_, _>>()
         .map_err(|_| bad())?;
     c.try_into().map_err(|_| bad())
+}
+
+/// An option's value parsed by its enum's `FromStr` (the JS binding's
+/// parser too); the error names the option as the CLI spells it.
+pub fn word<T: std::str::FromStr<Err = surfmesh::UnknownWord>>(value: OsString) -> Result<T, String> {
+    value.to_str().unwrap_or("").parse::<T>().map_err(|e| format!("--{e}"))
 }
 
 fn number(name: &str, value: OsString) -> Result<f64, String> {

@@ -358,10 +358,10 @@ fn check_file(a: &CheckArgs, path: &Path, name: &str, format: Format) -> Row {
         row.deviation_ratio = if rep.tolerance > 0.0 { rep.max_deviation / rep.tolerance } else { 0.0 };
         row.units = rep.units.clone();
         // Reader warnings first, as `mesh` reports them.
-        let mut warnings: Vec<&String> = model.warnings.iter().collect();
+        let mut warnings: Vec<&surfmesh::Warning> = model.warnings.iter().collect();
         warnings.extend(rep.warnings.iter().filter(|w| !model.warnings.contains(w)));
         row.warnings = warnings.len();
-        row.first_warning = warnings.first().map(|w| one_line(w));
+        row.first_warning = warnings.first().map(|w| one_line(&w.to_string()));
         Ok(())
     })();
     row.time_ms = start.elapsed().as_secs_f64() * 1e3;

@@ -63,14 +63,7 @@ pub fn parse(mut args: impl Iterator<Item = OsString>) -> Result<ReparamArgs, St
         match name.as_str() {
             "--tol" => tol = Some(number(&name, value()?)?),
             "--tol-rel" => tol_rel = Some(number(&name, value()?)?),
-            "--reparam" => {
-                mode = match value()?.to_str() {
-                    Some("auto") => Reparam::Auto,
-                    Some("off") => Reparam::Off,
-                    Some("force") => Reparam::Force,
-                    _ => return Err("--reparam must be auto, off or force".into()),
-                }
-            }
+            "--reparam" => mode = crate::args::word::<Reparam>(value()?)?,
             "--format" => {
                 let v = value()?;
                 format = Some(Format::from_name(&v.to_string_lossy()).map_err(|e| format!("--format: {e}"))?);

@@ -12,6 +12,7 @@ use super::{Ctx, MAX_CONTROL_POINTS, MAX_DEPTH};
 use crate::nurbs::analytic::{circle_arc, conic_segment, ellipse_arc, line};
 use crate::nurbs::reparam::{map_points, segment};
 use crate::nurbs::{NurbsCurve, MAX_DEGREE};
+use crate::warning::{Warning, WarningKind};
 use crate::Error;
 
 /// The model-space pieces of curve `de`, mapped by `parent` after the
@@ -321,7 +322,7 @@ fn bspline(ctx: &Ctx<'_>, e: &Entity) -> Result<NurbsCurve, Error> {
     let (v0, v1) = (r0.min(r1).max(a), r0.max(r1).min(b));
     let note = |kind: &'static str, what: alloc::string::String| {
         let m = alloc::format!("B-spline curve's parameter range [{r0}, {r1}] {what}");
-        ctx.notes.borrow_mut().note(kind, e.de, || alloc::format!("{}", e.error(m)));
+        ctx.notes.borrow_mut().note(kind, e.de, || Warning::new(WarningKind::Forgiven(e.error(m))));
     };
     if (v1 - v0).is_nan() || v1 - v0 <= eps {
         note("curve-range-empty", alloc::format!("holds none of the curve; its whole domain [{a}, {b}] is used"));

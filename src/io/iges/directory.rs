@@ -3,11 +3,12 @@
 //! the file is checked against the data actually present before anything is
 //! allocated from it.
 
-use alloc::string::{String, ToString};
+use alloc::string::String;
 use alloc::vec::Vec;
 
 use super::lexer::{Record, Tokenizer, Value};
 use super::{iges_error, Notes, Section, MAX_ENTITIES, MAX_PARAMS};
+use crate::warning::{Warning, WarningKind};
 use crate::Error;
 
 /// One entity: its directory entry fields and parameters.
@@ -40,7 +41,7 @@ pub(super) struct Entity {
 pub(super) struct Directory {
     pub entities: Vec<Entity>,
     /// What was forgiven or skipped, one warning per kind.
-    pub notes: Vec<String>,
+    pub notes: Vec<Warning>,
 }
 
 impl Directory {
@@ -57,7 +58,7 @@ impl Directory {
             notes.note("odd", 0, || {
                 let m = "odd number of directory records: the last entry's second line is missing \
                          (file truncated?); that entry is skipped";
-                iges_error(Section::Directory, line, d.len(), m).to_string()
+                Warning::new(WarningKind::Forgiven(iges_error(Section::Directory, line, d.len(), m)))
             });
             &d[..d.len() - 1]
         } else if d.len() % 2 != 0 {
@@ -135,8 +136,8 @@ impl Directory {
             let form = field(b, 4)?;
             let (pline, params, damage) = match parameters(p, de, kind, pstart, pcount, param, record, &mut notes) {
                 Ok((pline, params)) => (pline, params, None),
-                Err(err) => {
-                    notes.note(damage_kind(&err), de, || alloc::format!("{err}; the entity is skipped"));
+                Err((damage, err)) => {
+                    notes.note(damage.key(), de, || Warning::new(WarningKind::EntityDamaged(err.clone())));
                     (0, alloc::vec![Value::Int(kind)], Some(err))
                 }
             };
@@ -164,13 +165,28 @@ impl Directory {
     }
 }
 
-/// The kind of a damaged entity's error, so each kind is one warning.
-fn damage_kind(err: &Error) -> &'static str {
-    match err {
-        Error::Iges { message, .. } if message.contains("pointer") => "pointer",
-        Error::Iges { message, .. } if message.contains("directory entry says type") => "type",
-        Error::Iges { message, .. } if message.contains("';'") => "unended",
-        _ => "syntax",
+/// What is wrong with an entity's parameter data, so each kind is one warning.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Damage {
+    /// The pointer to its data is outside the Parameter section.
+    Pointer,
+    /// Its data names another entity type than its directory entry.
+    Type,
+    /// Its data ends without the record delimiter.
+    Unended,
+    /// A field that cannot be read.
+    Syntax,
+}
+
+impl Damage {
+    /// The key its warnings are gathered under.
+    fn key(self) -> &'static str {
+        match self {
+            Self::Pointer => "pointer",
+            Self::Type => "type",
+            Self::Unended => "unended",
+            Self::Syntax => "syntax",
+        }
     }
 }
 
@@ -190,8 +206,8 @@ fn parameters(
     param: u8,
     record: u8,
     notes: &mut Notes,
-) -> Result<(usize, Vec<Value>), Error> {
-    let bad = |message: String| iges_error(Section::Directory, 0, de, message);
+) -> Result<(usize, Vec<Value>), (Damage, Error)> {
+    let bad = |message: String| (Damage::Pointer, iges_error(Section::Directory, 0, de, message));
     let first = usize::try_from(pstart).ok().filter(|&s| s >= 1 && s <= p.len()).ok_or_else(|| {
         bad(alloc::format!(
             "parameter data pointer {pstart} is outside the Parameter section's {} lines (file truncated?)",
@@ -212,8 +228,9 @@ fn parameters(
             text.extend_from_slice(content(r));
         }
         let mut tok = Tokenizer::new(&text, param, record);
-        let params = tok.fields(MAX_PARAMS).map_err(|m| iges_error(Section::Parameter, pline, de, m))?;
-        Ok::<_, Error>((params, tok.ended))
+        let params =
+            tok.fields(MAX_PARAMS).map_err(|m| (Damage::Syntax, iges_error(Section::Parameter, pline, de, m)))?;
+        Ok::<_, (Damage, Error)>((params, tok.ended))
     };
     let (mut params, mut ended) = read(last)?;
     if !ended {
@@ -225,12 +242,15 @@ fn parameters(
         }
     }
     if !ended {
-        return Err(iges_error(
-            Section::Parameter,
-            pline,
-            de,
-            alloc::format!(
-                "parameter data on lines {first}..{last} end without the record delimiter ';' (file truncated?)"
+        return Err((
+            Damage::Unended,
+            iges_error(
+                Section::Parameter,
+                pline,
+                de,
+                alloc::format!(
+                    "parameter data on lines {first}..{last} end without the record delimiter ';' (file truncated?)"
+                ),
             ),
         ));
     }
@@ -241,7 +261,7 @@ fn parameters(
                  read up to the entity's ';'",
                 p.len()
             );
-            iges_error(Section::Directory, 0, de, m).to_string()
+            Warning::new(WarningKind::Forgiven(iges_error(Section::Directory, 0, de, m)))
         });
     }
     // Every entity's parameters are held until the faces are built: no
@@ -249,16 +269,19 @@ fn parameters(
     params.shrink_to_fit();
     match params.first() {
         Some(Value::Int(k)) if *k == kind => Ok((pline, params)),
-        other => Err(iges_error(
-            Section::Parameter,
-            pline,
-            de,
-            alloc::format!(
-                "parameter data start with {} but the directory entry says type {kind} (bad pointer?)",
-                match other {
-                    Some(Value::Int(k)) => alloc::format!("type {k}"),
-                    _ => "no entity type".into(),
-                }
+        other => Err((
+            Damage::Type,
+            iges_error(
+                Section::Parameter,
+                pline,
+                de,
+                alloc::format!(
+                    "parameter data start with {} but the directory entry says type {kind} (bad pointer?)",
+                    match other {
+                        Some(Value::Int(k)) => alloc::format!("type {k}"),
+                        _ => "no entity type".into(),
+                    }
+                ),
             ),
         )),
     }
@@ -294,8 +317,8 @@ fn back_pointer(r: &Record<'_>) -> Option<usize> {
 
 impl Entity {
     /// An error about this entity's parameter data.
-    pub fn error(&self, message: impl Into<String>) -> Error {
-        iges_error(Section::Parameter, self.pline, self.de, message.into())
+    pub fn error(&self, message: impl core::fmt::Display) -> Error {
+        iges_error(Section::Parameter, self.pline, self.de, message)
     }
 
     fn value(&self, i: usize) -> &Value {

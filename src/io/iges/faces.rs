@@ -22,6 +22,7 @@ use super::surfaces::{is_surface, surface_def};
 use super::xform::own_transform;
 use super::Ctx;
 use crate::model::{Face, SkippedFace};
+use crate::warning::{Entity as WarningEntity, Warning, WarningKind};
 use crate::Error;
 
 /// The faces of the file, in directory order, with warnings for what was
@@ -30,7 +31,7 @@ use crate::Error;
 /// for faces outside any; and the faces skipped, with their borders.
 pub(super) fn read_faces(
     ctx: &Ctx<'_>,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Warning>,
     skipped: &mut Vec<SkippedFace>,
 ) -> (Vec<Face>, Vec<u32>, Option<Error>) {
     let dir = ctx.dir;
@@ -74,12 +75,11 @@ pub(super) fn read_faces(
     }
     let FaceReader { out, mut bodies, first_error, unsupported, warnings, skipped, .. } = r;
     if hidden > 0 {
-        warnings
-            .push(alloc::format!("{hidden} hidden (blanked) surface entities skipped: the file does not show them"));
+        warnings.push(Warning::new(WarningKind::Hidden { count: hidden }));
     }
     for (kind, n) in unsupported {
         let what = if kind == 402 { "perforated planes" } else { "array or network subfigure instances" };
-        warnings.push(alloc::format!("{n} entities of type {kind} ({what}) skipped: not supported"));
+        warnings.push(Warning::new(WarningKind::Unsupported { count: n, kind, what }));
     }
     if bodies.iter().all(|&b| b == 0) && skipped.iter().all(|s| s.body == 0) {
         bodies.clear();
@@ -130,7 +130,7 @@ struct FaceReader<'c, 'r> {
     unsupported: Vec<(u32, usize)>,
     /// Subfigure instances expanded so far.
     count: Count,
-    warnings: &'r mut Vec<String>,
+    warnings: &'r mut Vec<Warning>,
     skipped: &'r mut Vec<SkippedFace>,
 }
 
@@ -194,7 +194,7 @@ impl FaceReader<'_, '_> {
         let result =
             face_source(ctx, fe, job, at.m).and_then(|src| build_face(src, &mut local).map_err(|m| fe.error(m)));
         for w in local {
-            self.warnings.push(alloc::format!("DE {} (type {}): {w}", fe.de, fe.kind));
+            self.warnings.push(Warning::entity(WarningEntity::Iges { de: fe.de, kind: fe.kind }, w));
         }
         let body = match job {
             Job::Brep(parents) if !parents.is_empty() => {
@@ -266,11 +266,11 @@ enum Job {
     Untrimmed,
 }
 
-fn skip(warnings: &mut Vec<String>, first: &mut Option<Error>, e: &Entity, err: Error) {
-    warnings.push(alloc::format!("DE {} (type {}): skipped: {err}", e.de, e.kind));
+fn skip(warnings: &mut Vec<Warning>, first: &mut Option<Error>, e: &Entity, err: Error) {
     if first.is_none() {
-        *first = Some(err);
+        *first = Some(err.clone());
     }
+    warnings.push(Warning::entity(WarningEntity::Iges { de: e.de, kind: e.kind }, WarningKind::Skipped(err)));
 }
 
 /// The source of face `e` read as `job` says, its definition space mapped

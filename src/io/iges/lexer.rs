@@ -7,6 +7,7 @@ use alloc::string::String;
 use alloc::vec::Vec;
 
 use super::{iges_error, Section};
+use crate::warning::{Warning, WarningKind};
 use crate::Error;
 
 /// One 80-column record.
@@ -31,7 +32,7 @@ pub(super) struct Sections<'a> {
     /// truncated there, and the record was dropped.
     pub truncated: Option<usize>,
     /// What was forgiven in the record layout, one warning each.
-    pub notes: Vec<String>,
+    pub notes: Vec<Warning>,
 }
 
 /// Splits `bytes` into records. Accepts LF or CRLF line ends, a missing
@@ -63,11 +64,7 @@ pub(super) fn split_sections(bytes: &[u8]) -> Result<Sections<'_>, Error> {
             continue;
         }
         if let Some(n) = unbroken(text) {
-            sp.out.notes.push(alloc::format!(
-                "line {}: {n} records of 80 columns with no line breaks between them; read as lines {line}..{}",
-                i + 1,
-                line + n - 1
-            ));
+            sp.out.notes.push(Warning::new(WarningKind::UnbrokenRecords { line: i + 1, records: n, first: line }));
             for (k, chunk) in text.chunks(80).enumerate() {
                 if !chunk.iter().all(|b| b.is_ascii_whitespace()) && !sp.record(line + k, chunk, false)? {
                     break;
@@ -81,16 +78,10 @@ pub(super) fn split_sections(bytes: &[u8]) -> Result<Sections<'_>, Error> {
         }
     }
     if let Some((line, n)) = sp.shifted {
-        sp.out.notes.push(alloc::format!(
-            "line {line}: a record pushed past column 80 by blanks before it; read without them{}",
-            if n > 1 { alloc::format!(" (and {} more like it)", n - 1) } else { String::new() }
-        ));
+        sp.out.notes.push(Warning { more: n - 1, ..Warning::new(WarningKind::ShiftedRecord { line }) });
     }
     if let Some((line, n)) = sp.lowercase {
-        sp.out.notes.push(alloc::format!(
-            "line {line}: the section letter in lower case; read as upper case{}",
-            if n > 1 { alloc::format!(" (and {} more like it)", n - 1) } else { String::new() }
-        ));
+        sp.out.notes.push(Warning { more: n - 1, ..Warning::new(WarningKind::LowerCaseSection { line }) });
     }
     Ok(sp.out)
 }
@@ -260,7 +251,7 @@ impl<'a> Tokenizer<'a> {
 
     /// The Global section's first two fields: the delimiters, each either
     /// empty (defaults `,` and `;`) or a `1H` string.
-    pub fn read_delimiters(&mut self) -> Result<(), String> {
+    pub fn read_delimiters(&mut self) -> Result<(), LexError> {
         self.skip_blanks();
         if self.text.get(self.pos) == Some(&b',') {
             self.param = b',';
@@ -270,7 +261,7 @@ impl<'a> Tokenizer<'a> {
             self.param = c;
             self.skip_blanks();
             if self.text.get(self.pos) != Some(&c) {
-                return Err("field 1: expected the parameter delimiter after it".into());
+                return Err(LexError::NoDelimiterAfter(1));
             }
             self.pos += 1;
         }
@@ -288,29 +279,29 @@ impl<'a> Tokenizer<'a> {
                 match self.text.get(self.pos) {
                     Some(&d) if d == self.param => self.pos += 1,
                     Some(&d) if d == self.record => {}
-                    _ => return Err("field 2: expected a delimiter after it".into()),
+                    _ => return Err(LexError::NoDelimiterAfter(2)),
                 }
             }
         }
         if self.param == self.record || self.param == b' ' || self.record == b' ' {
-            return Err("the parameter and record delimiters must differ and not be blank".into());
+            return Err(LexError::BadDelimiters);
         }
         Ok(())
     }
 
     /// `1Hc` at the cursor.
-    fn one_char_string(&mut self, field: usize) -> Result<u8, String> {
+    fn one_char_string(&mut self, field: usize) -> Result<u8, LexError> {
         let t = &self.text[self.pos..];
         if t.len() >= 3 && t[0] == b'1' && (t[1] == b'H' || t[1] == b'h') {
             self.pos += 3;
             return Ok(t[2]);
         }
-        Err(alloc::format!("field {field} (a delimiter) must be empty or a 1H string"))
+        Err(LexError::DelimiterNotString(field))
     }
 
     /// All fields up to the record delimiter (or the end of the text).
     /// `max` caps the count (the caller's limit).
-    pub fn fields(&mut self, max: usize) -> Result<Vec<Value>, String> {
+    pub fn fields(&mut self, max: usize) -> Result<Vec<Value>, LexError> {
         let mut out = Vec::new();
         let mut after_delim = false;
         loop {
@@ -322,7 +313,7 @@ impl<'a> Tokenizer<'a> {
                 return Ok(out);
             };
             if out.len() >= max {
-                return Err(alloc::format!("more than {max} parameters"));
+                return Err(LexError::TooMany(max));
             }
             if c == self.record {
                 if after_delim {
@@ -350,30 +341,22 @@ impl<'a> Tokenizer<'a> {
                     self.pos += 1;
                     after_delim = true;
                 }
-                Some(&d) => {
-                    return Err(alloc::format!(
-                        "parameter {}: unexpected '{}' after the value",
-                        out.len(),
-                        char::from(d).escape_default()
-                    ))
-                }
+                Some(&d) => return Err(LexError::AfterValue { index: out.len(), found: char::from(d) }),
             }
         }
     }
 
     /// One non-empty field starting at `pos`.
-    fn field(&mut self, index: usize) -> Result<Value, String> {
+    fn field(&mut self, index: usize) -> Result<Value, LexError> {
         let t = &self.text[self.pos..];
         let digits = t.iter().take_while(|b| b.is_ascii_digit()).count();
         if digits > 0 && matches!(t.get(digits), Some(b'H' | b'h')) {
             let n: usize = core::str::from_utf8(&t[..digits])
                 .ok()
                 .and_then(|s| s.parse().ok())
-                .ok_or_else(|| alloc::format!("parameter {index}: bad string length"))?;
+                .ok_or(LexError::BadStringLength(index))?;
             let start = digits + 1;
-            let body = t.get(start..start.saturating_add(n)).ok_or_else(|| {
-                alloc::format!("parameter {index}: string of {n} characters runs past the end of the entity's data")
-            })?;
+            let body = t.get(start..start.saturating_add(n)).ok_or(LexError::StringPastEnd { index, length: n })?;
             self.pos += start + n;
             return Ok(Value::Str(body.iter().map(|&b| char::from(b)).collect()));
         }
@@ -382,8 +365,64 @@ impl<'a> Tokenizer<'a> {
         let raw = &t[..len];
         parse_number(raw).ok_or_else(|| {
             let shown: String = raw.iter().take(24).map(|&b| char::from(b)).collect();
-            alloc::format!("parameter {index}: '{}' is not a number", shown.trim())
+            LexError::NotANumber { index, shown: shown.trim().into() }
         })
+    }
+}
+
+/// Why the Global section's delimiters or an entity's parameters could not be read.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(super) enum LexError {
+    /// Field 1 or 2 of the Global section not followed by a delimiter.
+    NoDelimiterAfter(usize),
+    /// The delimiters are one character or blank.
+    BadDelimiters,
+    /// A delimiter field that is neither empty nor a `1H` string.
+    DelimiterNotString(usize),
+    /// More parameters than the limit.
+    TooMany(usize),
+    /// Something other than a delimiter after parameter `index`.
+    AfterValue {
+        /// The parameter (1-based).
+        index: usize,
+        /// What follows it.
+        found: char,
+    },
+    /// A Hollerith string whose length is not a number.
+    BadStringLength(usize),
+    /// A Hollerith string running past the data.
+    StringPastEnd {
+        /// The parameter (1-based).
+        index: usize,
+        /// Its stated length.
+        length: usize,
+    },
+    /// A parameter that is not a number (its first characters).
+    NotANumber {
+        /// The parameter (1-based).
+        index: usize,
+        /// Its text, cut at 24 characters.
+        shown: String,
+    },
+}
+
+impl core::fmt::Display for LexError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::NoDelimiterAfter(1) => write!(f, "field 1: expected the parameter delimiter after it"),
+            Self::NoDelimiterAfter(k) => write!(f, "field {k}: expected a delimiter after it"),
+            Self::BadDelimiters => write!(f, "the parameter and record delimiters must differ and not be blank"),
+            Self::DelimiterNotString(k) => write!(f, "field {k} (a delimiter) must be empty or a 1H string"),
+            Self::TooMany(max) => write!(f, "more than {max} parameters"),
+            Self::AfterValue { index, found } => {
+                write!(f, "parameter {index}: unexpected '{}' after the value", found.escape_default())
+            }
+            Self::BadStringLength(index) => write!(f, "parameter {index}: bad string length"),
+            Self::StringPastEnd { index, length } => {
+                write!(f, "parameter {index}: string of {length} characters runs past the end of the entity's data")
+            }
+            Self::NotANumber { index, shown } => write!(f, "parameter {index}: '{shown}' is not a number"),
+        }
     }
 }
 

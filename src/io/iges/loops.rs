@@ -4,18 +4,18 @@
 //! surface's NURBS to them, fit the curves in its parameters and close every
 //! loop exactly (end of each curve = start of the next).
 
-use alloc::string::String;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
 use super::fit::Track;
 use super::surfaces::{AxisMap, SurfDef};
 use super::untangle::untangle;
-use super::wrap::{chain_loop, loop_shape, resolve_windings, windows, Range};
+use super::wrap::{chain_loop, loop_shape, resolve_windings, windows, Range, TrimError};
 use crate::model::{Face, FaceSurface, TrimLoop};
 use crate::nurbs::analytic::line;
 use crate::nurbs::reparam::{map_points, reversed, segment, with_end_points};
 use crate::nurbs::{Aabb, NurbsCurve, Surface};
+use crate::warning::WarningKind;
 
 /// One boundary loop as the file gives it.
 #[derive(Debug, Clone, Default)]
@@ -45,7 +45,7 @@ pub(in crate::io) struct FaceSrc {
 /// # Errors
 /// A message for the caller's "skipped" warning: loops that cannot be put in
 /// the surface's parameters, an unbounded surface without loops, bad geometry.
-pub(in crate::io) fn build_face(src: FaceSrc, warn: &mut Vec<String>) -> Result<Face, String> {
+pub(in crate::io) fn build_face(src: FaceSrc, warn: &mut Vec<WarningKind>) -> Result<Face, TrimError> {
     build_face_oriented(src, None, warn)
 }
 
@@ -62,8 +62,8 @@ pub(in crate::io) fn build_face(src: FaceSrc, warn: &mut Vec<String>) -> Result<
 pub(in crate::io) fn build_face_oriented(
     src: FaceSrc,
     left: Option<bool>,
-    warn: &mut Vec<String>,
-) -> Result<Face, String> {
+    warn: &mut Vec<WarningKind>,
+) -> Result<Face, TrimError> {
     let mut def = src.def.clone();
     let periods = def.periods();
     let natural = def.natural();
@@ -93,7 +93,7 @@ pub(in crate::io) fn build_face_oriented(
         loops_2d.push(pieces);
     }
     if unmet > 0 {
-        warn.push(alloc::format!("{unmet} trim curves fitted to within the sample limit only"));
+        warn.push(WarningKind::TrimFitLimit { curves: unmet });
     }
     let [lo, hi] = surface.domain();
     let mut loops: Vec<TrimLoop> = Vec::new();
@@ -126,8 +126,8 @@ pub(in crate::io) fn build_face_oriented(
 fn read_loops(
     src: &FaceSrc,
     def: &SurfDef,
-    warn: &mut Vec<String>,
-) -> Result<(Vec<Vec<NurbsCurve>>, Vec<Vec<Track>>), String> {
+    warn: &mut Vec<WarningKind>,
+) -> Result<(Vec<Vec<NurbsCurve>>, Vec<Vec<Track>>), TrimError> {
     let periods = def.periods();
     // Parameter curves on a B-spline surface in its own parameters need no fitting.
     let direct = def.fixed_domain() && src.native;
@@ -142,12 +142,8 @@ fn read_loops(
             }
             (Some(pc), true) if !pc.is_empty() => tracks.push(sample_loop(def, pc.clone(), false, periods)?),
             _ if !lp.model.is_empty() => tracks.push(sample_loop(def, lp.model.clone(), true, periods)?),
-            (Some(_), false) => {
-                return Err("parameter-space trim curves on a surface whose parameters are not read, \
-                            and no model-space curves"
-                    .into())
-            }
-            _ => return Err("a boundary loop without curves".into()),
+            (Some(_), false) => return Err(TrimError::UnreadParameters),
+            _ => return Err(TrimError::NoCurves),
         }
     }
     // Check the file's parameter curves against its model-space ones.
@@ -164,12 +160,12 @@ fn read_loops(
             }
         }
         if bad {
-            warn.push("parameter-space trim curves disagree with the model-space ones; projected instead".into());
+            warn.push(WarningKind::TrimSpacesDisagree);
             loops_2d.clear();
             tracks.clear();
             for lp in &src.loops {
                 if lp.model.is_empty() {
-                    return Err("parameter-space trim curves off the surface and no model-space curves".into());
+                    return Err(TrimError::OffSurface);
                 }
                 tracks.push(sample_loop(def, lp.model.clone(), true, periods)?);
             }
@@ -197,14 +193,14 @@ fn place_loops(
     def: &mut SurfDef,
     loops_2d: &mut [Vec<NurbsCurve>],
     tracks: &mut [Vec<Track>],
-) -> Result<Placed, String> {
+) -> Result<Placed, TrimError> {
     let (periods, natural) = (def.periods(), def.natural());
     let mut polys: Vec<Vec<DVec2>> = loops_2d.iter().map(|lp| pieces_poly(lp)).collect();
     polys.extend(tracks.iter().map(|lp| lp.iter().flat_map(|t| t.qs.iter().copied()).collect()));
     if polys.is_empty() {
         let [u, v] = natural;
         let (Some(u), Some(v)) = (u, v) else {
-            return Err("an unbounded surface without trim curves".into());
+            return Err(TrimError::Unbounded);
         };
         let (surface, maps) = def.build(u, v)?;
         return Ok(Placed::Surface(surface, maps));
@@ -220,7 +216,7 @@ fn place_loops(
             if a >= lo[k] - eps && b <= hi[k] + eps {
                 continue;
             }
-            let cannot = "trim loops cross the seam of a closed surface that cannot be re-cut there";
+            let cannot = TrimError::SeamRecut;
             if b - a > p * (1.0 + 1e-6) {
                 *def = def.unroll(k == 0, a, b).ok_or(cannot)?;
                 continue;
@@ -236,7 +232,8 @@ fn place_loops(
     for (lp, s) in loops_2d.iter_mut().zip(&shifts) {
         if *s != DVec2::ZERO {
             for c in lp.iter_mut() {
-                *c = map_points(c, |p| p + s.extend(0.0)).map_err(|e| alloc::format!("trim curve: {e}"))?;
+                *c = map_points(c, |p| p + s.extend(0.0))
+                    .map_err(|error| TrimError::Geometry { part: "trim curve", error })?;
             }
         }
     }
@@ -282,7 +279,7 @@ fn track_bounds(lp: &[Track]) -> (DVec2, DVec2) {
 /// pole, a patch bounded by iso-curves) is that box of the surface,
 /// untrimmed: made exactly over it (cut out of a B-spline surface), its
 /// border is the surface's own and no trim curve runs along a pole.
-fn rectangle_face(def: &SurfDef, lp: &[Track]) -> Result<Option<Face>, String> {
+fn rectangle_face(def: &SurfDef, lp: &[Track]) -> Result<Option<Face>, TrimError> {
     let (lo, hi) = track_bounds(lp);
     let span = hi - lo;
     if !(span.x > 0.0 && span.y > 0.0 && span.is_finite()) {
@@ -337,7 +334,7 @@ fn extents(
     periods: [Option<f64>; 2],
     natural: [Option<(f64, f64)>; 2],
     domain_outer: bool,
-) -> Result<(Range, Range), String> {
+) -> Result<(Range, Range), TrimError> {
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);
     for lp in tracks {
@@ -350,7 +347,7 @@ fn extents(
         let (lo, hi) = (lo[k], hi[k]);
         let span = hi - lo;
         if !span.is_finite() {
-            return Err("trim loops with no extent".into());
+            return Err(TrimError::NoExtent);
         }
         let margin = if def.fixed_domain() { 0.0 } else { 0.01 * span + 1e-9 * (lo.abs() + hi.abs()).max(1e-9) };
         let (mut a, mut b) = (lo - margin, hi + margin);
@@ -370,7 +367,7 @@ fn extents(
             }
         }
         if b.is_nan() || a.is_nan() || b <= a {
-            return Err("trim loops with no extent".into());
+            return Err(TrimError::NoExtent);
         }
         out[k] = (a, b);
     }
@@ -390,13 +387,16 @@ fn natural_box(def: &SurfDef, lo: DVec2, hi: DVec2, maps: &[AxisMap; 2]) -> [DVe
     b
 }
 
-fn rectangle(b: [DVec2; 2]) -> Result<TrimLoop, String> {
+fn rectangle(b: [DVec2; 2]) -> Result<TrimLoop, TrimError> {
     let [lo, hi] = b;
     let c = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
     let mut curves = Vec::with_capacity(4);
     for k in 0..4 {
         let (a, z) = (c[k], c[(k + 1) % 4]);
-        curves.push(line(a.extend(0.0), z.extend(0.0), 0.0, 1.0).map_err(|e| alloc::format!("outer boundary: {e}"))?);
+        curves.push(
+            line(a.extend(0.0), z.extend(0.0), 0.0, 1.0)
+                .map_err(|error| TrimError::Geometry { part: "outer boundary", error })?,
+        );
     }
     Ok(TrimLoop { curves })
 }
@@ -407,7 +407,7 @@ fn sample_loop(
     mut pieces: Vec<NurbsCurve>,
     model: bool,
     periods: [Option<f64>; 2],
-) -> Result<Vec<Track>, String> {
+) -> Result<Vec<Track>, TrimError> {
     orient_chain(&mut pieces);
     let mut bb = Aabb::EMPTY;
     for c in &pieces {
@@ -425,7 +425,7 @@ fn sample_loop(
         }
     }
     if out.is_empty() {
-        return Err("a boundary loop of zero length".into());
+        return Err(TrimError::ZeroLength);
     }
     Ok(out)
 }
@@ -577,8 +577,8 @@ fn close_loop(
     lo: DVec2,
     hi: DVec2,
     tol: f64,
-    warn: &mut Vec<String>,
-) -> Result<Option<TrimLoop>, String> {
+    warn: &mut Vec<WarningKind>,
+) -> Result<Option<TrimLoop>, TrimError> {
     // Pieces and gaps below a millionth of the domain are noise in the
     // file (a degenerate edge overshooting a corner): dropped and closed.
     let snap = 1e-6 * (hi - lo).max_element();
@@ -613,20 +613,23 @@ fn close_loop(
         }
     }
     if worst_gap > 0.0 {
-        warn.push(alloc::format!("trim loop with a gap of {worst_gap:.3e} between curves, closed by a line"));
+        warn.push(WarningKind::TrimGapClosed { gap: worst_gap });
     }
     let mut curves = Vec::with_capacity(2 * n);
     for (i, c) in pieces.iter().enumerate() {
         let moved = with_end_points(c, starts[i].extend(0.0), finishes[i].extend(0.0))
-            .map_err(|e| alloc::format!("trim curve: {e}"))?;
+            .map_err(|error| TrimError::Geometry { part: "trim curve", error })?;
         curves.push(moved);
         if let Some((a, b)) = connectors[i] {
-            curves.push(line(a.extend(0.0), b.extend(0.0), 0.0, 1.0).map_err(|e| alloc::format!("connector: {e}"))?);
+            curves.push(
+                line(a.extend(0.0), b.extend(0.0), 0.0, 1.0)
+                    .map_err(|error| TrimError::Geometry { part: "connector", error })?,
+            );
         }
     }
     let crossings = untangle(&mut curves);
     if crossings > 0 {
-        warn.push(alloc::format!("trim loop crossed itself {crossings} times (edges meeting tangentially); cut there"));
+        warn.push(WarningKind::TrimSelfCrossing { crossings });
     }
     Ok(Some(TrimLoop { curves }))
 }

@@ -28,6 +28,7 @@ use alloc::string::String;
 use alloc::vec::Vec;
 use glam::DAffine3;
 
+use crate::warning::{Warning, WarningKind};
 use crate::{Error, Model};
 use directory::{Directory, Entity};
 use lexer::{split_sections, Tokenizer, Value};
@@ -74,8 +75,8 @@ impl Section {
 }
 
 /// An [`Error::Iges`].
-fn iges_error(section: Section, line: usize, entity: usize, message: impl Into<String>) -> Error {
-    Error::Iges { section: section.name(), line, entity, message: message.into() }
+fn iges_error(section: Section, line: usize, entity: usize, message: impl core::fmt::Display) -> Error {
+    Error::Iges { section: section.name(), line, entity, message: alloc::format!("{message}") }
 }
 
 /// What the reader forgave, one warning per kind: the first occurrence's
@@ -83,28 +84,25 @@ fn iges_error(section: Section, line: usize, entity: usize, message: impl Into<S
 /// twice, as a curve two faces share is, counts once).
 #[derive(Default)]
 struct Notes {
-    kinds: Vec<(&'static str, String, usize)>,
+    kinds: Vec<(&'static str, Warning)>,
     seen: crate::collections::HashSet<(&'static str, usize)>,
 }
 
 impl Notes {
-    /// Notes `kind` for entity `de` (0: none); `message` is made only for the first.
-    fn note(&mut self, kind: &'static str, de: usize, message: impl FnOnce() -> String) {
+    /// Notes `kind` for entity `de` (0: none); `warning` is made only for the first.
+    fn note(&mut self, kind: &'static str, de: usize, warning: impl FnOnce() -> Warning) {
         if de != 0 && !self.seen.insert((kind, de)) {
             return;
         }
         match self.kinds.iter_mut().find(|k| k.0 == kind) {
-            Some(k) => k.2 += 1,
-            None => self.kinds.push((kind, message(), 0)),
+            Some(k) => k.1.more += 1,
+            None => self.kinds.push((kind, warning())),
         }
     }
 
     /// One warning per kind, in the order the kinds were first met.
-    fn warnings(&self) -> Vec<String> {
-        self.kinds
-            .iter()
-            .map(|(_, m, more)| if *more == 0 { m.clone() } else { alloc::format!("{m} (and {more} more like it)") })
-            .collect()
+    fn warnings(&self) -> Vec<Warning> {
+        self.kinds.iter().map(|(_, w)| w.clone()).collect()
     }
 }
 
@@ -207,18 +205,18 @@ pub fn read_iges(bytes: &[u8]) -> Result<Model, Error> {
     // Nothing the Global section holds is needed to read the entities: its
     // defaults (delimiters `,` and `;`, scale 1, millimetres) stand in.
     let g = if sections.global.is_empty() {
-        warnings.push("no Global section: the default delimiters, scale and unit are used".into());
+        warnings.push(Warning::new(WarningKind::NoGlobal));
         Global::default()
     } else {
         global(&sections.global).unwrap_or_else(|e| {
-            warnings.push(alloc::format!("{e}; the default delimiters, scale and unit are used"));
+            warnings.push(Warning::new(WarningKind::BadGlobal(e)));
             Global::default()
         })
     };
     let mut dir = Directory::parse(&sections.directory, &sections.parameter, g.param, g.record)?;
     warnings.append(&mut dir.notes);
     if let Some(line) = sections.truncated {
-        warnings.push(alloc::format!("line {line} is cut short (file truncated?): ignored"));
+        warnings.push(Warning::new(WarningKind::TruncatedLine { line }));
     }
     check_terminate(&sections, &mut warnings);
     let ctx = Ctx {
@@ -297,9 +295,9 @@ fn unit_name(flag: i64, name: Option<&str>) -> String {
 
 /// Compares the Terminate section's counts with the records found (a
 /// mismatch is reported, not fatal: the data itself was complete).
-fn check_terminate(s: &lexer::Sections<'_>, warnings: &mut Vec<String>) {
+fn check_terminate(s: &lexer::Sections<'_>, warnings: &mut Vec<Warning>) {
     let Some(t) = s.terminate.first() else {
-        warnings.push("no Terminate section (file truncated?)".into());
+        warnings.push(Warning::new(WarningKind::NoTerminate));
         return;
     };
     let count = |letter: u8| -> Option<usize> {
@@ -314,7 +312,8 @@ fn check_terminate(s: &lexer::Sections<'_>, warnings: &mut Vec<String>) {
     ] {
         if let Some(n) = count(letter) {
             if n != found {
-                warnings.push(alloc::format!("the Terminate section counts {n} {name} lines, the file has {found}"));
+                let kind = WarningKind::TerminateCount { counted: n, section: name, found };
+                warnings.push(Warning::new(kind));
             }
         }
     }

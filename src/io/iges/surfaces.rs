@@ -16,6 +16,7 @@ use glam::{DAffine3, DVec2, DVec3};
 
 use super::curves::model_curve;
 use super::directory::Entity;
+use super::wrap::TrimError;
 use super::xform::{own_transform, similarity_scale};
 use super::{Ctx, MAX_CONTROL_POINTS, MAX_DEPTH};
 use crate::model::FaceSurface;
@@ -228,13 +229,13 @@ impl SurfDef {
     ///
     /// # Errors
     /// Invalid geometry (a profile crossing the axis, zero extents).
-    pub fn build(&self, u: (f64, f64), v: (f64, f64)) -> Result<(FaceSurface, [AxisMap; 2]), String> {
+    pub fn build(&self, u: (f64, f64), v: (f64, f64)) -> Result<(FaceSurface, [AxisMap; 2]), TrimError> {
         match self {
             Self::Nurbs { surface, .. } => Ok((FaceSurface::Nurbs(surface.clone()), [AxisMap::Identity; 2])),
             Self::Plane { origin, x, y } => {
                 let at = |a: f64, b: f64| *origin + *x * a + *y * b;
                 let s = bilinear([[at(u.0, v.0), at(u.0, v.1)], [at(u.1, v.0), at(u.1, v.1)]], [u.0, u.1], [v.0, v.1])
-                    .map_err(|e| alloc::format!("plane: {e}"))?;
+                    .map_err(|error| TrimError::Geometry { part: "plane", error })?;
                 Ok((FaceSurface::Nurbs(s), [AxisMap::Identity; 2]))
             }
             Self::Revolution(r) => r.build(u, v),
@@ -245,8 +246,6 @@ impl SurfDef {
         }
     }
 }
-
-use alloc::string::String;
 
 impl Revolution {
     fn frame(&self) -> (DVec3, DVec3) {
@@ -309,27 +308,28 @@ impl Revolution {
         Native { q: DVec2::new(t, theta), free: [false, on_axis] }
     }
 
-    fn build(&self, u: (f64, f64), v: (f64, f64)) -> Result<(FaceSurface, [AxisMap; 2]), String> {
+    fn build(&self, u: (f64, f64), v: (f64, f64)) -> Result<(FaceSurface, [AxisMap; 2]), TrimError> {
         let (x, _) = self.frame();
         let to3 = |q: DVec2| self.origin + x * q.x + self.axis * q.y;
         let (profile, umap) = match &self.profile {
             Profile::Line { p0, d } => {
                 let c = crate::nurbs::analytic::line(to3(*p0 + *d * u.0), to3(*p0 + *d * u.1), u.0, u.1)
-                    .map_err(|e| alloc::format!("profile: {e}"))?;
+                    .map_err(|error| TrimError::Geometry { part: "profile", error })?;
                 (c, AxisMap::Identity)
             }
             Profile::Circle { c, rho, .. } => {
-                let arc =
-                    circle_arc(to3(*c), x, self.axis, *rho, u.0, u.1).map_err(|e| alloc::format!("profile: {e}"))?;
+                let arc = circle_arc(to3(*c), x, self.axis, *rho, u.0, u.1)
+                    .map_err(|error| TrimError::Geometry { part: "profile", error })?;
                 (arc, AxisMap::Arc(ArcParam::new(u.0, u.1)))
             }
             Profile::Curve(curve) => {
                 let (a, b) = curve.domain();
                 let c = if u.0 > a || u.1 < b { segment(curve, u.0, u.1) } else { Ok(curve.clone()) };
-                (c.map_err(|e| alloc::format!("profile: {e}"))?, AxisMap::Identity)
+                (c.map_err(|error| TrimError::Geometry { part: "profile", error })?, AxisMap::Identity)
             }
         };
-        let s = revolve(&profile, self.origin, self.axis, v.0, v.1).map_err(|e| alloc::format!("revolution: {e}"))?;
+        let s = revolve(&profile, self.origin, self.axis, v.0, v.1)
+            .map_err(|error| TrimError::Geometry { part: "revolution", error })?;
         Ok((FaceSurface::Nurbs(s), [umap, AxisMap::Arc(ArcParam::new(v.0, v.1))]))
     }
 }

@@ -6,12 +6,12 @@
 //! chosen where it crosses nothing else; all loops are then placed in one
 //! window of the periods, wider than a period where the face wraps further.
 
-use alloc::string::String;
 use alloc::vec::Vec;
 use glam::DVec2;
 
 use super::fit::{unwrap_near, Track};
 use super::surfaces::{Profile, SurfDef};
+use crate::nurbs::NurbsError;
 
 /// A closed interval `(low, high)` of one coordinate.
 pub(super) type Range = (f64, f64);
@@ -138,7 +138,7 @@ pub(super) fn resolve_windings(
     periods: [Option<f64>; 2],
     natural: [Option<Range>; 2],
     left: Option<bool>,
-) -> Result<(), String> {
+) -> Result<(), TrimError> {
     let mut windings = windings.to_vec();
     for k in 0..2 {
         let Some(p) = periods[k] else { continue };
@@ -146,7 +146,7 @@ pub(super) fn resolve_windings(
         match idx.as_slice() {
             [] => {}
             [i] => {
-                let side = left.ok_or("a trim loop winds around the surface's seam (not supported)")?;
+                let side = left.ok_or(TrimError::SeamWinding)?;
                 let at = tracks[*i].first().and_then(|t| t.qs.first()).map_or(0.0, |q| q[1 - k]);
                 close_at_bound(&mut tracks[*i], k, windings[*i][k], side, bounds_of(def, natural, 1 - k, at))?;
                 windings[*i][k] = 0;
@@ -161,12 +161,7 @@ pub(super) fn resolve_windings(
                 tracks.push(join_across_seam(def, a, b, &others, k, p, periods)?);
                 windings.push([0; 2]);
             }
-            _ => {
-                return Err(alloc::format!(
-                    "{} trim loops go round the surface's periodic direction; cannot tell how they bound the face",
-                    idx.len()
-                ))
-            }
+            _ => return Err(TrimError::PeriodicLoops(idx.len())),
         }
     }
     Ok(())
@@ -197,25 +192,25 @@ fn bounds_of(def: &SurfDef, natural: [Option<Range>; 2], k: usize, at: f64) -> O
 
 /// Closes a loop going `turns` times round coordinate `k` along the bound
 /// of the other coordinate on the face's side: down to it, along it, back.
-fn close_at_bound(lp: &mut Vec<Track>, k: usize, turns: i64, left: bool, nat: Option<Range>) -> Result<(), String> {
+fn close_at_bound(lp: &mut Vec<Track>, k: usize, turns: i64, left: bool, nat: Option<Range>) -> Result<(), TrimError> {
     let o = 1 - k;
     // Going +k, the left side is +o for k = 0 and −o for k = 1.
     let side = if k == 0 { 1.0 } else { -1.0 } * turns.signum() as f64 * if left { 1.0 } else { -1.0 };
     let bound = nat.map(|(a, b)| if side > 0.0 { b } else { a }).filter(|x| x.is_finite());
     let Some(bound) = bound else {
-        return Err("a trim loop goes round a surface that is unbounded on the face's side".into());
+        return Err(TrimError::UnboundedSide);
     };
     let (Some(s), Some(e)) =
         (lp.first().and_then(|t| t.qs.first().copied()), lp.last().and_then(|t| t.qs.last().copied()))
     else {
-        return Err("an empty trim loop".into());
+        return Err(TrimError::EmptyLoop);
     };
     let (mut e2, mut s2) = (e, s);
     e2[o] = bound;
     s2[o] = bound;
     for (a, b) in [(e, e2), (e2, s2), (s2, s)] {
         if a.distance(b) > 0.0 {
-            lp.push(Track::link(a, b).ok_or("a link along the surface's bound could not be made")?);
+            lp.push(Track::link(a, b).ok_or(TrimError::BoundLink)?);
         }
     }
     Ok(())
@@ -331,10 +326,10 @@ fn rotate_at(
     k: usize,
     turn: DVec2,
     periods: [Option<f64>; 2],
-) -> Result<Vec<Track>, String> {
+) -> Result<Vec<Track>, TrimError> {
     let i = x.track;
     let (head, tail) = {
-        let t = lp.get_mut(i).ok_or("a cut outside its loop")?;
+        let t = lp.get_mut(i).ok_or(TrimError::CutOutside)?;
         let at_sample = |j: usize| t.qs.get(j).is_some_and(|q| q[k] == x.at);
         if at_sample(x.sample) {
             t.cut_at_sample(x.sample)
@@ -353,7 +348,7 @@ fn rotate_at(
         out.push(t);
     }
     if out.is_empty() {
-        return Err("an empty trim loop".into());
+        return Err(TrimError::EmptyLoop);
     }
     Ok(out)
 }
@@ -376,9 +371,9 @@ fn join_across_seam(
     k: usize,
     p: f64,
     periods: [Option<f64>; 2],
-) -> Result<Vec<Track>, String> {
+) -> Result<Vec<Track>, TrimError> {
     let (Some((a0, a1)), Some((b0, b1))) = (ends(&a), ends(&b)) else {
-        return Err("an empty trim loop".into());
+        return Err(TrimError::EmptyLoop);
     };
     let lift = |s: DVec2, e: DVec2| {
         let mut v = DVec2::ZERO;
@@ -386,12 +381,11 @@ fn join_across_seam(
         v
     };
     let (turn_a, turn_b) = (lift(a0, a1), lift(b0, b1));
-    let (xa, xb) = choose_cut(&a, &b, others, k, p)
-        .ok_or("a trim loop going round the surface does not cross its partner's seam")?;
+    let (xa, xb) = choose_cut(&a, &b, others, k, p).ok_or(TrimError::NoSeamCrossing)?;
     let a = rotate_at(def, a, &xa, k, turn_a, periods)?;
     let mut b = rotate_at(def, b, &xb, k, turn_b, periods)?;
     let (Some((a0, a1)), Some((b0, _))) = (ends(&a), ends(&b)) else {
-        return Err("an empty trim loop".into());
+        return Err(TrimError::EmptyLoop);
     };
     // Line b's start up with a's end.
     let mut shift = DVec2::ZERO;
@@ -400,14 +394,14 @@ fn join_across_seam(
         t.shift(shift);
     }
     let (Some((b0, b1)), mut out) = (ends(&b), a) else {
-        return Err("an empty trim loop".into());
+        return Err(TrimError::EmptyLoop);
     };
     if a1.distance(b0) > 0.0 {
-        out.push(Track::link(a1, b0).ok_or("a link along the seam could not be made")?);
+        out.push(Track::link(a1, b0).ok_or(TrimError::SeamLink)?);
     }
     out.extend(b);
     if b1.distance(a0) > 0.0 {
-        out.push(Track::link(b1, a0).ok_or("a link along the seam could not be made")?);
+        out.push(Track::link(b1, a0).ok_or(TrimError::SeamLink)?);
     }
     Ok(out)
 }
@@ -422,7 +416,7 @@ pub(super) fn windows(
     polys: &[Vec<DVec2>],
     periods: [Option<f64>; 2],
     natural: [Option<(f64, f64)>; 2],
-) -> Result<(Vec<DVec2>, [Range; 2]), String> {
+) -> Result<(Vec<DVec2>, [Range; 2]), TrimError> {
     let bounds: Vec<(DVec2, DVec2)> = polys.iter().map(|q| poly_bounds(q)).collect();
     let mut shifts = alloc::vec![DVec2::ZERO; bounds.len()];
     let mut range = [(0.0, 0.0); 2];
@@ -455,7 +449,7 @@ pub(super) fn windows(
         let Some((span, sh, wlo, whi)) = best else { continue };
         // Rounding in a file's loops can take them a hair past one turn.
         let (sh, wlo, whi) = if span > p * (1.0 + 1e-6) {
-            inside_outer(polys, &bounds, k, p).ok_or("the trim loops span more than one turn of the surface")?
+            inside_outer(polys, &bounds, k, p).ok_or(TrimError::MoreThanOneTurn)?
         } else {
             (sh, wlo, whi)
         };
@@ -522,4 +516,78 @@ fn inside_outer(polys: &[Vec<DVec2>], bounds: &[(DVec2, DVec2)], k: usize, p: f6
         out.push(d);
     }
     Some((out, wlo, whi))
+}
+
+/// Why a face's trim loops could not be built (the reader's reason for skipping the face).
+#[derive(Debug, Clone, PartialEq)]
+pub(in crate::io) enum TrimError {
+    /// A loop winding round a seam.
+    SeamWinding,
+    /// Several loops round the periodic direction (how many).
+    PeriodicLoops(usize),
+    /// A loop round a surface unbounded on the face's side.
+    UnboundedSide,
+    /// A loop of no curves.
+    EmptyLoop,
+    /// A link along the surface's bound that could not be made.
+    BoundLink,
+    /// A cut outside its loop.
+    CutOutside,
+    /// A loop going round that does not cross its partner's seam.
+    NoSeamCrossing,
+    /// A link along the seam that could not be made.
+    SeamLink,
+    /// Loops spanning more than one turn.
+    MoreThanOneTurn,
+    /// Parameter-space curves on a surface whose parameters are not read, and no model-space ones.
+    UnreadParameters,
+    /// A boundary loop without curves.
+    NoCurves,
+    /// Parameter-space curves off the surface and no model-space ones.
+    OffSurface,
+    /// An unbounded surface without trim curves.
+    Unbounded,
+    /// Loops across the seam of a closed surface that cannot be re-cut there.
+    SeamRecut,
+    /// Loops of no extent.
+    NoExtent,
+    /// A boundary loop of zero length.
+    ZeroLength,
+    /// A curve of the loop or a part of the surface (`part` names which) could not be built.
+    Geometry {
+        /// e.g. `trim curve`, `connector`, `profile`.
+        part: &'static str,
+        /// The NURBS error.
+        error: NurbsError,
+    },
+}
+
+impl core::fmt::Display for TrimError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::SeamWinding => write!(f, "a trim loop winds around the surface's seam (not supported)"),
+            Self::PeriodicLoops(n) => write!(
+                f,
+                "{n} trim loops go round the surface's periodic direction; cannot tell how they bound the face"
+            ),
+            Self::UnboundedSide => write!(f, "a trim loop goes round a surface that is unbounded on the face's side"),
+            Self::EmptyLoop => write!(f, "an empty trim loop"),
+            Self::BoundLink => write!(f, "a link along the surface's bound could not be made"),
+            Self::CutOutside => write!(f, "a cut outside its loop"),
+            Self::NoSeamCrossing => write!(f, "a trim loop going round the surface does not cross its partner's seam"),
+            Self::SeamLink => write!(f, "a link along the seam could not be made"),
+            Self::MoreThanOneTurn => write!(f, "the trim loops span more than one turn of the surface"),
+            Self::UnreadParameters => write!(
+                f,
+                "parameter-space trim curves on a surface whose parameters are not read, and no model-space curves"
+            ),
+            Self::NoCurves => write!(f, "a boundary loop without curves"),
+            Self::OffSurface => write!(f, "parameter-space trim curves off the surface and no model-space curves"),
+            Self::Unbounded => write!(f, "an unbounded surface without trim curves"),
+            Self::SeamRecut => write!(f, "trim loops cross the seam of a closed surface that cannot be re-cut there"),
+            Self::NoExtent => write!(f, "trim loops with no extent"),
+            Self::ZeroLength => write!(f, "a boundary loop of zero length"),
+            Self::Geometry { part, error } => write!(f, "{part}: {error}"),
+        }
+    }
 }

@@ -21,6 +21,7 @@ use super::curves::Geo;
 use super::graph::{Ent, Graph, Value};
 use super::{MAX_DEPTH, MAX_FACES};
 use crate::model::{Assembly, AssemblyNode, PartInstance};
+use crate::warning::{Entity, Warning, WarningKind};
 use crate::Error;
 
 /// One shape item to read, placed.
@@ -172,7 +173,7 @@ struct Groups {
 ///
 /// # Errors
 /// Malformed relations (bad references, placements that are not placements).
-pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error> {
+pub(super) fn plan(g: &Graph, warnings: &mut Vec<Warning>) -> Result<Plan, Error> {
     let reps = representations(g, warnings);
     let mut parent: Vec<usize> = (0..reps.list.len()).collect();
     let cdsr = cdsr_products(g);
@@ -190,7 +191,7 @@ pub(super) fn plan(g: &Graph, warnings: &mut Vec<String>) -> Result<Plan, Error>
 }
 
 /// Every representation of `g`, and the units of its context.
-fn representations(g: &Graph, warnings: &mut Vec<String>) -> Reps {
+fn representations(g: &Graph, warnings: &mut Vec<Warning>) -> Reps {
     let mut list: Vec<(u64, Vec<u64>, u64)> = Vec::new();
     let mut index: HashMap<u64, usize> = HashMap::default();
     for e in g.all() {
@@ -363,7 +364,7 @@ fn walk(
     product_of_rep: &HashMap<u64, (u64, Option<String>)>,
     out_mm: f64,
     plan: &mut Plan,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Warning>,
 ) -> (HashSet<u64>, f64) {
     let (members, children) = (&groups.members, &groups.children);
     let mut seen: HashSet<(u64, [u64; 12])> = HashSet::default();
@@ -381,9 +382,7 @@ fn walk(
     while let Some((gi, m, name, depth, up, local, occurrence)) = stack.pop() {
         visits += 1;
         if depth > MAX_DEPTH || visits > MAX_FACES {
-            warnings.push(format!(
-                "assembly deeper than {MAX_DEPTH} levels or with more than {MAX_FACES} instances: the rest is skipped"
-            ));
+            warnings.push(Warning::new(WarningKind::AssemblyLimit { depth: MAX_DEPTH, instances: MAX_FACES }));
             break;
         }
         let orphan = depth == 0 && !in_products(gi);
@@ -403,7 +402,10 @@ fn walk(
             let u = reps.units[i];
             for &it in &reps.list[i].1 {
                 let Some(e) = g.find(it) else {
-                    warnings.push(format!("#{}: item #{it} is not defined; skipped", reps.list[i].0));
+                    warnings.push(Warning::entity(
+                        Entity::step_id(reps.list[i].0),
+                        WarningKind::ItemUndefined { item: it },
+                    ));
                     continue;
                 };
                 if !is_shape(e) || (orphan && emitted.contains(&it)) {
@@ -437,7 +439,7 @@ fn walk(
 
 /// Solids and surface models no representation lists (none of the items
 /// `emitted` and not inside one of them): read in place, each a root node.
-fn read_unlisted_solids(g: &Graph, emitted: &HashSet<u64>, plan: &mut Plan, warnings: &mut Vec<String>) {
+fn read_unlisted_solids(g: &Graph, emitted: &HashSet<u64>, plan: &mut Plan, warnings: &mut Vec<Warning>) {
     let mut nested: HashSet<u64> = HashSet::default();
     for p in &plan.placed {
         if let Some(e) = g.find(p.item) {
@@ -455,7 +457,8 @@ fn read_unlisted_solids(g: &Graph, emitted: &HashSet<u64>, plan: &mut Plan, warn
     for e in g.all() {
         let top = ["MANIFOLD_SOLID_BREP", "BREP_WITH_VOIDS", "FACETED_BREP", "SHELL_BASED_SURFACE_MODEL"];
         if top.iter().any(|n| e.has(n)) && !emitted.contains(&e.id()) && !nested.contains(&e.id()) {
-            warnings.push(format!("#{} {}: not in any representation; read in place", e.id(), e.type_name()));
+            let kind = WarningKind::NotInRepresentation;
+            warnings.push(Warning::entity(Entity::step(e.id(), e.type_name()), kind));
             let node = plan.nodes.len();
             plan.nodes.push(PlanNode {
                 parent: None,
@@ -623,7 +626,7 @@ fn unit_name(mm: f64) -> String {
 }
 
 /// Units and uncertainty of a representation context.
-fn context_units(g: &Graph, ctx: u64, warnings: &mut Vec<String>) -> Units {
+fn context_units(g: &Graph, ctx: u64, warnings: &mut Vec<Warning>) -> Units {
     let mut u = Units::default();
     let Some(c) = g.find(ctx) else { return u };
     if let Some(a) = c.part("GLOBAL_UNIT_ASSIGNED_CONTEXT") {
@@ -632,7 +635,7 @@ fn context_units(g: &Graph, ctx: u64, warnings: &mut Vec<String>) -> Units {
             if e.has("LENGTH_UNIT") {
                 match unit_factor(e, 0) {
                     Some(f) => u.mm = f,
-                    None => warnings.push(format!("#{r}: length unit not understood; millimetres assumed")),
+                    None => warnings.push(Warning::entity(Entity::step_id(r), WarningKind::LengthUnitUnknown)),
                 }
             } else if e.has("PLANE_ANGLE_UNIT") {
                 if let Some(f) = unit_factor(e, 0) {

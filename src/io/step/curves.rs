@@ -4,7 +4,6 @@
 //! between its vertices and turned into exact NURBS pieces.
 
 use alloc::format;
-use alloc::string::String;
 use alloc::vec::Vec;
 use glam::{DAffine3, DMat3, DVec3};
 
@@ -13,7 +12,7 @@ use super::{MAX_CONTROL_POINTS, MAX_DEPTH};
 use crate::nurbs::analytic::{ellipse_arc, hyperbola_arc, line, parabola_arc};
 use crate::nurbs::join::join;
 use crate::nurbs::reparam::{reversed, segment, with_end_points, RawCurve};
-use crate::nurbs::{NurbsCurve, MAX_DEGREE};
+use crate::nurbs::{NurbsCurve, NurbsError, MAX_DEGREE};
 use crate::Error;
 
 const TAU: f64 = core::f64::consts::TAU;
@@ -448,34 +447,34 @@ impl Geo<'_> {
 }
 
 /// `c` restricted to `[t0, t1]` (clamped to its domain).
-pub(super) fn seg(c: &NurbsCurve, t0: f64, t1: f64) -> Result<NurbsCurve, String> {
+pub(super) fn seg(c: &NurbsCurve, t0: f64, t1: f64) -> Result<NurbsCurve, CurveError> {
     let (a, b) = c.domain();
     let (t0, t1) = (t0.max(a), t1.min(b));
     if t1.is_nan() || t0.is_nan() || t1 <= t0 {
-        return Err(format!("empty parameter range {t0} to {t1}"));
+        return Err(CurveError::EmptyRange(t0, t1));
     }
-    segment(c, t0, t1).map_err(|x| format!("{x}"))
+    Ok(segment(c, t0, t1)?)
 }
 
 /// Every curve of `v` run backwards, in reverse order.
-pub(super) fn rev_all(v: &mut [NurbsCurve]) -> Result<(), String> {
+pub(super) fn rev_all(v: &mut [NurbsCurve]) -> Result<(), NurbsError> {
     v.reverse();
     for c in v.iter_mut() {
-        *c = reversed(c).map_err(|x| format!("{x}"))?;
+        *c = reversed(c)?;
     }
     Ok(())
 }
 
 /// A clamped copy of `c` (its ends are control points).
-fn clamped(c: NurbsCurve) -> Result<NurbsCurve, String> {
+fn clamped(c: NurbsCurve) -> Result<NurbsCurve, NurbsError> {
     let mut r = RawCurve::of(&c);
     r.clamp();
-    r.build().map_err(|x| format!("{x}"))
+    r.build()
 }
 
 /// `c` with its ends moved to `s` and `e`.
-pub(super) fn move_ends(c: &NurbsCurve, s: DVec3, e: DVec3) -> Result<NurbsCurve, String> {
-    with_end_points(c, s, e).map_err(|x| format!("{x}"))
+pub(super) fn move_ends(c: &NurbsCurve, s: DVec3, e: DVec3) -> Result<NurbsCurve, NurbsError> {
+    with_end_points(c, s, e)
 }
 
 /// Whether `e` is a B-spline curve of any form.
@@ -529,12 +528,55 @@ pub(super) fn period(c: &Curve3) -> Option<f64> {
     }
 }
 
+/// Why a piece of a STEP curve could not be cut out of it.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum CurveError {
+    /// The NURBS operation failed.
+    Nurbs(NurbsError),
+    /// A parameter range from the first to the second that holds nothing.
+    EmptyRange(f64, f64),
+    /// A range outside the curve's domain.
+    OutsideRange {
+        /// The range asked for.
+        range: (f64, f64),
+        /// The curve's domain.
+        domain: (f64, f64),
+    },
+    /// A range on a closed curve that holds nothing.
+    EmptyClosedRange,
+    /// A line with no range (in a composite curve).
+    UnboundedLine,
+    /// A hyperbola or parabola with no range (in a composite curve).
+    UnboundedConic,
+}
+
+impl core::fmt::Display for CurveError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Nurbs(e) => write!(f, "{e}"),
+            Self::EmptyRange(t0, t1) => write!(f, "empty parameter range {t0} to {t1}"),
+            Self::OutsideRange { range: (t0, t1), domain: (a, b) } => {
+                write!(f, "parameter range {t0} to {t1} outside the curve's {a} to {b}")
+            }
+            Self::EmptyClosedRange => write!(f, "empty closed-curve range"),
+            Self::UnboundedLine => write!(f, "an unbounded line in a composite curve"),
+            Self::UnboundedConic => write!(f, "an unbounded hyperbola or parabola in a composite curve"),
+        }
+    }
+}
+
+impl From<NurbsError> for CurveError {
+    fn from(e: NurbsError) -> Self {
+        Self::Nurbs(e)
+    }
+}
+
 /// NURBS pieces of the curve from parameter `t0` to `t1 > t0` along its
 /// parameter (a closed B-spline is gone round from its end to its start).
-pub(super) fn pieces_between(c: &Curve3, t0: f64, t1: f64) -> Result<Vec<NurbsCurve>, String> {
-    let err = |x: crate::NurbsError| format!("{x}");
+pub(super) fn pieces_between(c: &Curve3, t0: f64, t1: f64) -> Result<Vec<NurbsCurve>, CurveError> {
+    let err = CurveError::Nurbs;
     if t1.is_nan() || t0.is_nan() || t1 <= t0 {
-        return Err(format!("empty parameter range {t0} to {t1}"));
+        return Err(CurveError::EmptyRange(t0, t1));
     }
     match c {
         Curve3::Line { p, d } => Ok(alloc::vec![line(*p + *d * t0, *p + *d * t1, 0.0, 1.0).map_err(err)?]),
@@ -548,7 +590,7 @@ pub(super) fn pieces_between(c: &Curve3, t0: f64, t1: f64) -> Result<Vec<NurbsCu
             if !*closed || (t0 >= a - tiny && t1 <= b + tiny) {
                 let (s0, s1) = (t0.max(a), t1.min(b));
                 if s1.is_nan() || s0.is_nan() || s1 <= s0 {
-                    return Err(format!("parameter range {t0} to {t1} outside the curve's {a} to {b}"));
+                    return Err(CurveError::OutsideRange { range: (t0, t1), domain: (a, b) });
                 }
                 return Ok(alloc::vec![seg(c, s0, s1)?]);
             }
@@ -569,7 +611,7 @@ pub(super) fn pieces_between(c: &Curve3, t0: f64, t1: f64) -> Result<Vec<NurbsCu
                 }
             }
             if out.is_empty() {
-                return Err("empty closed-curve range".into());
+                return Err(CurveError::EmptyClosedRange);
             }
             Ok(out)
         }
@@ -578,15 +620,13 @@ pub(super) fn pieces_between(c: &Curve3, t0: f64, t1: f64) -> Result<Vec<NurbsCu
 
 /// The bounded part of a curve as NURBS pieces in its own direction
 /// (trimmed range, reversed when the trimmed curve runs against its basis).
-pub(super) fn bounded_pieces(def: &CurveDef) -> Result<Vec<NurbsCurve>, String> {
+pub(super) fn bounded_pieces(def: &CurveDef) -> Result<Vec<NurbsCurve>, CurveError> {
     let (t0, t1) = match (def.range, &def.curve) {
         (Some(r), _) => r,
         (None, Curve3::Nurbs { c, .. }) => c.domain(),
         (None, Curve3::Conic { .. }) => (0.0, TAU),
-        (None, Curve3::Line { .. }) => return Err("an unbounded line in a composite curve".into()),
-        (None, Curve3::Hyperbola { .. } | Curve3::Parabola { .. }) => {
-            return Err("an unbounded hyperbola or parabola in a composite curve".into())
-        }
+        (None, Curve3::Line { .. }) => return Err(CurveError::UnboundedLine),
+        (None, Curve3::Hyperbola { .. } | Curve3::Parabola { .. }) => return Err(CurveError::UnboundedConic),
     };
     // The range runs from the start to the end of the trimmed curve; along
     // the basis parameter that is increasing unless `reversed`.

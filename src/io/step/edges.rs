@@ -4,14 +4,13 @@
 //! read once and shared by the faces that use it.
 
 use crate::collections::HashMap;
-use alloc::format;
-use alloc::string::String;
 use alloc::vec::Vec;
 use glam::DVec3;
 
-use super::curves::{move_ends, param_of, period, pieces_between, rev_all, Curve3, CurveDef, Geo};
+use super::curves::{move_ends, param_of, period, pieces_between, rev_all, Curve3, CurveDef, CurveError, Geo};
 use super::graph::Ent;
 use crate::nurbs::NurbsCurve;
+use crate::warning::WarningKind;
 use crate::Error;
 
 /// An edge in its own direction (start vertex to end vertex).
@@ -20,7 +19,7 @@ pub(super) struct Edge {
     /// Pieces from the start vertex to the end vertex (empty: degenerate edge).
     pub pieces: Vec<NurbsCurve>,
     /// What was repaired, if anything (reported once per edge).
-    pub repaired: Option<String>,
+    pub repaired: Option<WarningKind>,
 }
 
 /// Edges read so far, by `#id`.
@@ -92,10 +91,7 @@ fn read_edge(
         };
         let uses = uses.get_or_insert_with(|| LoopUses::of(geo));
         let (p, lp) = uses.neighbour_vertex(geo, e.id(), end).ok_or(missing)?;
-        let which = if end { "end" } else { "start" };
-        found = Some(format!(
-            "its {which} vertex #{v} is not defined; the point its neighbour in loop #{lp} gives is used"
-        ));
+        found = Some(WarningKind::VertexFromNeighbour { end, vertex: v, lp });
         Ok(p)
     };
     let ps = end_point(false, vs)?;
@@ -106,7 +102,7 @@ fn read_edge(
     let (pieces, repaired) =
         cut(&def, &ends, same_sense, vs == ve || alone, geo.uncertainty).map_err(|m| e.error(m))?;
     let repaired = match (found, repaired) {
-        (Some(f), Some(r)) => Some(format!("{f}; {r}")),
+        (Some(f), Some(r)) => Some(WarningKind::Joined(alloc::vec![f, r])),
         (f, r) => f.or(r),
     };
     Ok(Edge { pieces, repaired })
@@ -233,7 +229,7 @@ fn cut(
     same_sense: bool,
     closed: bool,
     uncertainty: f64,
-) -> Result<(Vec<NurbsCurve>, Option<String>), String> {
+) -> Result<(Vec<NurbsCurve>, Option<WarningKind>), CurveError> {
     let (ps, pe) = (verts.ps, verts.pe);
     let forward = same_sense != def.reversed;
     let (a, b) = if forward { (ps, pe) } else { (pe, ps) };
@@ -244,7 +240,7 @@ fn cut(
             if size == 0.0 {
                 return Ok((Vec::new(), None));
             }
-            alloc::vec![crate::nurbs::analytic::line(a, b, 0.0, 1.0).map_err(|x| format!("{x}"))?]
+            alloc::vec![crate::nurbs::analytic::line(a, b, 0.0, 1.0)?]
         }
         c => {
             let mut ta = param_of(c, a);
@@ -321,12 +317,12 @@ fn cut(
         let gap = s.distance(ps);
         if !verts.trust[0] {
             if gap > uncertainty {
-                repaired = Some(format!("its start vertex, which the file puts at two corners, lies {gap:.3e} from its curve; the curve's end is used"));
+                repaired = Some(WarningKind::VertexOffCurve { start: true, shared: true, gap });
             }
         } else if gap <= snap {
             *first = move_ends(first, ps, e)?;
         } else {
-            repaired = Some(format!("its start vertex lies {gap:.3e} from its curve; the curve's end is used"));
+            repaired = Some(WarningKind::VertexOffCurve { start: true, shared: false, gap });
         }
     }
     if let Some(last) = pieces.last_mut() {
@@ -334,12 +330,12 @@ fn cut(
         let gap = e.distance(pe);
         if !verts.trust[1] {
             if gap > uncertainty {
-                repaired = Some(format!("its end vertex, which the file puts at two corners, lies {gap:.3e} from its curve; the curve's end is used"));
+                repaired = Some(WarningKind::VertexOffCurve { start: false, shared: true, gap });
             }
         } else if gap <= snap {
             *last = move_ends(last, s, pe)?;
         } else {
-            repaired = Some(format!("its end vertex lies {gap:.3e} from its curve; the curve's end is used"));
+            repaired = Some(WarningKind::VertexOffCurve { start: false, shared: false, gap });
         }
     }
     Ok((pieces, repaired))

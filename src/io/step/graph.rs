@@ -9,6 +9,7 @@ use alloc::string::String;
 use alloc::vec::Vec;
 
 use super::step_error;
+use crate::warning::{Warning, WarningKind};
 use crate::Error;
 
 /// One parameter value. Lists and typed values point into [`Graph::values`].
@@ -85,27 +86,29 @@ pub(super) struct Graph {
 /// that kind followed, so a file with many of one flaw gets one warning.
 #[derive(Debug, Default)]
 pub(super) struct Forgiven {
-    kinds: Vec<(&'static str, String, usize)>,
+    kinds: Vec<(&'static str, Warning)>,
 }
 
 impl Forgiven {
-    /// Notes one occurrence of `kind`; `message` is made only for the first.
-    pub fn note(&mut self, kind: &'static str, message: impl FnOnce() -> String) {
+    /// Notes one occurrence of `kind`; `error` (what it would have been
+    /// without leniency) is made only for the first.
+    pub fn note(&mut self, kind: &'static str, error: impl FnOnce() -> Error) {
         match self.kinds.iter_mut().find(|k| k.0 == kind) {
-            Some(k) => k.2 += 1,
-            None => self.kinds.push((kind, message(), 0)),
+            Some(k) => k.1.more += 1,
+            None => self.kinds.push((kind, Warning::new(WarningKind::Forgiven(error())))),
         }
     }
 
     /// One warning per kind, in the order the kinds were first met.
-    pub fn warnings(&self) -> Vec<String> {
-        self.kinds
-            .iter()
-            .map(|(_, m, more)| match more {
-                0 => m.clone(),
-                n => format!("{m} (and {n} more like it)"),
-            })
-            .collect()
+    pub fn warnings(&self) -> Vec<Warning> {
+        self.kinds.iter().map(|(_, w)| w.clone()).collect()
+    }
+
+    /// The warnings' text but for those of kind `skip`, for tests of the text.
+    #[cfg(test)]
+    pub fn texts_except(&self, skip: &str) -> Vec<String> {
+        use alloc::string::ToString;
+        self.kinds.iter().filter(|(k, _)| *k != skip).map(|(_, w)| w.to_string()).collect()
     }
 }
 
@@ -310,9 +313,8 @@ impl<'g> Ent<'g> {
     }
 
     /// An error about this instance.
-    pub fn error(&self, message: impl Into<String>) -> Error {
-        let m: String = message.into();
-        step_error(self.id(), self.line(), format!("{}: {m}", self.type_name()))
+    pub fn error(&self, message: impl core::fmt::Display) -> Error {
+        step_error(self.id(), self.line(), format!("{}: {message}", self.type_name()))
     }
 }
 

@@ -18,7 +18,7 @@
 //! ([`header`]). Anything else malformed is an error naming its line.
 
 use alloc::format;
-use alloc::string::{String, ToString};
+use alloc::string::String;
 use alloc::vec::Vec;
 
 use super::graph::{Graph, Instance, Part, Value};
@@ -251,7 +251,7 @@ impl<'a> Lexer<'a> {
                         let line = self.line;
                         g.forgiven.note("apostrophe", || {
                             let m = "a lone apostrophe inside a string (not doubled); kept in the text";
-                            step_error(id, line, m).to_string()
+                            step_error(id, line, m)
                         });
                         out.push(b'\'');
                     }
@@ -303,7 +303,7 @@ impl<'a> Lexer<'a> {
         };
         let line = self.line;
         let mut note = |kind: &'static str, message: &str| {
-            g.forgiven.note(kind, || format!("{}; kept as raw text", step_error(id, line, message)));
+            g.forgiven.note(kind, || step_error(id, line, format!("{message}; kept as raw text")));
         };
         match rest {
             [b'\\', ..] => {
@@ -452,8 +452,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Graph, Error> {
         return Err(step_error(0, lx.line, "no DATA section"));
     }
     if !seen_header {
-        g.forgiven
-            .note("header", || step_error(0, 0, "no HEADER section; the DATA section is read anyway").to_string());
+        g.forgiven.note("header", || step_error(0, 0, "no HEADER section; the DATA section is read anyway"));
     }
     g.shrink();
     Ok(g)
@@ -560,7 +559,7 @@ fn instance(lx: &mut Lexer<'_>, g: &mut Graph, scratch: &mut Vec<Value>, id: u64
         let before = g.line_of(id);
         g.forgiven.note("duplicate", || {
             let m = format!("instance number defined twice; the first definition (line {before}) is kept");
-            step_error(id, line, m).to_string()
+            step_error(id, line, m)
         });
     }
     Ok(())

@@ -31,7 +31,8 @@ use crate::io::iges::surfaces::{map_surface, SurfDef};
 use crate::model::{Face, FaceSurface};
 use crate::nurbs::analytic::line;
 use crate::nurbs::reparam::map_points;
-use crate::nurbs::{NurbsCurve, NurbsSurface};
+use crate::nurbs::{NurbsCurve, NurbsError, NurbsSurface};
+use crate::warning::{Entity, Warning, WarningKind};
 use crate::Error;
 
 /// The faces of one item, in its own coordinates, and its shells as face ranges.
@@ -50,7 +51,7 @@ struct ItemFaces {
 struct Reader<'g, 'w> {
     g: &'g Graph,
     edges: Edges,
-    warnings: &'w mut Vec<String>,
+    warnings: &'w mut Vec<Warning>,
     first_error: Option<Error>,
     /// Edges whose repair was reported.
     repaired: HashSet<u64>,
@@ -76,7 +77,7 @@ pub(super) struct Shapes {
 ///
 /// # Errors
 /// The face limit.
-pub(super) fn read_shapes(g: &Graph, plan: &Plan, warnings: &mut Vec<String>) -> Result<Shapes, Error> {
+pub(super) fn read_shapes(g: &Graph, plan: &Plan, warnings: &mut Vec<Warning>) -> Result<Shapes, Error> {
     let mut r = Reader {
         g,
         edges: Edges::default(),
@@ -144,7 +145,7 @@ pub(super) fn read_shapes(g: &Graph, plan: &Plan, warnings: &mut Vec<String>) ->
                         [Some(*id), shell, Some(p.item)].into_iter().flatten().find_map(|i| styles.get(&i).copied());
                     out.colours.push(colour);
                 }
-                Err(m) => r.warnings.push(format!("#{}: a face could not be placed: {m}", p.item)),
+                Err(m) => r.warnings.push(Warning::entity(Entity::step_id(p.item), WarningKind::FaceNotPlaced(m))),
             }
         }
         let placed = out.faces.len() - base;
@@ -165,10 +166,10 @@ pub(super) fn read_shapes(g: &Graph, plan: &Plan, warnings: &mut Vec<String>) ->
 
 impl Reader<'_, '_> {
     fn skip(&mut self, e: Ent<'_>, err: Error) {
-        self.warnings.push(format!("#{} {}: skipped: {err}", e.id(), e.type_name()));
         if self.first_error.is_none() {
-            self.first_error = Some(err);
+            self.first_error = Some(err.clone());
         }
+        self.warnings.push(Warning::entity(Entity::step(e.id(), e.type_name()), WarningKind::Skipped(err)));
     }
 
     /// The faces of one shape item.
@@ -310,10 +311,8 @@ impl Reader<'_, '_> {
         }
         let once = count.values().filter(|&&c| c == 1).count();
         let closed = if closed && once > 0 && out.faces.len() - start == list.len() {
-            self.warnings.push(format!(
-                "#{} CLOSED_SHELL: {once} of its edges bound only one of its faces; it is open, its mesh will have a border",
-                s.id()
-            ));
+            let open = WarningKind::ShellOpen { edges: once };
+            self.warnings.push(Warning::entity(Entity::step(s.id(), "CLOSED_SHELL"), open));
             false
         } else {
             closed
@@ -368,13 +367,13 @@ impl Reader<'_, '_> {
         // normal is the face's.
         let r = build_face_oriented(src, Some(surf.flipped != same_sense), &mut local);
         for w in local {
-            self.warnings.push(format!("#{} {}: {w}", e.id(), e.type_name()));
+            self.warnings.push(Warning::entity(Entity::step(e.id(), e.type_name()), w));
         }
         let mut face = r.map_err(|m| e.error(m))?;
         // The NURBS normal is the STEP surface's unless flipped; the face's
         // outside is the surface's when same_sense.
         if surf.flipped == same_sense {
-            transpose_face(&mut face).map_err(|m| e.error(m))?;
+            transpose_face(&mut face).map_err(|m| e.error(format!("{m}")))?;
         }
         Ok(face)
     }
@@ -414,10 +413,7 @@ impl Reader<'_, '_> {
             let slit = !uses.is_empty()
                 && uses.iter().all(|(_, e, o)| uses.iter().any(|(_, f, p)| f.id() == e.id() && p != o));
             if slit {
-                self.warnings.push(format!(
-                    "#{} EDGE_LOOP: runs along its edges both ways (a slit in the face); ignored",
-                    lp.id()
-                ));
+                self.warnings.push(Warning::entity(Entity::step(lp.id(), "EDGE_LOOP"), WarningKind::LoopSlit));
                 return Ok(None);
             }
             // An edge used out and straight back (a dangling edge inside the
@@ -436,10 +432,8 @@ impl Reader<'_, '_> {
                 spikes += 1;
             }
             if spikes > 0 {
-                self.warnings.push(format!(
-                    "#{} EDGE_LOOP: {spikes} edge(s) run out and straight back inside the face; left out",
-                    lp.id()
-                ));
+                let kind = WarningKind::LoopSpikes { edges: spikes };
+                self.warnings.push(Warning::entity(Entity::step(lp.id(), "EDGE_LOOP"), kind));
             }
             let alone = uses.len() == 1;
             for (oe, edge, orientation) in uses {
@@ -447,7 +441,7 @@ impl Reader<'_, '_> {
                 let ed = self.edges.get(geo, edge, alone)?;
                 if let Some(m) = &ed.repaired {
                     if self.repaired.insert(edge.id()) {
-                        self.warnings.push(format!("#{} EDGE_CURVE: {m}", edge.id()));
+                        self.warnings.push(Warning::entity(Entity::step(edge.id(), "EDGE_CURVE"), m.clone()));
                     }
                 }
                 let mut pieces = ed.pieces.clone();
@@ -583,7 +577,7 @@ fn pcurve_2d(geo: &Geo<'_>, e: Ent<'_>) -> Result<super::curves::CurveDef, Error
 /// Joins consecutive curves of a loop whose ends are apart (a file whose
 /// loop skips from one vertex to another) by straight model-space pieces,
 /// which are then projected like the edges.
-fn bridge_gaps(model: &mut Vec<NurbsCurve>, lp: Ent<'_>, warnings: &mut Vec<String>) -> Result<(), String> {
+fn bridge_gaps(model: &mut Vec<NurbsCurve>, lp: Ent<'_>, warnings: &mut Vec<Warning>) -> Result<(), NurbsError> {
     let mut bb = crate::nurbs::Aabb::EMPTY;
     for c in model.iter() {
         bb.union(&c.bbox());
@@ -604,11 +598,12 @@ fn bridge_gaps(model: &mut Vec<NurbsCurve>, lp: Ent<'_>, warnings: &mut Vec<Stri
         let gap = e.distance(s);
         if gap > hair {
             worst = worst.max(gap);
-            out.push(line(e, s, 0.0, 1.0).map_err(|x| format!("{x}"))?);
+            out.push(line(e, s, 0.0, 1.0)?);
         }
     }
     if worst > 0.0 {
-        warnings.push(format!("#{} EDGE_LOOP: a gap of {worst:.3e} between its edges, bridged by a line", lp.id()));
+        let kind = WarningKind::LoopGapBridged { gap: worst };
+        warnings.push(Warning::entity(Entity::step(lp.id(), "EDGE_LOOP"), kind));
     }
     *model = out;
     Ok(())
@@ -647,17 +642,17 @@ fn sample3(c: &NurbsCurve) -> impl Iterator<Item = DVec3> + '_ {
 }
 
 /// Swaps the surface's u and v (which turns its normal over) and the loops' coordinates.
-fn transpose_face(face: &mut Face) -> Result<(), String> {
+fn transpose_face(face: &mut Face) -> Result<(), NurbsError> {
     face.surface = transpose(&face.surface)?;
     for lp in &mut face.loops {
         for c in &mut lp.curves {
-            *c = map_points(c, |p| DVec3::new(p.y, p.x, 0.0)).map_err(|e| format!("{e}"))?;
+            *c = map_points(c, |p| DVec3::new(p.y, p.x, 0.0))?;
         }
     }
     Ok(())
 }
 
-fn transpose(s: &FaceSurface) -> Result<FaceSurface, String> {
+fn transpose(s: &FaceSurface) -> Result<FaceSurface, NurbsError> {
     match s {
         FaceSurface::Nurbs(n) => Ok(FaceSurface::Nurbs(transpose_nurbs(n)?)),
         FaceSurface::Rebuilt(n) => Ok(FaceSurface::Rebuilt(transpose_nurbs(n)?)),
@@ -668,7 +663,7 @@ fn transpose(s: &FaceSurface) -> Result<FaceSurface, String> {
     }
 }
 
-fn transpose_nurbs(s: &NurbsSurface) -> Result<NurbsSurface, String> {
+fn transpose_nurbs(s: &NurbsSurface) -> Result<NurbsSurface, NurbsError> {
     let [nu, nv] = s.counts();
     let mut pts = Vec::with_capacity(nv);
     let mut ws = Vec::with_capacity(nv);
@@ -684,12 +679,12 @@ fn transpose_nurbs(s: &NurbsSurface) -> Result<NurbsSurface, String> {
         ws.push(wrow);
     }
     let w = s.is_rational().then_some(ws.as_slice());
-    NurbsSurface::from_parts(s.knots_v().clone(), s.knots_u().clone(), &pts, w).map_err(|e| format!("{e}"))
+    NurbsSurface::from_parts(s.knots_v().clone(), s.knots_u().clone(), &pts, w)
 }
 
 /// The face moved by an affine map: control points mapped (exact), offsets
 /// scaled; a mirror turns the surface's normal, so the face is turned back.
-fn place_face(f: &Face, m: &DAffine3) -> Result<Face, String> {
+fn place_face(f: &Face, m: &DAffine3) -> Result<Face, NurbsError> {
     if *m == DAffine3::IDENTITY {
         return Ok(f.clone());
     }
@@ -702,10 +697,10 @@ fn place_face(f: &Face, m: &DAffine3) -> Result<Face, String> {
     Ok(out)
 }
 
-fn map_face_surface(s: &FaceSurface, m: &DAffine3, scale: f64) -> Result<FaceSurface, String> {
+fn map_face_surface(s: &FaceSurface, m: &DAffine3, scale: f64) -> Result<FaceSurface, NurbsError> {
     match s {
-        FaceSurface::Nurbs(n) => Ok(FaceSurface::Nurbs(map_surface(n, m).map_err(|e| format!("{e}"))?)),
-        FaceSurface::Rebuilt(n) => Ok(FaceSurface::Rebuilt(map_surface(n, m).map_err(|e| format!("{e}"))?)),
+        FaceSurface::Nurbs(n) => Ok(FaceSurface::Nurbs(map_surface(n, m)?)),
+        FaceSurface::Rebuilt(n) => Ok(FaceSurface::Rebuilt(map_surface(n, m)?)),
         // Under a mirror the mapped base's normal is the mirror image's
         // opposite; the offset follows the base, so its sign turns too.
         FaceSurface::Offset { base, distance } => {

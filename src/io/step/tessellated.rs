@@ -28,7 +28,6 @@
 
 use crate::collections::{HashMap, HashSet};
 use alloc::format;
-use alloc::string::String;
 use alloc::vec::Vec;
 use core::ops::Range;
 use glam::{DAffine3, DVec3};
@@ -38,6 +37,7 @@ use super::graph::{Attrs, Ent, Graph, Value};
 use super::styles::{colours, Rgb};
 use super::{StepShell, MAX_CONTROL_POINTS, MAX_DEPTH, MAX_FACES};
 use crate::model::TessellatedFace;
+use crate::warning::{Entity, Warning, WarningKind};
 use crate::Error;
 
 /// Entity names of the tessellated items this reader turns into faces.
@@ -88,7 +88,7 @@ struct ItemFacets {
 /// Reading state shared by all items.
 struct Reader<'g, 'w> {
     g: &'g Graph,
-    warnings: &'w mut Vec<String>,
+    warnings: &'w mut Vec<Warning>,
     /// Coordinates lists read so far, by `#id` (many faces share one).
     coordinates: HashMap<u64, Result<Vec<DVec3>, Error>>,
     /// The exact faces and solids the file also gives.
@@ -100,7 +100,7 @@ struct Reader<'g, 'w> {
 /// Reads every tessellated item `plan` places. `exact`: the `#id`s of the
 /// exact faces, shells and solids read from the file; triangles whose
 /// geometric link names one of them are left out.
-pub(super) fn read(g: &Graph, plan: &Plan, exact: &HashSet<u64>, warnings: &mut Vec<String>) -> Facets {
+pub(super) fn read(g: &Graph, plan: &Plan, exact: &HashSet<u64>, warnings: &mut Vec<Warning>) -> Facets {
     let styles = colours(g);
     // Faces a tessellated shell or solid holds are not read again where a
     // representation lists them on their own (as for exact faces).
@@ -126,11 +126,8 @@ pub(super) fn read(g: &Graph, plan: &Plan, exact: &HashSet<u64>, warnings: &mut 
         let Some(item) = cache.get(&p.item) else { continue };
         let count: usize = item.faces.iter().map(|f| f.triangles.len()).sum();
         if out.faces.len() + item.faces.len() > MAX_FACES || r.triangles + count > MAX_TRIANGLES {
-            r.warnings.push(format!(
-                "#{}: more than {MAX_FACES} faces or {MAX_TRIANGLES} tessellated triangles (after assembly \
-                 instancing); this placement and the rest are skipped",
-                p.item
-            ));
+            let kind = WarningKind::TessellatedLimit { faces: MAX_FACES, triangles: MAX_TRIANGLES };
+            r.warnings.push(Warning::entity(Entity::step_id(p.item), kind));
             break;
         }
         r.triangles += count;
@@ -174,7 +171,7 @@ fn place(f: &TessellatedFace, m: &DAffine3) -> TessellatedFace {
 
 impl Reader<'_, '_> {
     fn skip(&mut self, e: Ent<'_>, err: &Error) {
-        self.warnings.push(format!("#{} {}: skipped: {err}", e.id(), e.type_name()));
+        self.warnings.push(Warning::entity(Entity::step(e.id(), e.type_name()), WarningKind::Skipped(err.clone())));
     }
 
     /// The faces of one placed tessellated item.
@@ -204,14 +201,16 @@ impl Reader<'_, '_> {
             let mut listed = 0;
             for r in items {
                 let Some(f) = self.g.find(r) else {
-                    self.warnings.push(format!("#{}: item #{r} is not defined; skipped", e.id()));
+                    let kind = WarningKind::ItemUndefined { item: r };
+                    self.warnings.push(Warning::entity(Entity::step_id(e.id()), kind));
                     continue;
                 };
                 if is_face(f) {
                     listed += 1;
                     self.face_into(f, &mut out);
                 } else if f.has("CUBIC_BEZIER_TRIANGULATED_FACE") || f.has("TESSELLATED_FACE") {
-                    self.warnings.push(format!("#{} {}: not supported; skipped", f.id(), f.type_name()));
+                    let kind = WarningKind::ItemUnsupported;
+                    self.warnings.push(Warning::entity(Entity::step(f.id(), f.type_name()), kind));
                 }
                 // Tessellated edges and vertices bound faces; they add no surface.
             }
@@ -262,11 +261,8 @@ impl Reader<'_, '_> {
             return Err(e.error("has no triangles"));
         }
         if repeated > 0 {
-            self.warnings.push(format!(
-                "#{} {}: {repeated} triangles name one point twice (no area); left out",
-                e.id(),
-                e.type_name()
-            ));
+            let kind = WarningKind::RepeatedPointTriangles { count: repeated };
+            self.warnings.push(Warning::entity(Entity::step(e.id(), e.type_name()), kind));
         }
         let normals = self.normals(e, &a, n)?;
         let name = a.string(0).unwrap_or("").trim();
@@ -402,21 +398,17 @@ impl Reader<'_, '_> {
             normals.push(d);
         }
         let why = if normals.contains(&DVec3::ZERO) {
-            Some(String::from("a normal of no length or not three numbers"))
+            Some(WarningKind::NormalsNotVectors)
         } else if normals.len() == 1 {
             return Ok(alloc::vec![normals[0]; n]);
         } else if normals.len() == n || normals.is_empty() {
             return Ok(normals);
         } else {
-            Some(format!("{} normals for {n} points (expected 0, 1 or {n})", normals.len()))
+            Some(WarningKind::NormalsCount { normals: normals.len(), points: n })
         };
         if let Some(why) = why {
-            self.warnings.push(format!(
-                "#{} {} (line {}): {why}; its normals are left out",
-                e.id(),
-                e.type_name(),
-                e.line()
-            ));
+            let at = Entity::Step { id: e.id(), type_name: Some(e.type_name()), line: Some(e.line()) };
+            self.warnings.push(Warning::entity(at, why));
         }
         Ok(Vec::new())
     }

@@ -42,7 +42,7 @@ pub(super) fn header(lx: &mut Lexer<'_>, g: &mut Graph, scratch: &mut Vec<Value>
     if !problems.is_empty() {
         g.forgiven.note("header", || {
             let m = format!("HEADER section: {}; the DATA section is read anyway", problems.join("; "));
-            step_error(0, first_line, m).to_string()
+            step_error(0, first_line, m)
         });
     }
 }
@@ -136,7 +136,7 @@ mod tests {
         let read = |header: &str| {
             let g = parse(format!("ISO-10303-21;\n{header}{data}").as_bytes()).unwrap();
             assert_eq!(g.get(1, 0).unwrap().attrs().int(0).unwrap(), 1);
-            g.forgiven.warnings()
+            g.forgiven.texts_except("")
         };
         let good = "HEADER;\nFILE_DESCRIPTION((''),'2;1');\nFILE_NAME('','',(''),(''),'','','');\nFILE_SCHEMA(('S'));\nENDSEC;\n";
         assert!(read(good).is_empty());
