@@ -13,7 +13,9 @@ mod extent;
 pub use assembly::{Assembly, AssemblyNode, PartInstance};
 pub(crate) use bodies::body_count;
 pub use bodies::share_of_faces;
-pub(crate) use extent::{trimmed_bbox, LoopSample};
+pub(crate) use extent::trimmed_bbox;
+#[cfg(feature = "std")]
+pub(crate) use extent::LoopSample;
 
 /// Everything read from one input file.
 #[derive(Debug, Clone, Default)]

@@ -6,10 +6,10 @@
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
-use super::{key, uv_area, Criteria, TriMeasure, WorkMesh, NONE};
-use crate::nurbs::Surface;
+use super::{key, uv_area, Criteria, TriMeasure, WorkMesh, NONE, STALE};
 #[cfg(feature = "std")]
-use {super::STALE, crate::nurbs::project_to_surface};
+use crate::nurbs::project_to_surface;
+use crate::nurbs::Surface;
 
 /// The smallest angle below which [`WorkMesh::improve_angles`] looks for a
 /// better diagonal (radians, 15°): wider pairs gain little for the measuring.
@@ -56,9 +56,24 @@ impl WorkMesh {
                 // No flip helps: move an inner vertex of the fold to the
                 // middle of its neighbours (borders stay where sewing put them).
                 for &x in &v {
-                    if let Some(moved) = self.try_smooth(surface, c, x) {
+                    if let Some(moved) = self.try_smooth(surface, c, t, x) {
                         changed.extend(moved.iter().copied());
                         next.extend(moved);
+                        fixed = true;
+                        break;
+                    }
+                }
+                if fixed {
+                    continue;
+                }
+                // Nor a move: where the (u,v) map is far from linear, the
+                // fold's corners sit in space where no triangle between them
+                // faces the surface's way; an inner corner goes.
+                for &x in &v {
+                    if let Some(kept) = self.try_collapse(surface, c, t, x) {
+                        changed.extend(kept.iter().copied());
+                        next.extend(kept);
+                        flipped = true;
                         break;
                     }
                 }
@@ -75,6 +90,7 @@ impl WorkMesh {
             }
             todo = next;
         }
+        self.drop_dead(&mut changed);
         changed.sort_unstable();
         changed.dedup();
         let left = self.folded(surface);
@@ -264,11 +280,37 @@ impl WorkMesh {
         good.then_some(u)
     }
 
+    /// The triangles round inner vertex `x`, one of them `t`, in index
+    /// order: walked across the edges at `x`, so it costs the fan, not the
+    /// face. `None` where the walk meets a border (or the fan passes a
+    /// hundred triangles, or its turns disagree).
+    fn fan(&self, t: u32, x: u32) -> Option<Vec<u32>> {
+        let mut ring = alloc::vec![t];
+        let mut cur = t;
+        while ring.len() <= 100 {
+            let tv = self.tris[cur as usize];
+            let k = tv.iter().position(|&v| v == x)?;
+            let z = tv[(k + 1) % 3];
+            let &adj = self.edges.get(&key(x, z))?;
+            let next = if adj[0] == cur { adj[1] } else { adj[0] };
+            if next == NONE || next == cur {
+                return None;
+            }
+            if next == t {
+                ring.sort_unstable();
+                return Some(ring);
+            }
+            ring.push(next);
+            cur = next;
+        }
+        None
+    }
+
     /// Moves inner vertex `x` to the (u,v) centroid of its neighbours when
     /// that leaves every triangle around it facing the surface's way, with
     /// its (u,v) orientation, and within the limits; returns those triangles.
-    fn try_smooth(&mut self, surface: &dyn Surface, c: &Criteria, x: u32) -> Option<Vec<u32>> {
-        let ring: Vec<u32> = (0..self.tris.len() as u32).filter(|&t| self.tris[t as usize].contains(&x)).collect();
+    fn try_smooth(&mut self, surface: &dyn Surface, c: &Criteria, t: u32, x: u32) -> Option<Vec<u32>> {
+        let ring = self.fan(t, x)?;
         if ring.len() < 3 {
             return None;
         }
@@ -311,6 +353,127 @@ impl WorkMesh {
         } else {
             set(self, old_uv, old_p, old_n);
             None
+        }
+    }
+
+    /// Collapses inner vertex `x` into a neighbour `y`, the nearest in space
+    /// that works: the two triangles on edge `x-y` go (left as dead
+    /// triangles `[y, y, y]` with no edges, for [`Self::drop_dead`]), and
+    /// the others around `x` take `y` in its place. Kept only when each of
+    /// those faces the surface's way, keeps its (u,v) orientation and passes
+    /// the limits, and the face stays a manifold: `x` and `y` share no
+    /// neighbour but the two across their edge, and no new edge joins two
+    /// border nodes. Returns the changed triangles.
+    pub(super) fn try_collapse(&mut self, surface: &dyn Surface, c: &Criteria, t: u32, x: u32) -> Option<Vec<u32>> {
+        let ring = self.fan(t, x)?;
+        if ring.len() < 3 || self.gid[x as usize] != NONE {
+            return None;
+        }
+        let mut around: Vec<u32> = Vec::new();
+        for &t in &ring {
+            let tv = self.tris[t as usize];
+            for k in 0..3 {
+                let (a, b) = (tv[k], tv[(k + 1) % 3]);
+                if (a == x || b == x) && self.edges.get(&key(a, b)).is_none_or(|e| e[1] == NONE) {
+                    return None; // on a border
+                }
+                if tv[k] != x && !around.contains(&tv[k]) {
+                    around.push(tv[k]);
+                }
+            }
+        }
+        let here = self.pos[x as usize];
+        around.sort_by(|&a, &b| self.pos[a as usize].distance(here).total_cmp(&self.pos[b as usize].distance(here)));
+        let sense: f64 = ring.iter().map(|&t| uv_area(self.uv(t as usize))).sum();
+        'candidates: for &y in &around {
+            let &pair = self.edges.get(&key(x, y))?;
+            let gone = [pair[0], pair[1]];
+            // y's (u,v), the same in both triangles of the edge (one chart).
+            let at = |m: &Self, t: u32| {
+                let tv = m.tris[t as usize];
+                (0..3).find(|&k| tv[k] == y).map(|k| m.uv(t as usize)[k])
+            };
+            let (Some(q0), Some(q1)) = (at(self, gone[0]), at(self, gone[1])) else { continue };
+            if !super::same_uv(q0, q1) {
+                continue;
+            }
+            // The link condition: the common neighbours are the two apexes.
+            let apexes: Vec<u32> = gone
+                .iter()
+                .filter_map(|&t| self.tris[t as usize].iter().copied().find(|&z| z != x && z != y))
+                .collect();
+            for &z in &around {
+                if z == y || apexes.contains(&z) {
+                    continue;
+                }
+                if self.edges.contains_key(&key(y, z)) {
+                    continue 'candidates;
+                }
+                if self.gid[y as usize] != NONE && self.gid[z as usize] != NONE {
+                    continue 'candidates;
+                }
+            }
+            let kept: Vec<u32> = ring.iter().copied().filter(|t| !gone.contains(t)).collect();
+            let old: Vec<([u32; 3], [DVec2; 3])> =
+                kept.iter().map(|&t| (self.tris[t as usize], self.uv(t as usize))).collect();
+            for (&t, (tv, w)) in kept.iter().zip(&old) {
+                let k = tv.iter().position(|&v| v == x).unwrap_or(0);
+                let (mut nv, mut nw) = (*tv, *w);
+                nv[k] = y;
+                nw[k] = q0;
+                self.tris[t as usize] = nv;
+                self.set_uv(t as usize, nw);
+            }
+            let good = kept.iter().all(|&t| self.holds(surface, c, t, sense));
+            for (&t, (tv, w)) in kept.iter().zip(&old) {
+                self.tris[t as usize] = *tv;
+                self.set_uv(t as usize, *w);
+            }
+            if !good {
+                continue;
+            }
+            for &t in ring.iter() {
+                let tv = self.tris[t as usize];
+                for k in 0..3 {
+                    self.detach(tv[k], tv[(k + 1) % 3], t);
+                }
+            }
+            for &t in &gone {
+                self.tris[t as usize] = [y; 3];
+                self.set_uv(t as usize, [q0; 3]);
+            }
+            for (&t, (tv, w)) in kept.iter().zip(&old) {
+                let k = tv.iter().position(|&v| v == x).unwrap_or(0);
+                let (mut nv, mut nw) = (*tv, *w);
+                nv[k] = y;
+                nw[k] = q0;
+                self.tris[t as usize] = nv;
+                self.set_uv(t as usize, nw);
+                for k in 0..3 {
+                    self.attach(nv[k], nv[(k + 1) % 3], t);
+                }
+            }
+            return Some(kept);
+        }
+        None
+    }
+
+    /// Removes the dead triangles [`Self::try_collapse`] left (`[y, y, y]`),
+    /// keeping `changed` pointing at the same triangles.
+    pub(super) fn drop_dead(&mut self, changed: &mut Vec<u32>) {
+        let dead: Vec<usize> = (0..self.tris.len())
+            .rev()
+            .filter(|&t| self.tris[t][0] == self.tris[t][1] && self.tris[t][1] == self.tris[t][2])
+            .collect();
+        for t in dead {
+            let last = (self.tris.len() - 1) as u32;
+            self.remove_triangle(t);
+            changed.retain(|&u| u as usize != t);
+            for u in changed.iter_mut() {
+                if *u == last {
+                    *u = t as u32;
+                }
+            }
         }
     }
 
@@ -496,7 +659,6 @@ impl WorkMesh {
 
     /// Removes triangle `t`; the last triangle takes its index. Its corners
     /// stay as vertices (one no other triangle uses is simply not drawn).
-    #[cfg(feature = "std")]
     pub fn remove_triangle(&mut self, t: usize) {
         if t >= self.tris.len() {
             return;

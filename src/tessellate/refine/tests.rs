@@ -232,3 +232,29 @@ fn lift_mends_a_fan_of_needles_within_its_budget() {
     m.lift_angles(&s, &Criteria { lift: Lift { most: n + 4, ..lift }, ..c });
     assert!(m.tris.len() <= n + 4, "{}", m.tris.len());
 }
+
+/// An inner vertex whose point lies far from its (u,v) folds the fan
+/// around it; collapsing it into a neighbour leaves two triangles fewer,
+/// none folded, the tables in step. A border vertex is never collapsed.
+#[test]
+fn a_folded_fan_collapses_into_a_neighbour() {
+    let s = plane();
+    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 10.0, min_edge: 0.0, steps: 2, lift: Lift::NONE };
+    let mut m = grid();
+    let x = 12; // (2, 2), inner
+    m.pos[x] = DVec3::new(3.6, 2.4, 0.0);
+    assert!(!m.folded(&s).is_empty(), "the displaced vertex folds nothing");
+    let with = |m: &WorkMesh, v: u32| m.tris.iter().position(|t| t.contains(&v)).unwrap() as u32;
+    assert!(m.try_collapse(&s, &c, with(&m, 0), 0).is_none(), "a border vertex was collapsed");
+    let kept = m.try_collapse(&s, &c, with(&m, x as u32), x as u32).expect("no neighbour took the vertex");
+    let mut changed = kept.clone();
+    m.drop_dead(&mut changed);
+    assert_eq!(m.tris.len(), 30);
+    assert!(m.tris.iter().all(|t| !t.contains(&(x as u32))));
+    assert!(m.folded(&s).is_empty(), "still folded: {:?}", m.folded(&s));
+    assert!(changed.iter().all(|&t| (t as usize) < m.tris.len()));
+    m.check_tables().unwrap();
+    for t in 0..m.tris.len() {
+        assert!(uv_area(m.uv(t)) > 0.0, "triangle {t} turned clockwise in (u,v)");
+    }
+}
