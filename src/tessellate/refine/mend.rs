@@ -414,6 +414,11 @@ impl WorkMesh {
                 }
             }
             let kept: Vec<u32> = ring.iter().copied().filter(|t| !gone.contains(t)).collect();
+            // An edge of three triangles (the table holds two): a third
+            // triangle on x-y would keep y twice.
+            if !gone.iter().all(|t| ring.contains(t)) || kept.iter().any(|&t| self.tris[t as usize].contains(&y)) {
+                continue;
+            }
             let old: Vec<([u32; 3], [DVec2; 3])> =
                 kept.iter().map(|&t| (self.tris[t as usize], self.uv(t as usize))).collect();
             for (&t, (tv, w)) in kept.iter().zip(&old) {
