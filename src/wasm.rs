@@ -632,13 +632,11 @@ fn options(value: JsValue, example: &str, known: &[&str]) -> Result<Fields, Stri
     Ok(Fields(Some(object)))
 }
 
-/// One of `allowed`, by index; the message lists them as `expected`.
-fn word(value: &Option<Text>, name: &str, allowed: &[&str], expected: &str) -> Result<Option<usize>, String> {
+/// The option's value parsed by its enum's `FromStr` (the CLI's parser
+/// too); the message lists the words as `expected`.
+fn word<T: core::str::FromStr>(value: &Option<Text>, name: &str, expected: &str) -> Result<Option<T>, String> {
     let Some(Text(text)) = value else { return Ok(None) };
-    match allowed.iter().position(|a| a == text) {
-        Some(i) => Ok(Some(i)),
-        None => Err(format!("option {name}: expected {expected}")),
-    }
+    text.parse().map(Some).map_err(|_| format!("option {name}: expected {expected}"))
 }
 
 /// Whether `x` is a whole number from 0 to `u32::MAX`.
@@ -679,8 +677,8 @@ fn mesh_options(value: JsValue) -> Result<(MeshOptions, Output), String> {
         }
         o = o.with_max_triangles(n as usize);
     }
-    if let Some(r) = word(&js.reparam, "reparam", &["auto", "off", "force"], "\"auto\", \"off\" or \"force\"")? {
-        o = o.with_reparam([Reparam::Auto, Reparam::Off, Reparam::Force][r]);
+    if let Some(r) = word::<Reparam>(&js.reparam, "reparam", "\"auto\", \"off\" or \"force\"")? {
+        o = o.with_reparam(r);
     }
     let mut quality = o.quality.clone();
     match (js.size, js.size_rel) {
@@ -689,13 +687,12 @@ fn mesh_options(value: JsValue) -> Result<(MeshOptions, Output), String> {
         (None, Some(Number(r))) => quality = quality.with_relative_size(r),
         (None, None) => {}
     }
-    let methods = ["looping", "delaunay", "best"];
-    if let Some(m) = word(&js.method, "method", &methods, "one of \"looping\", \"delaunay\", \"best\"")? {
-        quality = quality.with_method([QualityMethod::Looping, QualityMethod::Delaunay, QualityMethod::Best][m]);
+    if let Some(m) = word::<QualityMethod>(&js.method, "method", "one of \"looping\", \"delaunay\", \"best\"")? {
+        quality = quality.with_method(m);
     }
     o = o.with_quality(quality);
-    if let Some(m) = word(&js.mode, "mode", &["fast", "quality"], "one of \"fast\", \"quality\"")? {
-        o = o.with_mode([MeshMode::Fast, MeshMode::Quality][m]);
+    if let Some(m) = word::<MeshMode>(&js.mode, "mode", "one of \"fast\", \"quality\"")? {
+        o = o.with_mode(m);
     }
     if let Some(List(pair)) = js.share {
         match pair.as_slice() {
@@ -1143,8 +1140,8 @@ pub fn repair(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, J
 fn repair_options(value: JsValue) -> Result<RepairOptions, String> {
     let js = JsRepairOptions::read(&options(value, "bucketing: \"kd\"", REPAIR_OPTION_NAMES)?)?;
     let mut o = RepairOptions::default();
-    if let Some(b) = word(&js.bucketing, "bucketing", &["kd", "bvh"], "\"kd\" or \"bvh\"")? {
-        o = o.with_bucketing([Bucketing::KdTree, Bucketing::Bvh][b]);
+    if let Some(b) = word::<Bucketing>(&js.bucketing, "bucketing", "\"kd\" or \"bvh\"")? {
+        o = o.with_bucketing(b);
     }
     if let Some(Number(n)) = js.bucket_capacity {
         if !whole(n) {

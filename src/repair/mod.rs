@@ -48,6 +48,18 @@ pub enum Bucketing {
     Bvh,
 }
 
+impl Bucketing {
+    /// The words `FromStr` takes, in declaration order.
+    pub const WORDS: &'static [&'static str] = &["kd", "bvh"];
+}
+
+impl core::str::FromStr for Bucketing {
+    type Err = crate::UnknownWord;
+    fn from_str(s: &str) -> Result<Self, crate::UnknownWord> {
+        crate::options::parse_word(s, "bucketing", Self::WORDS, &[Self::KdTree, Self::Bvh])
+    }
+}
+
 /// Options of [`repair_mesh`]. Lengths are fractions of the input's
 /// bounding-box diagonal.
 #[derive(Debug, Clone, PartialEq)]

@@ -102,13 +102,7 @@ pub fn parse_repair(args: impl Iterator<Item = OsString>) -> Result<RepairArgs, 
                 output = Some((path.clone(), output_format(&path)?));
             }
             "--report" => report = Some(PathBuf::from(value()?)),
-            "--bucketing" => {
-                opts = opts.clone().with_bucketing(match value()?.to_str() {
-                    Some("kd") => Bucketing::KdTree,
-                    Some("bvh") => Bucketing::Bvh,
-                    _ => return Err("--bucketing must be kd or bvh".into()),
-                })
-            }
+            "--bucketing" => opts = opts.clone().with_bucketing(super::args::word::<Bucketing>(value()?)?),
             "--bucket-capacity" => {
                 let v = value()?;
                 let n = v.to_str().and_then(|s| s.parse().ok());
