@@ -55,27 +55,18 @@ impl WorkMesh {
                 }
                 // No flip helps: move an inner vertex of the fold to the
                 // middle of its neighbours (borders stay where sewing put them).
-                for &x in &v {
-                    if let Some(moved) = self.try_smooth(surface, c, t, x) {
-                        changed.extend(moved.iter().copied());
-                        next.extend(moved);
-                        fixed = true;
-                        break;
-                    }
-                }
-                if fixed {
-                    continue;
-                }
                 // Nor a move: where the (u,v) map is far from linear, the
                 // fold's corners sit in space where no triangle between them
-                // faces the surface's way; an inner corner goes.
-                for &x in &v {
-                    if let Some(kept) = self.try_collapse(surface, c, t, x) {
-                        changed.extend(kept.iter().copied());
-                        next.extend(kept);
-                        flipped = true;
-                        break;
-                    }
+                // faces the surface's way; an inner corner goes, which
+                // changes the triangles round it as a flip does.
+                let mended = v.iter().find_map(|&x| self.try_smooth(surface, c, t, x)).or_else(|| {
+                    let kept = v.iter().find_map(|&x| self.try_collapse(surface, c, t, x));
+                    flipped |= kept.is_some();
+                    kept
+                });
+                if let Some(ring) = mended {
+                    changed.extend(ring.iter().copied());
+                    next.extend(ring);
                 }
             }
             // A fold of several triangles (a fan on a border) unfolds one
@@ -283,7 +274,9 @@ impl WorkMesh {
     /// The triangles round inner vertex `x`, one of them `t`, in index
     /// order: walked across the edges at `x`, so it costs the fan, not the
     /// face. `None` where the walk meets a border (or the fan passes a
-    /// hundred triangles, or its turns disagree).
+    /// hundred triangles, or its turns disagree). An edge of three
+    /// triangles (the table holds two) can close the walk early, so callers
+    /// still check every edge at `x`.
     fn fan(&self, t: u32, x: u32) -> Option<Vec<u32>> {
         let mut ring = alloc::vec![t];
         let mut cur = t;
@@ -386,8 +379,7 @@ impl WorkMesh {
         around.sort_by(|&a, &b| self.pos[a as usize].distance(here).total_cmp(&self.pos[b as usize].distance(here)));
         let sense: f64 = ring.iter().map(|&t| uv_area(self.uv(t as usize))).sum();
         'candidates: for &y in &around {
-            let &pair = self.edges.get(&key(x, y))?;
-            let gone = [pair[0], pair[1]];
+            let &gone = self.edges.get(&key(x, y))?;
             // y's (u,v), the same in both triangles of the edge (one chart).
             let at = |m: &Self, t: u32| {
                 let tv = m.tris[t as usize];
@@ -419,21 +411,26 @@ impl WorkMesh {
             if !gone.iter().all(|t| ring.contains(t)) || kept.iter().any(|&t| self.tris[t as usize].contains(&y)) {
                 continue;
             }
+            // Each kept triangle before and after (x's corner taken by y).
             let old: Vec<([u32; 3], [DVec2; 3])> =
                 kept.iter().map(|&t| (self.tris[t as usize], self.uv(t as usize))).collect();
-            for (&t, (tv, w)) in kept.iter().zip(&old) {
-                let k = tv.iter().position(|&v| v == x).unwrap_or(0);
-                let (mut nv, mut nw) = (*tv, *w);
-                nv[k] = y;
-                nw[k] = q0;
-                self.tris[t as usize] = nv;
-                self.set_uv(t as usize, nw);
-            }
+            let new: Vec<([u32; 3], [DVec2; 3])> = old
+                .iter()
+                .map(|&(mut tv, mut w)| {
+                    let k = tv.iter().position(|&v| v == x).unwrap_or(0);
+                    (tv[k], w[k]) = (y, q0);
+                    (tv, w)
+                })
+                .collect();
+            let put = |m: &mut Self, rows: &[([u32; 3], [DVec2; 3])]| {
+                for (&t, &(tv, w)) in kept.iter().zip(rows) {
+                    m.tris[t as usize] = tv;
+                    m.set_uv(t as usize, w);
+                }
+            };
+            put(self, &new);
             let good = kept.iter().all(|&t| self.holds(surface, c, t, sense));
-            for (&t, (tv, w)) in kept.iter().zip(&old) {
-                self.tris[t as usize] = *tv;
-                self.set_uv(t as usize, *w);
-            }
+            put(self, &old);
             if !good {
                 continue;
             }
@@ -447,15 +444,10 @@ impl WorkMesh {
                 self.tris[t as usize] = [y; 3];
                 self.set_uv(t as usize, [q0; 3]);
             }
-            for (&t, (tv, w)) in kept.iter().zip(&old) {
-                let k = tv.iter().position(|&v| v == x).unwrap_or(0);
-                let (mut nv, mut nw) = (*tv, *w);
-                nv[k] = y;
-                nw[k] = q0;
-                self.tris[t as usize] = nv;
-                self.set_uv(t as usize, nw);
+            put(self, &new);
+            for (&t, &(tv, _)) in kept.iter().zip(&new) {
                 for k in 0..3 {
-                    self.attach(nv[k], nv[(k + 1) % 3], t);
+                    self.attach(tv[k], tv[(k + 1) % 3], t);
                 }
             }
             return Some(kept);
