@@ -214,7 +214,9 @@ fn own_bodies(model: &Model, mine: &[bool], reach: f64) -> Vec<u32> {
 }
 
 /// Sews the outlines of the faces to be meshed (see [`sew::unify`]), after
-/// the tessellated faces' border vertices are pinned on them; returns the node ids given.
+/// the tessellated faces' border vertices are pinned on them, and halves the
+/// sewn chords that then cross ([`sew::split_crossing_chords`]); returns the
+/// node ids given.
 fn unify_outlines(
     chosen: &mut [Option<Chosen<'_>>],
     bodies: &[u32],
@@ -230,7 +232,8 @@ fn unify_outlines(
         let mut faces: Vec<Option<(&dyn Surface, &mut face::Outline<'_>)>> =
             chosen.iter_mut().map(|c| c.as_mut().map(|c| (&c.face.surface as &dyn Surface, &mut c.outline))).collect();
         tessellated::pin_outlines(&mut faces, bodies, facets, sew_tol);
-        sew::unify(&mut faces, bodies, &moved, sew_tol, tight, reach)
+        let ids = sew::unify(&mut faces, bodies, &moved, sew_tol, tight, reach);
+        sew::split_crossing_chords(&mut faces, ids)
     }
     #[cfg(not(feature = "std"))]
     {

@@ -95,9 +95,13 @@ pub(super) fn nearest_fraction(dist: &dyn Fn(f64) -> f64, s0: f64) -> (f64, f64)
 mod outlines;
 #[cfg(feature = "std")]
 mod slide;
+#[cfg(feature = "std")]
+mod uncross;
 
 #[cfg(feature = "std")]
 pub(crate) use outlines::unify;
+#[cfg(feature = "std")]
+pub(crate) use uncross::split_crossing_chords;
 
 /// Where each model edge (a pair of node ids) is used: face and local ends.
 type Uses = HashMap<(u32, u32), Vec<(u32, u32, u32)>>;

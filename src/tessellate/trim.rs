@@ -379,10 +379,10 @@ fn segments_meet(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
 
 /// Two loop segments that cross or touch: (loop, segment) of each, and
 /// whether they are neighbours folding back onto each other.
-struct Crossing {
-    a: (usize, usize),
-    b: (usize, usize),
-    folds: bool,
+pub(crate) struct Crossing {
+    pub a: (usize, usize),
+    pub b: (usize, usize),
+    pub folds: bool,
 }
 
 /// Most rounds of splitting crossing chords (see [`split_crossings`]).
@@ -442,6 +442,13 @@ fn crossing_error(face: usize, x: &Crossing, order: &[usize]) -> Error {
 /// Finds a pair of loop segments that cross or touch (other than neighbours
 /// sharing their common node), bucketed on a uniform grid.
 fn first_crossing(loops: &Loops<'_>) -> Option<Crossing> {
+    crossings(loops, |_| true)
+}
+
+/// Calls `stop` with each pair of loop segments that cross or touch (a
+/// pair in two grid cells may come twice) until it returns true; returns
+/// that pair.
+pub(crate) fn crossings(loops: &Loops<'_>, mut stop: impl FnMut(&Crossing) -> bool) -> Option<Crossing> {
     struct Seg {
         a: DVec2,
         b: DVec2,
@@ -484,14 +491,18 @@ fn first_crossing(loops: &Loops<'_>) -> Option<Crossing> {
                         // Neighbours share one node; they only conflict if they fold back.
                         let (shared, p, q) = if (s.idx + 1) % n == t.idx { (s.b, s.a, t.b) } else { (s.a, s.b, t.a) };
                         let folds = orient(shared, p, q) == 0.0 && (p - shared).dot(q - shared) > 0.0;
-                        if folds && n > 2 {
-                            return Some(Crossing { a: (s.lp, s.idx), b: (t.lp, t.idx), folds: true });
+                        let x = Crossing { a: (s.lp, s.idx), b: (t.lp, t.idx), folds: true };
+                        if folds && n > 2 && stop(&x) {
+                            return Some(x);
                         }
                         continue;
                     }
                 }
                 if segments_meet(s.a, s.b, t.a, t.b) {
-                    return Some(Crossing { a: (s.lp, s.idx), b: (t.lp, t.idx), folds: false });
+                    let x = Crossing { a: (s.lp, s.idx), b: (t.lp, t.idx), folds: false };
+                    if stop(&x) {
+                        return Some(x);
+                    }
                 }
             }
         }

@@ -1,0 +1,182 @@
+//! Border chords that cross once the outlines are sewn.
+//!
+//! Each face's loops are freed of crossing chords before sewing
+//! ([`crate::tessellate::trim`], paper 000 §3.2), but sewing then adds the
+//! neighbours' nodes to them. A node added on a curve moves that chord out
+//! to the curve, and on a face narrower than its chords' sagitta (a ring a
+//! millimetre wide between two cylinders, at a coarse tolerance) it can move
+//! one border's chord across the other's. The triangulation cannot keep
+//! both, and the triangles between them go missing: a crack. Here such
+//! chords are halved again, in every face that shares them, so the sewn
+//! borders stay one.
+
+use alloc::vec::Vec;
+use glam::DVec3;
+
+use super::nearest_fraction;
+use crate::nurbs::Surface;
+use crate::tessellate::face::Outline;
+use crate::tessellate::trim::{crossings, CurveRef};
+
+/// Most rounds of halving; curves that really cross stay crossing after it.
+const MAX_ROUNDS: usize = 16;
+
+/// Most chords one round halves, so a face whose loops really cross
+/// everywhere costs a bounded amount.
+const MAX_CUTS: usize = 4096;
+
+/// Halves, on their curves, the sewn border segments that cross another
+/// segment of their face's loops, in every face that has that segment (by
+/// its two end ids); `ids` is the count of node ids given so far, and the
+/// count after the new nodes is returned. Each face's new node lies at its
+/// own curve's point nearest the first face's middle point, under one id.
+pub(crate) fn split_crossing_chords(faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>], mut ids: u32) -> u32 {
+    for _ in 0..MAX_ROUNDS {
+        let mut cuts: Vec<((u32, u32), DVec3)> = Vec::new();
+        for (surface, o) in faces.iter().flatten() {
+            let note = |k: usize, i: usize, cuts: &mut Vec<((u32, u32), DVec3)>| {
+                let (Some(poly), Some(g)) = (o.loops.polys.get(k), o.gids.get(k)) else { return };
+                let n = poly.uv.len();
+                let (Some(&(c, ta, tb)), Some(&ga), Some(&gb)) = (poly.seg.get(i), g.get(i), g.get((i + 1) % n)) else {
+                    return;
+                };
+                let Some(curve) = o.loops.curves.get(c as usize) else { return };
+                let tm = 0.5 * (ta + tb);
+                if ga == gb || ga == u32::MAX || gb == u32::MAX || tm == ta || tm == tb || !tm.is_finite() {
+                    return;
+                }
+                cuts.push(((ga.min(gb), ga.max(gb)), surface.point(curve.point(tm).truncate())));
+            };
+            crossings(&o.loops, |x| {
+                if !x.folds {
+                    note(x.a.0, x.a.1, &mut cuts);
+                    note(x.b.0, x.b.1, &mut cuts);
+                }
+                cuts.len() >= MAX_CUTS
+            });
+        }
+        if cuts.is_empty() {
+            break;
+        }
+        // One new id per segment, the first face's middle point for all.
+        crate::sort::by_u64(&mut cuts, |c| (u64::from(c.0 .0) << 32) | u64::from(c.0 .1));
+        cuts.dedup_by_key(|c| c.0);
+        for (surface, o) in faces.iter_mut().flatten() {
+            cut_face(*surface, o, &cuts, ids);
+        }
+        ids += cuts.len() as u32;
+    }
+    ids
+}
+
+/// Adds the new node of every segment of `o` whose end ids are in `cuts`
+/// (sorted by them): id `first + ` its place in `cuts`.
+fn cut_face(surface: &dyn Surface, o: &mut Outline<'_>, cuts: &[((u32, u32), DVec3)], first: u32) {
+    for k in 0..o.loops.polys.len() {
+        let poly = &mut o.loops.polys[k];
+        let gids = &mut o.gids[k];
+        let n = poly.uv.len();
+        if gids.len() != n {
+            continue;
+        }
+        // From the last segment, so the earlier indices stay valid.
+        for i in (0..n).rev() {
+            let (ga, gb) = (gids[i], gids[(i + 1) % n]);
+            let Ok(at) = cuts.binary_search_by_key(&(ga.min(gb), ga.max(gb)), |c| c.0) else { continue };
+            let (c, ta, tb) = poly.seg[i];
+            let Some(curve) = o.loops.curves.get(c as usize) else { continue };
+            let target = cuts[at].1;
+            let on_curve = |s: f64| surface.point(curve.point(ta + (tb - ta) * s).truncate());
+            let (s, _) = nearest_fraction(&|s: f64| on_curve(s).distance(target), 0.5);
+            let s = if s > 1e-9 && s < 1.0 - 1e-9 { s } else { 0.5 };
+            let t = ta + (tb - ta) * s;
+            poly.seg[i] = (c, ta, t);
+            poly.seg.insert(i + 1, (c, t, tb));
+            poly.uv.insert(i + 1, curve.point(t).truncate());
+            poly.at.insert(i + 1, CurveRef { curve: c, t });
+            gids.insert(i + 1, first + at as u32);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nurbs::NurbsCurve;
+    use crate::tessellate::trim::{Loops, Polyline};
+    use alloc::vec::Vec;
+    use glam::DVec2;
+
+    /// A line in (u,v) from `p` to `q`, parameter 0 to 1.
+    fn line(p: DVec2, q: DVec2) -> NurbsCurve {
+        NurbsCurve::try_new(1, alloc::vec![0.0, 0.0, 1.0, 1.0], alloc::vec![p.extend(0.0), q.extend(0.0)], None)
+            .unwrap()
+    }
+
+    /// A quadratic Bézier in (u,v) from `p` over control `c` to `q`.
+    fn arc(p: DVec2, c: DVec2, q: DVec2) -> NurbsCurve {
+        let pts = alloc::vec![p.extend(0.0), c.extend(0.0), q.extend(0.0)];
+        NurbsCurve::try_new(2, alloc::vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0], pts, None).unwrap()
+    }
+
+    /// One loop per entry, each of whole curves (one chord each) with their node ids.
+    fn outline<'a>(curves: &'a [NurbsCurve], loops: &[&[(usize, u32)]]) -> Outline<'a> {
+        let mut polys = Vec::new();
+        let mut gids = Vec::new();
+        for l in loops {
+            let mut poly = Polyline::default();
+            for &(c, _) in l.iter() {
+                poly.uv.push(curves[c].point(0.0).truncate());
+                poly.at.push(CurveRef { curve: c as u32, t: 0.0 });
+                poly.seg.push((c as u32, 0.0, 1.0));
+            }
+            polys.push(poly);
+            gids.push(l.iter().map(|x| x.1).collect());
+        }
+        let loops = Loops { polys, curves: curves.iter().collect(), mended: None };
+        Outline { loops, pu: Vec::new(), pv: Vec::new(), gids }
+    }
+
+    /// A face below an arc, with a hole that pokes up through the arc's
+    /// chord but not through the arc; the face above shares the arc. The
+    /// arc is halved in both faces under one new id, after which nothing
+    /// crosses. The two hole sides it crossed are halved too (in one round:
+    /// three new ids), which changes nothing on a line.
+    #[test]
+    fn a_chord_crossing_a_hole_is_halved_in_both_faces() {
+        let plane = crate::nurbs::analytic::xy_plane(10.0);
+        let p = |x: f64, y: f64| DVec2::new(x, y);
+        let below = [
+            line(p(-1.0, -1.0), p(1.0, -1.0)),
+            line(p(1.0, -1.0), p(1.0, 0.0)),
+            arc(p(1.0, 0.0), p(0.0, 2.0), p(-1.0, 0.0)),
+            line(p(-1.0, 0.0), p(-1.0, -1.0)),
+            // The hole, clockwise.
+            line(p(-0.2, -0.2), p(0.0, 0.4)),
+            line(p(0.0, 0.4), p(0.2, -0.2)),
+            line(p(0.2, -0.2), p(-0.2, -0.2)),
+        ];
+        let above = [
+            arc(p(-1.0, 0.0), p(0.0, 2.0), p(1.0, 0.0)),
+            line(p(1.0, 0.0), p(1.0, 3.0)),
+            line(p(1.0, 3.0), p(-1.0, 3.0)),
+            line(p(-1.0, 3.0), p(-1.0, 0.0)),
+        ];
+        let mut a = outline(&below, &[&[(0, 0), (1, 1), (2, 2), (3, 3)], &[(4, 4), (5, 5), (6, 6)]]);
+        let mut b = outline(&above, &[&[(0, 3), (1, 2), (2, 7), (3, 8)]]);
+        assert!(crossings(&a.loops, |_| true).is_some(), "the test's chords must cross");
+        let ids = {
+            let mut faces = alloc::vec![Some((&plane as &dyn Surface, &mut a)), Some((&plane as &dyn Surface, &mut b))];
+            split_crossing_chords(&mut faces, 9)
+        };
+        assert_eq!(ids, 12, "the arc and the two hole sides it crossed, once each");
+        assert!(crossings(&a.loops, |_| true).is_none());
+        // The arc's node (the first segment by ids) sits on its top in
+        // both faces, under id 9.
+        for (o, k) in [(&a, 3), (&b, 1)] {
+            let at = o.gids[0].iter().position(|&g| g == 9).expect("the new node");
+            assert_eq!(at, k, "{:?}", o.gids[0]);
+            assert!(o.loops.polys[0].uv[at].distance(p(0.0, 1.0)) < 1e-9, "{:?}", o.loops.polys[0].uv);
+        }
+    }
+}
