@@ -43,7 +43,7 @@ pub(crate) fn collapse_edges(tris: &mut Vec<[u32; 3]>, same: impl Fn(u32, u32) -
     if edges.is_empty() {
         return 0;
     }
-    edges.sort_unstable();
+    crate::sort::pairs(&mut edges);
     edges.dedup();
     // The triangles at each end of a candidate edge: all a collapse looks at.
     let mut around: HashMap<u32, Vec<u32>> = HashMap::default();
@@ -103,7 +103,7 @@ pub(crate) fn collapse_edges(tris: &mut Vec<[u32; 3]>, same: impl Fn(u32, u32) -
                     }
                 }
             }
-            seen.sort_unstable();
+            crate::sort::pairs(&mut seen);
             // An edge from `me` with one triangle: `me` is on the border.
             let mut k = 0;
             let mut any = false;
