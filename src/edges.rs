@@ -68,7 +68,7 @@ pub fn edge_lines(mesh: &Mesh) -> EdgeLines {
             }
         }
         let mut once: Vec<(u32, u32)> = uses.iter().filter(|(_, &n)| n == 1).map(|(e, _)| *e).collect();
-        once.sort_unstable();
+        crate::sort::pairs(&mut once);
         for e in once {
             let b = *border_of.entry(e).or_insert_with(|| {
                 borders.push(Border { ends: [e.0, e.1], faces: Vec::new() });

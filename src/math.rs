@@ -21,14 +21,32 @@ pub(crate) fn atan2(y: f64, x: f64) -> f64 {
     libm::atan2(y, x)
 }
 
+/// Rounding up: with `std`, the processor's instruction (`f64.ceil` on
+/// wasm32, where libm's is a bit-twiddling routine); without it, libm. Both
+/// are exact, so the results are the same.
 #[inline]
 pub(crate) fn ceil(x: f64) -> f64 {
-    libm::ceil(x)
+    #[cfg(feature = "std")]
+    {
+        x.ceil()
+    }
+    #[cfg(not(feature = "std"))]
+    {
+        libm::ceil(x)
+    }
 }
 
+/// Rounding down, as [`ceil`]: the instruction with `std`, else libm.
 #[inline]
 pub(crate) fn floor(x: f64) -> f64 {
-    libm::floor(x)
+    #[cfg(feature = "std")]
+    {
+        x.floor()
+    }
+    #[cfg(not(feature = "std"))]
+    {
+        libm::floor(x)
+    }
 }
 
 /// Angle in radians between two vectors; 0 when either is zero.

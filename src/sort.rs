@@ -53,10 +53,64 @@ fn sort_f64_keys(keys: &mut [(f64, u32)]) {
     });
 }
 
-/// The one sort of `(u64 key, index)` pairs.
+/// The one sort of `(u64 key, index)` pairs (also pairs of other meanings:
+/// every sort of two or three integers goes through it).
 #[inline(never)]
-fn sort_u64_keys(keys: &mut [(u64, u32)]) {
+pub(crate) fn sort_u64_keys(keys: &mut [(u64, u32)]) {
     keys.sort_unstable();
+}
+
+/// Sorts `v` ascending through [`sort_u64_keys`]: `key` must map `v`'s order
+/// onto the keys' and `back` undo it, so that equal keys are equal items and
+/// the result is that of `v.sort_unstable()`.
+fn through_keys<T>(v: &mut [T], key: impl Fn(&T) -> (u64, u32), back: impl Fn((u64, u32)) -> T) {
+    if v.len() < 2 {
+        return;
+    }
+    let mut keys: Vec<(u64, u32)> = v.iter().map(key).collect();
+    sort_u64_keys(&mut keys);
+    for (x, k) in v.iter_mut().zip(keys) {
+        *x = back(k);
+    }
+}
+
+/// The two halves of a [`pair`] key.
+fn unpair(k: u64) -> (u32, u32) {
+    ((k >> 32) as u32, k as u32)
+}
+
+/// Sorts pairs ascending, as `v.sort_unstable()` does.
+pub(crate) fn pairs(v: &mut [(u32, u32)]) {
+    through_keys(v, |&(a, b)| (pair(a, b), 0), |(k, _)| unpair(k));
+}
+
+/// Sorts triples ascending, as `v.sort_unstable()` does.
+pub(crate) fn triples(v: &mut [(u32, u32, u32)]) {
+    through_keys(
+        v,
+        |&(a, b, c)| (pair(a, b), c),
+        |(k, c)| {
+            let (a, b) = unpair(k);
+            (a, b, c)
+        },
+    );
+}
+
+/// Sorts `(u32, bool, u32)` ascending, as `v.sort_unstable()` does.
+pub(crate) fn flagged_triples(v: &mut [(u32, bool, u32)]) {
+    through_keys(
+        v,
+        |&(a, f, c)| (pair(a, u32::from(f)), c),
+        |(k, c)| {
+            let (a, f) = unpair(k);
+            (a, f != 0, c)
+        },
+    );
+}
+
+/// Sorts indices ascending, as `v.sort_unstable()` does.
+pub(crate) fn usizes(v: &mut [usize]) {
+    through_keys(v, |&x| (x as u64, 0), |(k, _)| k as usize);
 }
 
 /// Reorders `v` so that its item `k` is the old item `order(k)`, by following
@@ -122,6 +176,29 @@ mod tests {
         f64s(&mut got);
         want.reverse();
         assert_eq!(bits(&got), bits(&want));
+    }
+
+    #[test]
+    fn tuple_sorts_match_sort_unstable() {
+        let mut seed = 11;
+        for n in [0usize, 1, 2, 5, 40, 700] {
+            let mut r = |m: u64| (lcg(&mut seed) % m) as u32;
+            let p: Vec<(u32, u32)> = (0..n).map(|_| (r(7), r(5) * 0x3000_0000)).collect();
+            let t: Vec<(u32, u32, u32)> = (0..n).map(|_| (r(4) * 0x5000_0000, r(9), r(3) * 0x7000_0000)).collect();
+            let f: Vec<(u32, bool, u32)> = (0..n).map(|_| (r(6), r(2) == 1, r(4))).collect();
+            let u: Vec<usize> = (0..n).map(|_| r(50) as usize * 1_000_003).collect();
+            let (mut pw, mut tw, mut fw, mut uw) = (p.clone(), t.clone(), f.clone(), u.clone());
+            pw.sort_unstable();
+            tw.sort_unstable();
+            fw.sort_unstable();
+            uw.sort_unstable();
+            let (mut pg, mut tg, mut fg, mut ug) = (p, t, f, u);
+            pairs(&mut pg);
+            triples(&mut tg);
+            flagged_triples(&mut fg);
+            usizes(&mut ug);
+            assert_eq!((pg, tg, fg, ug), (pw, tw, fw, uw), "n = {n}");
+        }
     }
 
     #[test]

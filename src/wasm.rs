@@ -1,10 +1,10 @@
 //! The JavaScript door (wasm-bindgen): JS values in, core types through
 //! [`crate::mesh_instanced`], typed arrays out. No algorithm lives here.
 //!
-//! Options are read key by key from the JS object (every key must be
-//! known, every value of its type); reports leave as JS objects serialized
-//! straight from the core's structs, the typed arrays beside them passed
-//! through as they are.
+//! Options come in through serde-wasm-bindgen (every key must be known,
+//! every value of its type; a bad one is an [`OptionError`]); reports leave
+//! as JS objects serialized straight from the core's structs, the typed
+//! arrays beside them passed through as they are.
 //!
 //! Errors are thrown as JS `Error` objects whose message is the
 //! [`crate::Error`] `Display` text, the same line the command line prints.
@@ -18,6 +18,7 @@ use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 
 use js_sys::{Array, Float32Array, Function, Uint32Array};
+use serde::de::{DeserializeSeed, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
@@ -26,7 +27,7 @@ use crate::{edge_lines, flatten, mesh_instanced, mm_per_unit, read_model, read_s
 use crate::{fit_points, read_points, FitOptions, FitReport, FitResult, PointFormat};
 #[cfg(feature = "repair")]
 use crate::{offset_mesh, read_mesh, repair_mesh_timed, Bucketing, MeshFormat, RepairOptions, RepairReport};
-use crate::{Error, Format, InstancedResult, Mesh, MeshMode, MeshOptions, QualityMethod, Report, Units};
+use crate::{Error, Format, InstancedResult, Mesh, MeshMode, MeshOptions, OptionsError, QualityMethod, Report, Units};
 // `tests/wasm_node.rs` compiles this file into a crate where `crate::` is the
 // test itself, which does not import this name; take it from the library there.
 #[cfg(not(test))]
@@ -447,130 +448,338 @@ export function fit(bytes: Uint8Array, format: string, options?: FitOptions): Fi
 "#;
 
 // ---------------------------------------------------------------------------
-// Option values: read key by key from the options object, each getter saying
-// what it expected and what it found, in the words of the one-line errors,
-// after the option's name. (Hand-written rather than serde: the derive and
-// its path tracking were 20 KB of the viewer module, 8 KB gzipped.)
+// Options: serde-wasm-bindgen reads an options object's entries (every own
+// key, so an unknown one is caught) into one raw value per known option;
+// typed getters then check the values in the order of the option names, so
+// of two bad options the first named is the error, whatever the key order.
+// (A derived Deserialize would not do: through serde-wasm-bindgen a derived
+// struct reads only its own field names, so `deny_unknown_fields` never sees
+// an unknown key, and its errors are JS objects without the option's name.)
 
-/// A finite number.
-#[derive(Debug, Clone, Copy)]
-struct Number(f64);
-
-/// A string.
-#[derive(Debug, Clone)]
-struct Text(String);
-
-/// A boolean.
-#[derive(Debug, Clone, Copy)]
-struct Flag(bool);
-
-/// Any value, told apart only as much as the errors need: numbers, the rest by kind.
-#[derive(Debug, Clone, Copy)]
-enum Loose {
-    Number(f64),
-    Other,
+/// Why an options object was rejected; `Display` is the one-line message.
+#[derive(Debug, Clone, PartialEq)]
+enum OptionError {
+    /// Not an object; `example` shows one.
+    NotObject { example: &'static str, found: &'static str },
+    /// A key that names no option.
+    Unknown { key: String, known: &'static [&'static str] },
+    /// A value of the wrong kind.
+    Kind { name: &'static str, expected: &'static str, found: &'static str },
+    /// A number that is NaN or infinite.
+    NotFinite { name: &'static str, found: f64 },
+    /// A number that must be whole (and within `range`, words after "whole number").
+    NotWhole { name: &'static str, range: &'static str, found: f64 },
+    /// A value none of the accepted ones, which `expected` lists.
+    Expected { name: &'static str, expected: &'static str },
+    /// Two options that exclude each other.
+    Both { name: &'static str, other: &'static str },
+    /// A value the core rejects (its own option words).
+    Core(OptionsError),
 }
 
-/// What `share` holds: the first few values of an array, checked once read.
-#[derive(Debug, Clone)]
-struct List(Vec<Loose>);
-
-/// The message of a `share` that is not `[index, count]`.
-const SHARE_EXPECTED: &str = "expected [index, count] with whole numbers, index < count";
-
-/// The kind of a JS value, as the errors name it.
-fn kind(v: &JsValue) -> &'static str {
-    if v.as_bool().is_some() {
-        "boolean"
-    } else if v.as_f64().is_some() || v.is_bigint() {
-        "number"
-    } else if v.is_string() {
-        "string"
-    } else if Array::is_array(v) {
-        "an array"
-    } else if v.is_function() {
-        "function"
-    } else if v.is_symbol() {
-        "symbol"
-    } else {
-        "object"
+impl core::fmt::Display for OptionError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::NotObject { example, found } => {
+                write!(f, "options: expected an object like {{ {example} }}, found {found}")
+            }
+            Self::Unknown { key, known } => write!(f, "option {key}: unknown option (known: {})", known.join(", ")),
+            Self::Kind { name, expected, found } => write!(f, "option {name}: expected {expected}, found {found}"),
+            Self::NotFinite { name, found } => write!(f, "option {name}: expected a finite number, found {found}"),
+            Self::NotWhole { name, range, found } => {
+                write!(f, "option {name}: expected a whole number{range}, found {found}")
+            }
+            Self::Expected { name, expected } => write!(f, "option {name}: expected {expected}"),
+            Self::Both { name, other } => write!(f, "option {name}: give {name} or {other}, not both"),
+            Self::Core(e) => write!(f, "{e}"),
+        }
     }
 }
 
-/// A JS number as f64; a BigInt too (one beyond the i64 range is infinite).
-fn number_of(v: &JsValue) -> Option<f64> {
-    v.as_f64().or_else(|| v.is_bigint().then(|| i64::try_from(v.clone()).map_or(f64::INFINITY, |x| x as f64)))
+impl From<OptionsError> for OptionError {
+    fn from(e: OptionsError) -> Self {
+        Self::Core(e)
+    }
 }
 
-/// The options object after `options()` checked it: each getter reads one
-/// key, `None` when it is absent, undefined or null.
-struct Fields(Option<js_sys::Object>);
+/// One option's value as serde-wasm-bindgen gives it, told apart only as
+/// much as the getters and their errors need.
+#[derive(Debug, Clone, Default)]
+enum Value {
+    /// Absent, undefined or null: the default.
+    #[default]
+    Absent,
+    Number(f64),
+    Text(String),
+    Flag(bool),
+    /// An array's first three items, each a number or not (enough to tell
+    /// `[index, count]` from anything else).
+    List(Vec<Option<f64>>),
+    /// Any other object.
+    Object,
+    /// What serde-wasm-bindgen cannot read: a function, a symbol, a Set or
+    /// typed array, a BigInt beyond 64 bits.
+    Unsupported,
+}
+
+impl Value {
+    /// The value's kind, as the errors name it.
+    fn kind(&self) -> &'static str {
+        match self {
+            Self::Absent => "null",
+            Self::Number(_) => "number",
+            Self::Text(_) => "string",
+            Self::Flag(_) => "boolean",
+            Self::List(_) => "an array",
+            Self::Object => "object",
+            Self::Unsupported => "an unsupported value",
+        }
+    }
+}
+
+/// Reads any JS value as a [`Value`]; `Scalar` reads an array item, which
+/// is a number or not (so nested arrays are never walked).
+struct ValueVisitor {
+    scalar: bool,
+}
+
+impl<'de> Visitor<'de> for ValueVisitor {
+    type Value = Value;
+
+    fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("an option value")
+    }
+    fn visit_unit<E>(self) -> Result<Value, E> {
+        Ok(Value::Absent)
+    }
+    fn visit_none<E>(self) -> Result<Value, E> {
+        Ok(Value::Absent)
+    }
+    fn visit_bool<E>(self, b: bool) -> Result<Value, E> {
+        Ok(Value::Flag(b))
+    }
+    fn visit_i64<E>(self, x: i64) -> Result<Value, E> {
+        Ok(Value::Number(x as f64))
+    }
+    fn visit_u64<E>(self, x: u64) -> Result<Value, E> {
+        Ok(Value::Number(x as f64))
+    }
+    fn visit_f64<E>(self, x: f64) -> Result<Value, E> {
+        Ok(Value::Number(x))
+    }
+    fn visit_str<E>(self, s: &str) -> Result<Value, E> {
+        Ok(Value::Text(s.into()))
+    }
+    fn visit_string<E>(self, s: String) -> Result<Value, E> {
+        Ok(Value::Text(s))
+    }
+    fn visit_bytes<E>(self, _: &[u8]) -> Result<Value, E> {
+        Ok(Value::Object)
+    }
+    fn visit_map<A: MapAccess<'de>>(self, _: A) -> Result<Value, A::Error> {
+        Ok(Value::Object)
+    }
+    fn visit_seq<A: SeqAccess<'de>>(self, mut items: A) -> Result<Value, A::Error> {
+        if self.scalar {
+            return Ok(Value::List(Vec::new()));
+        }
+        let mut first = Vec::new();
+        while first.len() < 3 {
+            match items.next_element_seed(ValueSeed { scalar: true }) {
+                Ok(Some(Value::Number(x))) => first.push(Some(x)),
+                Ok(Some(_)) | Err(_) => first.push(None),
+                Ok(None) => break,
+            }
+        }
+        Ok(Value::List(first))
+    }
+}
+
+/// [`ValueVisitor`] as a seed: an option's value, or an array's item.
+struct ValueSeed {
+    scalar: bool,
+}
+
+impl<'de> DeserializeSeed<'de> for ValueSeed {
+    type Value = Value;
+
+    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Value, D::Error> {
+        d.deserialize_any(ValueVisitor { scalar: self.scalar })
+    }
+}
+
+/// An options object's entries: one [`Value`] per name of `known`, or the
+/// first key that is none of them.
+struct Entries {
+    known: &'static [&'static str],
+}
+
+impl<'de> Visitor<'de> for Entries {
+    type Value = Result<Vec<Value>, OptionError>;
+
+    fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("an options object")
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+        let mut values = alloc::vec![Value::Absent; self.known.len()];
+        let mut unknown = None;
+        while let Some(key) = map.next_key::<String>()? {
+            match self.known.iter().position(|&n| n == key) {
+                // A value serde-wasm-bindgen cannot read is kept as such, for the getter to name.
+                Some(k) => values[k] = map.next_value_seed(ValueSeed { scalar: false }).unwrap_or(Value::Unsupported),
+                None => {
+                    map.next_value::<IgnoredAny>()?;
+                    unknown.get_or_insert(key);
+                }
+            }
+        }
+        Ok(match unknown {
+            Some(key) => Err(OptionError::Unknown { key, known: self.known }),
+            None => Ok(values),
+        })
+    }
+}
+
+/// A checked options object: each getter reads one option, `None` when it
+/// is absent, undefined or null, else its value or the option's error.
+struct Fields {
+    known: &'static [&'static str],
+    values: Vec<Value>,
+}
 
 impl Fields {
-    fn get(&self, name: &str) -> Option<JsValue> {
-        let v = js_sys::Reflect::get(self.0.as_ref()?, &JsValue::from_str(name)).ok()?;
-        (!v.is_undefined() && !v.is_null()).then_some(v)
+    /// Reads `value` through serde-wasm-bindgen: undefined and null are the
+    /// defaults; anything but a plain object, or a key not in `known`, is an
+    /// error (`example` shows an options object in it).
+    fn read(value: JsValue, example: &'static str, known: &'static [&'static str]) -> Result<Self, OptionError> {
+        let values = alloc::vec![Value::Absent; known.len()];
+        if value.is_undefined() || value.is_null() {
+            return Ok(Self { known, values });
+        }
+        let not_object = |found| OptionError::NotObject { example, found };
+        if Array::is_array(&value) {
+            return Err(not_object("an array"));
+        }
+        if !value.is_object() {
+            return Err(not_object(match value.js_typeof().as_string().as_deref() {
+                Some("number") => "number",
+                Some("string") => "string",
+                Some("boolean") => "boolean",
+                Some("bigint") => "bigint",
+                Some("function") => "function",
+                _ => "symbol",
+            }));
+        }
+        // A Map, Set or typed array would be read as a list of entries.
+        if js_sys::Symbol::iterator().js_in(&value) {
+            return Err(not_object("an iterable"));
+        }
+        let values = serde_wasm_bindgen::Deserializer::from(value)
+            .deserialize_map(Entries { known })
+            .unwrap_or_else(|_| Err(not_object("an unreadable object")))?;
+        Ok(Self { known, values })
     }
 
-    fn number(&self, name: &str) -> Result<Option<Number>, String> {
-        let Some(v) = self.get(name) else { return Ok(None) };
-        match number_of(&v) {
-            Some(x) if x.is_finite() => Ok(Some(Number(x))),
-            Some(x) => Err(format!("option {name}: expected a finite number, found {x}")),
-            None => Err(format!("option {name}: expected a number, found {}", kind(&v))),
+    /// The value of option `name` (one of `known`).
+    fn get(&self, name: &'static str) -> &Value {
+        self.known.iter().position(|&n| n == name).and_then(|k| self.values.get(k)).unwrap_or(&Value::Absent)
+    }
+
+    fn number(&self, name: &'static str) -> Result<Option<f64>, OptionError> {
+        match *self.get(name) {
+            Value::Absent => Ok(None),
+            Value::Number(x) if x.is_finite() => Ok(Some(x)),
+            Value::Number(found) => Err(OptionError::NotFinite { name, found }),
+            ref v => Err(OptionError::Kind { name, expected: "a number", found: v.kind() }),
         }
     }
 
-    fn text(&self, name: &str) -> Result<Option<Text>, String> {
-        let Some(v) = self.get(name) else { return Ok(None) };
-        match v.as_string() {
-            Some(t) => Ok(Some(Text(t))),
-            None => Err(format!("option {name}: expected a string, found {}", kind(&v))),
+    fn text(&self, name: &'static str) -> Result<Option<&str>, OptionError> {
+        match self.get(name) {
+            Value::Absent => Ok(None),
+            Value::Text(t) => Ok(Some(t)),
+            v => Err(OptionError::Kind { name, expected: "a string", found: v.kind() }),
         }
     }
 
-    fn flag(&self, name: &str) -> Result<Option<Flag>, String> {
-        let Some(v) = self.get(name) else { return Ok(None) };
-        match v.as_bool() {
-            Some(b) => Ok(Some(Flag(b))),
-            None => Err(format!("option {name}: expected a boolean, found {}", kind(&v))),
+    fn flag(&self, name: &'static str) -> Result<Option<bool>, OptionError> {
+        match *self.get(name) {
+            Value::Absent => Ok(None),
+            Value::Flag(b) => Ok(Some(b)),
+            ref v => Err(OptionError::Kind { name, expected: "a boolean", found: v.kind() }),
         }
     }
 
-    /// An array's first three values (enough to tell `[index, count]` from longer ones).
-    fn list(&self, name: &str) -> Result<Option<List>, String> {
-        let Some(v) = self.get(name) else { return Ok(None) };
-        if !Array::is_array(&v) {
-            return Err(format!("option {name}: {SHARE_EXPECTED}"));
+    /// An array's first three items, each a number or not.
+    fn list(&self, name: &'static str) -> Result<Option<&[Option<f64>]>, OptionError> {
+        match self.get(name) {
+            Value::Absent => Ok(None),
+            Value::List(items) => Ok(Some(items)),
+            _ => Err(share_error(name)),
         }
-        let items = Array::from(&v).into_iter().take(3);
-        Ok(Some(List(items.map(|x| number_of(&x).map_or(Loose::Other, Loose::Number)).collect())))
     }
 }
 
-/// The options of `mesh` as JS gives them.
-#[derive(Debug, Default)]
-struct JsMeshOptions {
-    tolerance: Option<Number>,
-    tolerance_rel: Option<Number>,
-    angle: Option<Number>,
-    max_edge: Option<Number>,
-    min_edge: Option<Number>,
-    max_triangles: Option<Number>,
-    reparam: Option<Text>,
-    mode: Option<Text>,
-    size: Option<Number>,
-    size_rel: Option<Number>,
-    method: Option<Text>,
-    share: Option<List>,
-    units: Option<Text>,
-    flatten: Option<Flag>,
-    console_warnings: Option<Flag>,
+/// The error of a `share` that is not `[index, count]`.
+fn share_error(name: &'static str) -> OptionError {
+    OptionError::Expected { name, expected: "[index, count] with whole numbers, index < count" }
 }
 
-impl JsMeshOptions {
-    /// Reads every option in this order: the first bad one is the error.
-    fn read(f: &Fields) -> Result<Self, String> {
+/// `[index, count]`: whole numbers, index < count.
+fn share(name: &'static str, items: &[Option<f64>]) -> Result<(u32, u32), OptionError> {
+    match items {
+        [Some(i), Some(n)] if whole(*i) && whole(*n) && i < n => Ok((*i as u32, *n as u32)),
+        _ => Err(share_error(name)),
+    }
+}
+
+/// The option's word parsed by its enum's `FromStr` (the CLI's parser
+/// too); the error lists the words as `expected`.
+fn word<T: core::str::FromStr>(
+    text: Option<&str>,
+    name: &'static str,
+    expected: &'static str,
+) -> Result<Option<T>, OptionError> {
+    text.map(|t| t.parse().map_err(|_| OptionError::Expected { name, expected })).transpose()
+}
+
+/// `n` if it is a whole number from 0 to `u32::MAX`.
+fn whole_number(n: Option<f64>, name: &'static str) -> Result<Option<usize>, OptionError> {
+    match n {
+        Some(n) if whole(n) => Ok(Some(n as usize)),
+        Some(found) => Err(OptionError::NotWhole { name, range: "", found }),
+        None => Ok(None),
+    }
+}
+
+/// Whether `x` is a whole number from 0 to `u32::MAX`.
+fn whole(x: f64) -> bool {
+    x.fract() == 0.0 && (0.0..=u32::MAX as f64).contains(&x)
+}
+
+/// The options of `mesh`, each of its type (read in [`OPTION_NAMES`] order:
+/// the first bad one is the error).
+struct JsMeshOptions<'a> {
+    tolerance: Option<f64>,
+    tolerance_rel: Option<f64>,
+    angle: Option<f64>,
+    max_edge: Option<f64>,
+    min_edge: Option<f64>,
+    max_triangles: Option<f64>,
+    reparam: Option<&'a str>,
+    mode: Option<&'a str>,
+    size: Option<f64>,
+    size_rel: Option<f64>,
+    method: Option<&'a str>,
+    share: Option<&'a [Option<f64>]>,
+    units: Option<&'a str>,
+    flatten: Option<bool>,
+    console_warnings: Option<bool>,
+}
+
+impl<'a> JsMeshOptions<'a> {
+    fn read(f: &'a Fields) -> Result<Self, OptionError> {
         Ok(Self {
             tolerance: f.number("tolerance")?,
             tolerance_rel: f.number("toleranceRel")?,
@@ -610,40 +819,6 @@ const OPTION_NAMES: &[&str] = &[
     "consoleWarnings",
 ];
 
-/// Checks an options object: undefined and null are the defaults (as is an
-/// option that is undefined or null); anything but an object, or a key not
-/// in `known`, is a one-line error. The values are read by [`Fields`].
-fn options(value: JsValue, example: &str, known: &[&str]) -> Result<Fields, String> {
-    if value.is_undefined() || value.is_null() {
-        return Ok(Fields(None));
-    }
-    if !value.is_object() || Array::is_array(&value) || value.is_function() {
-        let found =
-            if Array::is_array(&value) { "an array".into() } else { value.js_typeof().as_string().unwrap_or_default() };
-        return Err(format!("options: expected an object like {{ {example} }}, found {found}"));
-    }
-    let object: js_sys::Object = value.unchecked_into();
-    for key in js_sys::Object::keys(&object).iter() {
-        let key = key.as_string().unwrap_or_default();
-        if !known.contains(&key.as_str()) {
-            return Err(format!("option {key}: unknown option (known: {})", known.join(", ")));
-        }
-    }
-    Ok(Fields(Some(object)))
-}
-
-/// The option's value parsed by its enum's `FromStr` (the CLI's parser
-/// too); the message lists the words as `expected`.
-fn word<T: core::str::FromStr>(value: &Option<Text>, name: &str, expected: &str) -> Result<Option<T>, String> {
-    let Some(Text(text)) = value else { return Ok(None) };
-    text.parse().map(Some).map_err(|_| format!("option {name}: expected {expected}"))
-}
-
-/// Whether `x` is a whole number from 0 to `u32::MAX`.
-fn whole(x: f64) -> bool {
-    x.fract() == 0.0 && (0.0..=u32::MAX as f64).contains(&x)
-}
-
 /// What `mesh` does besides the meshing options.
 #[derive(Debug, Clone, Copy)]
 struct Output {
@@ -653,61 +828,55 @@ struct Output {
 }
 
 /// The meshing options, the unit of the result and the output's shape.
-fn mesh_options(value: JsValue) -> Result<(MeshOptions, Output), String> {
-    let js = JsMeshOptions::read(&options(value, "toleranceRel: 0.001", OPTION_NAMES)?)?;
+fn mesh_options(value: JsValue) -> Result<(MeshOptions, Output), OptionError> {
+    let fields = Fields::read(value, "toleranceRel: 0.001", OPTION_NAMES)?;
+    let js = JsMeshOptions::read(&fields)?;
     let mut o = MeshOptions::default();
     match (js.tolerance, js.tolerance_rel) {
-        (Some(_), Some(_)) => return Err("option tolerance: give tolerance or toleranceRel, not both".into()),
-        (Some(Number(t)), None) => o = o.with_tolerance(t),
-        (None, Some(Number(r))) => o = o.with_relative_tolerance(r),
+        (Some(_), Some(_)) => return Err(OptionError::Both { name: "tolerance", other: "toleranceRel" }),
+        (Some(t), None) => o = o.with_tolerance(t),
+        (None, Some(r)) => o = o.with_relative_tolerance(r),
         (None, None) => {}
     }
-    if let Some(Number(a)) = js.angle {
+    if let Some(a) = js.angle {
         o = o.with_angle(a);
     }
-    if let Some(Number(m)) = js.max_edge {
+    if let Some(m) = js.max_edge {
         o = o.with_max_edge(Some(m));
     }
-    if let Some(Number(m)) = js.min_edge {
+    if let Some(m) = js.min_edge {
         o = o.with_min_edge(Some(m));
     }
-    if let Some(Number(n)) = js.max_triangles {
-        if !whole(n) {
-            return Err(format!("option maxTriangles: expected a whole number, found {n}"));
-        }
-        o = o.with_max_triangles(n as usize);
+    if let Some(n) = whole_number(js.max_triangles, "maxTriangles")? {
+        o = o.with_max_triangles(n);
     }
-    if let Some(r) = word::<Reparam>(&js.reparam, "reparam", "\"auto\", \"off\" or \"force\"")? {
+    if let Some(r) = word::<Reparam>(js.reparam, "reparam", "\"auto\", \"off\" or \"force\"")? {
         o = o.with_reparam(r);
     }
     let mut quality = o.quality.clone();
     match (js.size, js.size_rel) {
-        (Some(_), Some(_)) => return Err("option size: give size or sizeRel, not both".into()),
-        (Some(Number(h)), None) => quality = quality.with_size(h),
-        (None, Some(Number(r))) => quality = quality.with_relative_size(r),
+        (Some(_), Some(_)) => return Err(OptionError::Both { name: "size", other: "sizeRel" }),
+        (Some(h), None) => quality = quality.with_size(h),
+        (None, Some(r)) => quality = quality.with_relative_size(r),
         (None, None) => {}
     }
-    if let Some(m) = word::<QualityMethod>(&js.method, "method", "one of \"looping\", \"delaunay\", \"best\"")? {
+    if let Some(m) = word::<QualityMethod>(js.method, "method", "one of \"looping\", \"delaunay\", \"best\"")? {
         quality = quality.with_method(m);
     }
     o = o.with_quality(quality);
-    if let Some(m) = word::<MeshMode>(&js.mode, "mode", "one of \"fast\", \"quality\"")? {
+    if let Some(m) = word::<MeshMode>(js.mode, "mode", "one of \"fast\", \"quality\"")? {
         o = o.with_mode(m);
     }
-    if let Some(List(pair)) = js.share {
-        match pair.as_slice() {
-            [Loose::Number(i), Loose::Number(n)] if whole(*i) && whole(*n) && i < n => {
-                o = o.with_share(*i as u32, *n as u32);
-            }
-            _ => return Err(format!("option share: {SHARE_EXPECTED}")),
-        }
+    if let Some(items) = js.share {
+        let (index, count) = share("share", items)?;
+        o = o.with_share(index, count);
     }
     let units = match js.units {
-        Some(Text(name)) => Units::from_name(&name).map_err(|e| e.to_string())?,
+        Some(name) => Units::from_name(name)?,
         None => Units::File,
     };
-    let flatten = js.flatten.is_some_and(|Flag(b)| b);
-    let console_warnings = js.console_warnings.is_some_and(|Flag(b)| b);
+    let flatten = js.flatten.unwrap_or(false);
+    let console_warnings = js.console_warnings.unwrap_or(false);
     Ok((o, Output { units, flatten, console_warnings }))
 }
 
@@ -738,7 +907,7 @@ pub fn memory_bytes() -> f64 {
 /// that is invalid.
 #[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
 pub fn mesh(bytes: Vec<u8>, format: &str, options: JsValue) -> Result<JsValue, JsError> {
-    let (options, output) = mesh_options(options).map_err(|e| JsError::new(&e))?;
+    let (options, output) = mesh_options(options).map_err(|e| JsError::new(&one_line(&e.to_string())))?;
     run(bytes, format, &options, output, &mut |_, _| true).map_err(|e| JsError::new(&one_line(&e.to_string())))
 }
 
@@ -757,7 +926,8 @@ pub fn mesh_with_progress(
     options: JsValue,
     progress: &Function,
 ) -> Result<JsValue, JsValue> {
-    let (options, output) = mesh_options(options).map_err(|e| JsValue::from(JsError::new(&e)))?;
+    let (options, output) =
+        mesh_options(options).map_err(|e| JsValue::from(JsError::new(&one_line(&e.to_string()))))?;
     let mut thrown: Option<JsValue> = None;
     let mut call = |done: usize, total: usize| -> bool {
         match progress.call2(&JsValue::NULL, &JsValue::from(done as f64), &JsValue::from(total as f64)) {
@@ -1096,21 +1266,20 @@ fn flat_to_js(result: &InstancedResult, read: &Read, faces: usize) -> Result<JsV
 // ---------------------------------------------------------------------------
 // The full build's functions: repair, offset, fit.
 
-/// The options of `repair` as JS gives them.
+/// The options of `repair`, each of its type (read in
+/// [`REPAIR_OPTION_NAMES`] order: the first bad one is the error).
 #[cfg(feature = "repair")]
-#[derive(Debug, Default)]
-struct JsRepairOptions {
-    bucketing: Option<Text>,
-    bucket_capacity: Option<Number>,
-    weld_tolerance: Option<Number>,
-    perturbation: Option<Number>,
-    verify: Option<Flag>,
+struct JsRepairOptions<'a> {
+    bucketing: Option<&'a str>,
+    bucket_capacity: Option<f64>,
+    weld_tolerance: Option<f64>,
+    perturbation: Option<f64>,
+    verify: Option<bool>,
 }
 
 #[cfg(feature = "repair")]
-impl JsRepairOptions {
-    /// Reads every option in this order: the first bad one is the error.
-    fn read(f: &Fields) -> Result<Self, String> {
+impl<'a> JsRepairOptions<'a> {
+    fn read(f: &'a Fields) -> Result<Self, OptionError> {
         Ok(Self {
             bucketing: f.text("bucketing")?,
             bucket_capacity: f.number("bucketCapacity")?,
@@ -1132,30 +1301,28 @@ const REPAIR_OPTION_NAMES: &[&str] = &["bucketing", "bucketCapacity", "weldToler
 #[cfg(feature = "repair")]
 #[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
 pub fn repair(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsError> {
-    let options = repair_options(options).map_err(|e| JsError::new(&e))?;
+    let options = repair_options(options).map_err(|e| JsError::new(&one_line(&e.to_string())))?;
     run_repair(bytes, format, &options).map_err(|e| JsError::new(&one_line(&e.to_string())))
 }
 
 #[cfg(feature = "repair")]
-fn repair_options(value: JsValue) -> Result<RepairOptions, String> {
-    let js = JsRepairOptions::read(&options(value, "bucketing: \"kd\"", REPAIR_OPTION_NAMES)?)?;
+fn repair_options(value: JsValue) -> Result<RepairOptions, OptionError> {
+    let fields = Fields::read(value, "bucketing: \"kd\"", REPAIR_OPTION_NAMES)?;
+    let js = JsRepairOptions::read(&fields)?;
     let mut o = RepairOptions::default();
-    if let Some(b) = word::<Bucketing>(&js.bucketing, "bucketing", "\"kd\" or \"bvh\"")? {
+    if let Some(b) = word::<Bucketing>(js.bucketing, "bucketing", "\"kd\" or \"bvh\"")? {
         o = o.with_bucketing(b);
     }
-    if let Some(Number(n)) = js.bucket_capacity {
-        if !whole(n) {
-            return Err(format!("option bucketCapacity: expected a whole number, found {n}"));
-        }
-        o = o.with_bucket_capacity(n as usize);
+    if let Some(n) = whole_number(js.bucket_capacity, "bucketCapacity")? {
+        o = o.with_bucket_capacity(n);
     }
-    if let Some(Number(w)) = js.weld_tolerance {
+    if let Some(w) = js.weld_tolerance {
         o = o.with_weld_tolerance(w);
     }
-    if let Some(Number(p)) = js.perturbation {
+    if let Some(p) = js.perturbation {
         o.perturbation = p;
     }
-    if let Some(Flag(v)) = js.verify {
+    if let Some(v) = js.verify {
         o = o.with_verify(v);
     }
     Ok(o)
@@ -1225,19 +1392,18 @@ fn run_repair(bytes: &[u8], format: &str, options: &RepairOptions) -> Result<JsV
     })
 }
 
-/// The options of `fit` as JS gives them.
+/// The options of `fit`, each of its type (read in [`FIT_OPTION_NAMES`]
+/// order: the first bad one is the error).
 #[cfg(feature = "fit")]
-#[derive(Debug, Default)]
 struct JsFitOptions {
-    tolerance: Option<Number>,
-    tolerance_rel: Option<Number>,
-    max_sides: Option<Number>,
+    tolerance: Option<f64>,
+    tolerance_rel: Option<f64>,
+    max_sides: Option<f64>,
 }
 
 #[cfg(feature = "fit")]
 impl JsFitOptions {
-    /// Reads every option in this order: the first bad one is the error.
-    fn read(f: &Fields) -> Result<Self, String> {
+    fn read(f: &Fields) -> Result<Self, OptionError> {
         Ok(Self {
             tolerance: f.number("tolerance")?,
             tolerance_rel: f.number("toleranceRel")?,
@@ -1258,7 +1424,7 @@ const FIT_OPTION_NAMES: &[&str] = &["tolerance", "toleranceRel", "maxSides"];
 #[cfg(feature = "fit")]
 #[cfg_attr(not(test), wasm_bindgen(skip_typescript))]
 pub fn fit(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsError> {
-    let options = fit_options(options).map_err(|e| JsError::new(&e))?;
+    let options = fit_options(options).map_err(|e| JsError::new(&one_line(&e.to_string())))?;
     let run = || -> Result<JsValue, Error> {
         let format = if format.is_empty() || format.eq_ignore_ascii_case("auto") {
             PointFormat::detect(bytes)
@@ -1275,22 +1441,22 @@ pub fn fit(bytes: &[u8], format: &str, options: JsValue) -> Result<JsValue, JsEr
 }
 
 #[cfg(feature = "fit")]
-fn fit_options(value: JsValue) -> Result<FitOptions, String> {
-    let js = JsFitOptions::read(&options(value, "toleranceRel: 0.001", FIT_OPTION_NAMES)?)?;
+fn fit_options(value: JsValue) -> Result<FitOptions, OptionError> {
+    let js = JsFitOptions::read(&Fields::read(value, "toleranceRel: 0.001", FIT_OPTION_NAMES)?)?;
     let mut o = FitOptions::default();
     match (js.tolerance, js.tolerance_rel) {
-        (Some(_), Some(_)) => return Err("option tolerance: give tolerance or toleranceRel, not both".into()),
-        (Some(Number(t)), None) => o = o.with_tolerance(t),
-        (None, Some(Number(r))) => o = o.with_relative_tolerance(r),
+        (Some(_), Some(_)) => return Err(OptionError::Both { name: "tolerance", other: "toleranceRel" }),
+        (Some(t), None) => o = o.with_tolerance(t),
+        (None, Some(r)) => o = o.with_relative_tolerance(r),
         (None, None) => {}
     }
-    if let Some(Number(n)) = js.max_sides {
+    if let Some(n) = js.max_sides {
         if !(n.fract() == 0.0 && (3.0..=32.0).contains(&n)) {
-            return Err(format!("option maxSides: expected a whole number from 3 to 32, found {n}"));
+            return Err(OptionError::NotWhole { name: "maxSides", range: " from 3 to 32", found: n });
         }
         o = o.with_max_polygon_sides(n as usize);
     }
-    o.validate().map_err(|e| e.to_string())?;
+    o.validate()?;
     Ok(o)
 }
 

@@ -14,8 +14,8 @@ extern crate alloc;
 use surfmesh::{
     edge_lines, fit_points, flatten, mesh_instanced, mesh_model, mm_per_unit, offset_mesh, read_mesh, read_model,
     read_points, read_step_parts, repair_mesh_timed, Assembly, Bucketing, EdgeLines, Error, FitOptions, FitReport,
-    FitResult, Format, InstancedResult, Mesh, MeshFormat, MeshMode, MeshOptions, PointFormat, QualityMethod,
-    RepairOptions, RepairReport, Report, Units,
+    FitResult, Format, InstancedResult, Mesh, MeshFormat, MeshMode, MeshOptions, OptionsError, PointFormat,
+    QualityMethod, RepairOptions, RepairReport, Report, Units,
 };
 
 #[path = "../src/wasm.rs"]
@@ -736,6 +736,7 @@ fn thrown<T>(result: Result<T, wasm_bindgen::JsError>) -> String {
 #[wasm_bindgen_test]
 fn each_bad_mesh_option_throws_one_line_naming_it() {
     let array = |xs: &[JsValue]| JsValue::from(xs.iter().collect::<Array>());
+    let nothing = js_sys::Function::new_no_args("");
     let cases: Vec<(JsValue, &str)> = vec![
         (options(&[("tolerance", "fine".into())]), "option tolerance: expected a number, found string"),
         (options(&[("toleranceRel", true.into())]), "option toleranceRel: expected a number, found boolean"),
@@ -763,6 +764,19 @@ fn each_bad_mesh_option_throws_one_line_naming_it() {
         (num(5.0), "options: expected an object like { toleranceRel: 0.001 }, found number"),
         ("fine".into(), "options: expected an object like { toleranceRel: 0.001 }, found string"),
         (array(&[]), "options: expected an object like { toleranceRel: 0.001 }, found an array"),
+        (true.into(), "options: expected an object like { toleranceRel: 0.001 }, found boolean"),
+        (nothing.clone().into(), "options: expected an object like { toleranceRel: 0.001 }, found function"),
+        // A Map would be read as a list of entries: not an options object.
+        (js_sys::Map::new().into(), "options: expected an object like { toleranceRel: 0.001 }, found an iterable"),
+        // What serde-wasm-bindgen cannot read is named as such.
+        (options(&[("angle", nothing.clone().into())]), "option angle: expected a number, found an unsupported value"),
+        (
+            options(&[("angle", js_sys::Set::new(&JsValue::UNDEFINED).into())]),
+            "option angle: expected a number, found an unsupported value",
+        ),
+        // Nested arrays are not walked; a nested one is not a number.
+        (options(&[("share", array(&[array(&[num(0.0)]), num(2.0)]))]), "option share: expected [index, count]"),
+        (options(&[("tolerance", Object::new().into())]), "option tolerance: expected a number, found object"),
     ];
     for (opts, expected) in cases {
         let m = thrown(binding::mesh(dome(), "json", opts.clone()));
@@ -778,6 +792,19 @@ fn each_bad_mesh_option_throws_one_line_naming_it() {
     // Of two bad options the error names the one first in OPTION_NAMES, whatever the object's key order.
     let m = thrown(binding::mesh(dome(), "json", options(&[("units", num(1.0)), ("angle", "x".into())])));
     assert!(m.starts_with("option angle: expected a number, found string"), "{m:?}");
+    // An unknown key is the error before any bad value, wherever it comes.
+    let m = thrown(binding::mesh(dome(), "json", options(&[("angle", "x".into()), ("tol", num(1.0))])));
+    assert!(m.starts_with("option tol: unknown option"), "{m:?}");
+    // A key with a line break still gives one line.
+    let m = thrown(binding::mesh(dome(), "json", options(&[("a\nb", num(1.0))])));
+    assert!(m.starts_with("option a b: unknown option") && !m.contains('\n'), "{m:?}");
+    // A good share with another option is read.
+    assert!(binding::mesh(
+        dome(),
+        "json",
+        options(&[("share", array(&[num(0.0), num(1.0)])), ("flatten", true.into())])
+    )
+    .is_ok());
 }
 
 /// The options of `repair` and `fit` are read the same way.

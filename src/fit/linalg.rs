@@ -42,7 +42,7 @@ pub(crate) fn sym_eigen3(m: [[f64; 3]; 3]) -> ([f64; 3], [DVec3; 3]) {
         }
     }
     let mut order = [0usize, 1, 2];
-    order.sort_by(|&i, &j| a[i][i].total_cmp(&a[j][j]));
+    crate::sort::by_f64(&mut order, |&i| a[i][i]);
     let values = [a[order[0]][order[0]], a[order[1]][order[1]], a[order[2]][order[2]]];
     let vec = |c: usize| DVec3::new(v[0][c], v[1][c], v[2][c]).normalize_or_zero();
     (values, [vec(order[0]), vec(order[1]), vec(order[2])])

@@ -91,9 +91,7 @@ fn orient(points: &[DVec3], nb: &Neighbours, k: usize, normals: &mut [DVec3]) {
     let centroid = points.iter().copied().sum::<DVec3>() / n.max(1) as f64;
     let mut done = vec![false; n];
     let mut by_distance: Vec<u32> = (0..n as u32).collect();
-    by_distance.sort_by(|&a, &b| {
-        points[b as usize].distance_squared(centroid).total_cmp(&points[a as usize].distance_squared(centroid))
-    });
+    crate::sort::by_f64_desc(&mut by_distance, |&a| points[a as usize].distance_squared(centroid));
     let mut heap = BinaryHeap::new();
     for &seed in &by_distance {
         let s = seed as usize;

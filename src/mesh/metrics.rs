@@ -137,7 +137,7 @@ pub(crate) fn edge_census(
                 }
             }
         }
-        around.sort_unstable();
+        crate::sort::flagged_triples(&mut around);
         for run in around.chunk_by(|x, y| x.0 == y.0) {
             let back = run.iter().filter(|x| x.1).count();
             match run.len() {
@@ -163,7 +163,7 @@ pub(crate) fn edge_census(
             None => gaps.push(Gap { faces, width }),
         }
     }
-    gaps.sort_by_key(|g| g.faces);
+    crate::sort::by_u64(&mut gaps, |g| crate::sort::pair(g.faces.0, g.faces.1));
     (out, gaps)
 }
 

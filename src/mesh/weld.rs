@@ -26,7 +26,7 @@ pub fn weld_positions(positions: &[DVec3], tol: f64) -> (Vec<u32>, usize) {
     // (hash of the cube, index), sorted: each cube's positions together, in
     // index order (the order the grid adds them); cubes of one hash share a group.
     let mut order: Vec<(u64, u32)> = positions.iter().enumerate().map(|(i, &p)| (hash(cube(p)), i as u32)).collect();
-    order.sort_unstable();
+    crate::sort::sort_u64_keys(&mut order);
     let groups = (0..order.len()).filter(|&k| k == 0 || order[k].0 != order[k - 1].0).count();
     let slots = groups + groups / 3 + 1;
     let home = |h: u64| ((u128::from(h) * slots as u128) >> 64) as usize;

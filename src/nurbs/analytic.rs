@@ -37,8 +37,11 @@ impl ArcParam {
     /// The piece layout used for an arc from `start` to `end` (`end > start`).
     pub fn new(start: f64, end: f64) -> Self {
         let sweep = end - start;
-        let pieces =
-            if sweep.is_finite() && sweep > 0.0 { (libm::ceil(sweep / MAX_PIECE) as usize).clamp(1, 64) } else { 1 };
+        let pieces = if sweep.is_finite() && sweep > 0.0 {
+            (crate::math::ceil(sweep / MAX_PIECE) as usize).clamp(1, 64)
+        } else {
+            1
+        };
         Self { start, end, pieces }
     }
 
@@ -53,7 +56,7 @@ impl ArcParam {
         if d.is_nan() || d <= 0.0 {
             return self.start;
         }
-        let k = libm::floor((theta - self.start) / d).clamp(0.0, (self.pieces - 1) as f64);
+        let k = crate::math::floor((theta - self.start) / d).clamp(0.0, (self.pieces - 1) as f64);
         let s0 = self.start + k * d;
         let mid = s0 + 0.5 * d;
         let sigma = 0.5 * (1.0 + libm::tan(0.5 * (theta - mid)) / libm::tan(0.25 * d));
@@ -142,7 +145,7 @@ pub fn hyperbola_arc(c: DVec3, x: DVec3, y: DVec3, start: f64, end: f64) -> Resu
     if end.is_nan() || start.is_nan() || end <= start {
         return Err(NurbsError::BadMultiplicity { index: 0 });
     }
-    let n = (libm::ceil((end - start) / MAX_HYPERBOLA_PIECE) as usize).clamp(1, 64);
+    let n = (crate::math::ceil((end - start) / MAX_HYPERBOLA_PIECE) as usize).clamp(1, 64);
     let d = (end - start) / n as f64;
     let h = 0.5 * d;
     let at = |t: f64| c + x * libm::cosh(t) + y * libm::sinh(t);

@@ -492,7 +492,7 @@ mod tests {
                     _ => (0..5).map(|_| next()).collect(),
                 };
                 let mut inner = inner;
-                inner.sort_by(f64::total_cmp);
+                crate::sort::f64s(&mut inner);
                 let mut knots = alloc::vec![0.0; p + 1];
                 knots.extend(&inner);
                 knots.extend(alloc::vec![1.0; p + 1]);

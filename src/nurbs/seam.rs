@@ -82,8 +82,8 @@ pub fn unroll(s: &NurbsSurface, along_u: bool, a: f64, b: f64) -> Option<NurbsSu
     if !(b > a && period > 0.0 && (b - a) / period <= MAX_TURNS) {
         return None;
     }
-    let n0 = libm::floor((a - lo[axis]) / period);
-    let n1 = libm::ceil((b - lo[axis]) / period);
+    let n0 = crate::math::floor((a - lo[axis]) / period);
+    let n1 = crate::math::ceil((b - lo[axis]) / period);
     let copies = (n1 - n0) as usize;
     let kv = if along_u { s.knots_u().clone() } else { s.knots_v().clone() };
     let p = kv.degree();

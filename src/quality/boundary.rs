@@ -293,7 +293,7 @@ fn split_at_vertices(
     for (ti, sm) in samples.iter().enumerate() {
         let (va, vb) = (vmap[2 * ti], vmap[2 * ti + 1]);
         let mut cuts: Vec<(f64, u32)> = on_trace(sm, vpos, va, vb, sew);
-        cuts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        crate::sort::by_f64(&mut cuts, |c| c.0);
         let len = sm.length();
         let mut prev = (0.0, va);
         cuts.push((len, vb));

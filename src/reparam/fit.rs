@@ -132,7 +132,7 @@ fn sample_count(surface: &FaceSurface, along_u: bool, eps: f64) -> usize {
     if !n.is_finite() {
         return MAX_SAMPLES;
     }
-    (libm::ceil(n) as usize).clamp(3, MAX_SAMPLES)
+    (crate::math::ceil(n) as usize).clamp(3, MAX_SAMPLES)
 }
 
 /// How [`even_params`] joins the spacing of its five iso-lines.
@@ -511,7 +511,7 @@ pub(super) fn fit_within(surface: &FaceSurface, tol: f64, spacing: Spacing) -> R
         // Interpolation error falls as h⁴: grow by the fourth root of the excess, at least 1.25×.
         let grow = |k: usize, e: f64| {
             let f = libm::pow(e / goal, 0.25).clamp(1.25, 4.0);
-            (libm::ceil(k as f64 * f) as usize).min(MAX_SAMPLES)
+            (crate::math::ceil(k as f64 * f) as usize).min(MAX_SAMPLES)
         };
         if eu > goal {
             n = grow(n, eu);

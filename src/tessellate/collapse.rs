@@ -112,7 +112,7 @@ fn collapse_edges_moving(
     if edges.is_empty() {
         return (0, HashMap::default());
     }
-    edges.sort_unstable();
+    crate::sort::pairs(&mut edges);
     edges.dedup();
     // The triangles at each end of a candidate edge: all a collapse looks at.
     let mut around: HashMap<u32, Vec<u32>> = HashMap::default();
@@ -190,7 +190,7 @@ fn collapse_edges_moving(
                     }
                 }
             }
-            seen.sort_unstable();
+            crate::sort::pairs(&mut seen);
             // An edge from `me` with one triangle: `me` is on the border.
             let mut k = 0;
             let mut any = false;

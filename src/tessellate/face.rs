@@ -58,7 +58,7 @@ pub(super) fn grid(
     let even = |along_u: bool| if limited { even_demand(surface, lo, hi, along_u, &half, region) } else { None };
     let (du, dv) = (even(true), even(false));
     if let (Some(du), Some(dv)) = (&du, &dv) {
-        let n = |d: &[f64]| libm::ceil(d.iter().sum::<f64>());
+        let n = |d: &[f64]| crate::math::ceil(d.iter().sum::<f64>());
         if n(du) * n(dv) > over as f64 {
             let equal = |a: f64, b: f64, d: &[f64]| {
                 let k = (n(d) as usize).clamp(1, MAX_PARAMS);

@@ -472,7 +472,7 @@ impl WorkMesh {
             return self.rim.keys().collect();
         }
         let mut out: Vec<(u32, u32)> = self.edges.iter().filter(|(_, t)| t[1] == NONE).map(|(k, _)| k).collect();
-        out.sort_unstable();
+        crate::sort::pairs(&mut out);
         out
     }
 

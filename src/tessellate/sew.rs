@@ -142,7 +142,7 @@ fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) {
     // Per (face, node id): the border neighbours' ids; per node id: (face,
     // vertex). From the border uses, in face and edge order.
     let mut edges: Vec<(u32, u32, u32)> = uses.values().flatten().copied().collect();
-    edges.sort_unstable();
+    crate::sort::triples(&mut edges);
     let mut around: HashMap<(u32, u32), Vec<u32>> = HashMap::default();
     let mut holders: HashMap<u32, Vec<(u32, u32)>> = HashMap::default();
     for (fi, a, b) in edges {
@@ -182,7 +182,7 @@ fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) {
     let mut plans: Vec<Plan> = Vec::new();
     let mut seen = crate::collections::HashSet::default();
     let mut starts: Vec<(u32, u32)> = around.keys().copied().collect();
-    starts.sort_unstable();
+    crate::sort::pairs(&mut starts);
     for (fa, ga) in starts {
         let Some(others) = holders.get(&ga) else { continue };
         for &(fb, _) in others {
@@ -657,7 +657,7 @@ mod tests {
                 .map(|(a, b)| node_key(f.mesh.gid[a as usize], f.mesh.gid[b as usize]))
                 .filter(|&(a, b)| a != NONE && b != NONE)
                 .collect();
-            e.sort_unstable();
+            crate::sort::pairs(&mut e);
             e
         };
         for (sew, closed) in [(0.1, true), (0.01, false)] {

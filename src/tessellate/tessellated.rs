@@ -115,7 +115,8 @@ impl<'a> Facets<'a> {
             }
         }
         let mut bodies: Vec<(u32, Vec<usize>)> = by_body.into_iter().collect();
-        bodies.sort_unstable();
+        // Each body once, so its number alone orders them.
+        crate::sort::by_u64(&mut bodies, |b| u64::from(b.0));
         bodies.into_iter().map(|(b, faces)| self.rim(b, &faces)).collect()
     }
 

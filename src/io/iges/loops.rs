@@ -221,7 +221,7 @@ fn place_loops(
                 *def = def.unroll(k == 0, a, b).ok_or(cannot)?;
                 continue;
             }
-            let c = lo[k] + (a - lo[k] - p * libm::floor((a - lo[k]) / p));
+            let c = lo[k] + (a - lo[k] - p * crate::math::floor((a - lo[k]) / p));
             *def = def.rotate_seam(k == 0, c).ok_or(cannot)?;
             for s in &mut shifts {
                 s[k] += c - a;

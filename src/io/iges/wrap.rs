@@ -240,7 +240,7 @@ fn crossings(lp: &[Track], k: usize, c: f64, p: f64) -> Vec<Crossing> {
             if hi.partial_cmp(&lo) != Some(core::cmp::Ordering::Greater) {
                 continue;
             }
-            let mut m = libm::ceil((lo - c) / p);
+            let mut m = crate::math::ceil((lo - c) / p);
             while c + m * p < hi && out.len() < 4096 {
                 let at = c + m * p;
                 let f = (at - q0[k]) / (q1[k] - q0[k]);
@@ -436,7 +436,7 @@ pub(super) fn windows(
             let mut sh = Vec::with_capacity(bounds.len());
             let (mut wlo, mut whi) = (f64::INFINITY, f64::NEG_INFINITY);
             for b in &bounds {
-                let d = libm::ceil((s - eps - b.0[k]) / p) * p;
+                let d = crate::math::ceil((s - eps - b.0[k]) / p) * p;
                 sh.push(d);
                 wlo = wlo.min(b.0[k] + d);
                 whi = whi.max(b.1[k] + d);
@@ -502,7 +502,7 @@ fn inside_outer(polys: &[Vec<DVec2>], bounds: &[(DVec2, DVec2)], k: usize, p: f6
         }
         let probe = *q.first()?;
         // Nearest copies first: the one starting in the outer loop's range.
-        let base = libm::floor((bounds[outer].0[k] - bounds[i].0[k]) / p);
+        let base = crate::math::floor((bounds[outer].0[k] - bounds[i].0[k]) / p);
         let d = (0..8i32)
             .map(|m| base + f64::from(if m % 2 == 0 { m / 2 } else { -(m + 1) / 2 }))
             .map(|m| m * p)

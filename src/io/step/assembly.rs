@@ -314,7 +314,7 @@ fn groups(reps: &Reps, mut parent: Vec<usize>, relations: &[Relation]) -> Groups
         members.entry(r).or_default().push(i);
     }
     let mut roots: Vec<usize> = (0..n).map(|i| root(&mut parent, i)).filter(|r| !is_child.contains(r)).collect();
-    roots.sort_unstable();
+    crate::sort::usizes(&mut roots);
     roots.dedup();
     Groups { children, members, roots }
 }

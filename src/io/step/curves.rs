@@ -596,7 +596,7 @@ pub(super) fn pieces_between(c: &Curve3, t0: f64, t1: f64) -> Result<Vec<NurbsCu
             }
             // Wraps past the end: the start brought into the domain (a start
             // at the domain's end is its beginning), then one piece or two.
-            let mut s0 = a + (t0 - a) - per * libm::floor((t0 - a) / per);
+            let mut s0 = a + (t0 - a) - per * crate::math::floor((t0 - a) / per);
             if b - s0 <= tiny {
                 s0 = a;
             }
@@ -632,7 +632,7 @@ pub(super) fn bounded_pieces(def: &CurveDef) -> Result<Vec<NurbsCurve>, CurveErr
     // the basis parameter that is increasing unless `reversed`.
     let (lo, hi) = if def.reversed { (t1, t0) } else { (t0, t1) };
     let hi = match period(&def.curve) {
-        Some(p) if hi <= lo => hi + p * libm::ceil((lo - hi) / p + 1e-12).max(1.0),
+        Some(p) if hi <= lo => hi + p * crate::math::ceil((lo - hi) / p + 1e-12).max(1.0),
         _ => hi,
     };
     let mut out = pieces_between(&def.curve, lo, hi)?;

@@ -257,7 +257,7 @@ fn cut(
                     }
                 }
                 Some(p) => {
-                    tb = ta + (tb - ta) - p * libm::floor((tb - ta) / p);
+                    tb = ta + (tb - ta) - p * crate::math::floor((tb - ta) / p);
                     if tb <= ta + 1e-12 * p {
                         tb += p;
                     }

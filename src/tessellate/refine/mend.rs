@@ -376,7 +376,7 @@ impl WorkMesh {
             }
         }
         let here = self.pos[x as usize];
-        around.sort_by(|&a, &b| self.pos[a as usize].distance(here).total_cmp(&self.pos[b as usize].distance(here)));
+        crate::sort::by_f64(&mut around, |&a| self.pos[a as usize].distance(here));
         let sense: f64 = ring.iter().map(|&t| uv_area(self.uv(t as usize))).sum();
         'candidates: for &y in &around {
             let &gone = self.edges.get(&key(x, y))?;
