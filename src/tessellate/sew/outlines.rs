@@ -587,6 +587,77 @@ impl<'n> Clusters<'n> {
         self.size[big as usize] += self.size[small as usize];
         self.next.swap(small as usize, big as usize);
     }
+
+    /// Joins nodes of one body within `sew` (`tight` inside one face) and
+    /// within both their reaches, nearest pairs first, so that a chain of
+    /// close nodes is cut where its nodes are farthest apart.
+    fn join_near(&mut self, bodies: &[u32], sew: f64) {
+        let (nodes, reach, tight) = (self.nodes, self.reach, self.tight);
+        let mut grid = CellGrid::new(1.0 / sew);
+        for (i, &(_, p)) in nodes.iter().enumerate() {
+            grid.insert(p, i as u32);
+        }
+        let body = |f: u32| crate::model::body_of(bodies, f as usize);
+        let mut pairs: Vec<(f64, u32, u32)> = Vec::new();
+        for (i, &(fi, p)) in nodes.iter().enumerate() {
+            for &j in grid.near(p) {
+                if j as usize <= i {
+                    continue;
+                }
+                let (fj, q) = nodes[j as usize];
+                if body(fi) != body(fj) {
+                    continue;
+                }
+                let d = p.distance(q);
+                let limit = if fi == fj { tight } else { sew };
+                if d <= limit.min(reach[i]).min(reach[j as usize]) {
+                    pairs.push((d, i as u32, j));
+                }
+            }
+        }
+        crate::sort::by_f64(&mut pairs, |x| x.0);
+        for (_, a, b) in pairs {
+            self.union(a, b);
+        }
+    }
+
+    /// A node no other face took, one segment shorter than `tight` from a
+    /// node shared with a face within `sew` of it, is that node: there the
+    /// other border has one node for this one's tiny jog. Only nodes shared
+    /// before this take others in, so it does not run along a border.
+    /// `index`: each outline node's place in the cluster's nodes.
+    fn absorb_jogs(&mut self, index: &PerNode<u32>, sew: f64) {
+        let (nodes, tight) = (self.nodes, self.tight);
+        let shared_before: Vec<bool> = (0..nodes.len() as u32)
+            .map(|a| {
+                let r = self.find(a);
+                self.size[r as usize] > 1
+            })
+            .collect();
+        for (fi, face) in index.iter().enumerate() {
+            for ring in face {
+                let n = ring.len();
+                for i in 0..n {
+                    let a = ring[i];
+                    if shared_before[a as usize] {
+                        continue;
+                    }
+                    let p = nodes[a as usize].1;
+                    for j in [(i + n - 1) % n, (i + 1) % n] {
+                        let b = ring[j];
+                        if b == a || !shared_before[b as usize] || nodes[b as usize].1.distance(p) > tight {
+                            continue;
+                        }
+                        let rb = self.find(b);
+                        let shared = self.members(rb).any(|(g, q, _)| g != fi as u32 && q.distance(p) <= sew);
+                        if shared && self.absorb(a, b) {
+                            break;
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Gives nodes within both their reaches of each other one id (within
@@ -600,8 +671,43 @@ fn name_nodes(
     sew: f64,
     tight: f64,
 ) -> u32 {
+    let (flat, index, r_flat) = flat_nodes(faces, radius_before, twins);
+    let mut cl = Clusters::new(&flat, &r_flat, tight);
+    // Twins first (they are one node by construction), then neighbours by distance.
+    let id_of = |n: NodeRef, index: &PerNode<u32>| index[n.0 as usize][n.1 as usize].get(n.2 as usize).copied();
+    for &(n, q) in twins {
+        if let (Some(a), Some(b)) = (id_of(n, &index), id_of(q, &index)) {
+            cl.union(a, b);
+        }
+    }
+    if sew > 0.0 {
+        cl.join_near(bodies, sew);
+        cl.absorb_jogs(&index, sew);
+    }
+    // Compact ids.
+    let mut ids: HashMap<u32, u32> = HashMap::default();
+    for (fi, item) in faces.iter_mut().enumerate() {
+        let Some((_, o)) = item else { continue };
+        for k in 0..o.gids.len() {
+            for i in 0..o.gids[k].len() {
+                let root = cl.find(index[fi][k][i]);
+                let next = ids.len() as u32;
+                o.gids[k][i] = *ids.entry(root).or_insert(next);
+            }
+        }
+    }
+    ids.len() as u32
+}
+
+/// Every outline node in one list: its face and place, where each node
+/// went in it, and its reach after insertion (a new node has its twin's,
+/// an old one keeps its own).
+fn flat_nodes(
+    faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
+    radius_before: &PerNode<f64>,
+    twins: &[(NodeRef, NodeRef)],
+) -> (Vec<(u32, DVec3)>, PerNode<u32>, Vec<f64>) {
     let pos = positions(faces);
-    // Reach after insertion: a new node has its twin's, an old one keeps its own.
     let mut radius: PerNode<f64> = per_node(&pos, 0.0);
     let mut index: PerNode<u32> = per_node(&pos, 0);
     let mut flat: Vec<(u32, DVec3)> = Vec::new();
@@ -629,87 +735,5 @@ fn name_nodes(
         radius[n.0 as usize][n.1 as usize][n.2 as usize] = r;
     }
     let r_flat: Vec<f64> = radius.iter().flatten().flatten().copied().collect();
-    let mut cl = Clusters::new(&flat, &r_flat, tight);
-    // Twins first (they are one node by construction), then neighbours by distance.
-    let id_of = |n: NodeRef, index: &PerNode<u32>| index[n.0 as usize][n.1 as usize].get(n.2 as usize).copied();
-    for &(n, q) in twins {
-        if let (Some(a), Some(b)) = (id_of(n, &index), id_of(q, &index)) {
-            cl.union(a, b);
-        }
-    }
-    if sew > 0.0 {
-        let mut grid = CellGrid::new(1.0 / sew);
-        for (i, &(_, p)) in flat.iter().enumerate() {
-            grid.insert(p, i as u32);
-        }
-        let body = |f: u32| crate::model::body_of(bodies, f as usize);
-        let mut pairs: Vec<(f64, u32, u32)> = Vec::new();
-        for (i, &(fi, p)) in flat.iter().enumerate() {
-            for &j in grid.near(p) {
-                if j as usize <= i {
-                    continue;
-                }
-                let (fj, q) = flat[j as usize];
-                if body(fi) != body(fj) {
-                    continue;
-                }
-                let d = p.distance(q);
-                let limit = if fi == fj { tight } else { sew };
-                if d <= limit.min(r_flat[i]).min(r_flat[j as usize]) {
-                    pairs.push((d, i as u32, j));
-                }
-            }
-        }
-        crate::sort::by_f64(&mut pairs, |x| x.0);
-        for (_, a, b) in pairs {
-            cl.union(a, b);
-        }
-        // A node no other face took, one segment shorter than `tight` from
-        // a node shared with a face within `sew` of it, is that node: there
-        // the other border has one node for this one's tiny jog. Only nodes
-        // shared before this take others in, so it does not run along a border.
-        let shared_before: Vec<bool> = (0..flat.len() as u32)
-            .map(|a| {
-                let r = cl.find(a);
-                cl.size[r as usize] > 1
-            })
-            .collect();
-        for (fi, item) in faces.iter().enumerate() {
-            let Some((_, o)) = item else { continue };
-            for (k, poly) in o.loops.polys.iter().enumerate() {
-                let n = poly.uv.len();
-                for i in 0..n {
-                    let a = index[fi][k][i];
-                    if shared_before[a as usize] {
-                        continue;
-                    }
-                    let p = flat[a as usize].1;
-                    for j in [(i + n - 1) % n, (i + 1) % n] {
-                        let b = index[fi][k][j];
-                        if b == a || !shared_before[b as usize] || flat[b as usize].1.distance(p) > tight {
-                            continue;
-                        }
-                        let rb = cl.find(b);
-                        let shared = cl.members(rb).any(|(g, q, _)| g != fi as u32 && q.distance(p) <= sew);
-                        if shared && cl.absorb(a, b) {
-                            break;
-                        }
-                    }
-                }
-            }
-        }
-    }
-    // Compact ids.
-    let mut ids: HashMap<u32, u32> = HashMap::default();
-    for (fi, item) in faces.iter_mut().enumerate() {
-        let Some((_, o)) = item else { continue };
-        for k in 0..o.gids.len() {
-            for i in 0..o.gids[k].len() {
-                let root = cl.find(index[fi][k][i]);
-                let next = ids.len() as u32;
-                o.gids[k][i] = *ids.entry(root).or_insert(next);
-            }
-        }
-    }
-    ids.len() as u32
+    (flat, index, r_flat)
 }
