@@ -11,7 +11,6 @@ use super::measure::{measure_projection, measure_triangle, sample_count, TriMeas
 use crate::math::angle_between;
 use crate::nurbs::{project_to_surface, regular_normal, NurbsCurve, Surface};
 
-#[cfg(any(test, debug_assertions))]
 mod check;
 mod edges;
 #[cfg(feature = "std")]
@@ -19,6 +18,7 @@ mod lift;
 mod limits;
 mod mend;
 
+pub(crate) use check::Known;
 pub(crate) use edges::EdgeList;
 pub(crate) use limits::{Criteria, Lift, Outcome};
 use limits::{Packed, STALE};
