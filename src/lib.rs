@@ -27,6 +27,8 @@ mod meshing;
 mod model;
 mod nurbs;
 mod options;
+#[cfg(any(feature = "repair", feature = "fit"))]
+mod predicates;
 mod quality;
 #[cfg(feature = "repair")]
 mod repair;

@@ -21,7 +21,6 @@ mod check;
 mod degenerate;
 mod intersect;
 mod offset;
-mod predicates;
 mod region;
 mod steps;
 mod topology;
