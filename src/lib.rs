@@ -25,6 +25,7 @@ mod measure;
 mod mesh;
 mod meshing;
 mod model;
+mod numeric;
 mod nurbs;
 mod options;
 #[cfg(any(feature = "repair", feature = "fit"))]

@@ -1,6 +1,7 @@
 //! Trim loops: discretization by the chord test, outer/hole classification,
 //! crossing checks and inside tests (paper 000 §3.2).
 
+use crate::numeric::TINY;
 use alloc::format;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
@@ -501,7 +502,7 @@ fn first_crossing(loops: &Loops<'_>) -> Option<Crossing> {
     }
     let (lo, hi) = loops.bounds();
     let cells = (crate::math::sqrt(segs.len() as f64) as usize).clamp(1, 512);
-    let size = (hi - lo).max(DVec2::splat(1e-300)) / cells as f64;
+    let size = (hi - lo).max(DVec2::splat(TINY)) / cells as f64;
     let cell_of = |p: DVec2| {
         let c = ((p - lo) / size).floor();
         (c.x.clamp(0.0, (cells - 1) as f64) as usize, c.y.clamp(0.0, (cells - 1) as f64) as usize)

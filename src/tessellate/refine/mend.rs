@@ -3,6 +3,7 @@
 //! sewing left open (a triangle beside a hole, a border split at a corner
 //! poking over it, a flap removed).
 
+use crate::numeric::TINY;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
@@ -237,7 +238,7 @@ impl WorkMesh {
         let (qa, qb, qc) = (tuv[i], tuv[(i + 1) % 3], tuv[(i + 2) % 3]);
         let (qb2, qa2, qd) = (uuv[j], uuv[(j + 1) % 3], uuv[(j + 2) % 3]);
         // One chart on both sides (not across a seam).
-        let span = (qa - qb).length().max(1e-300);
+        let span = (qa - qb).length().max(TINY);
         if (qa - qa2).length() > 1e-9 * span || (qb - qb2).length() > 1e-9 * span {
             return None;
         }
@@ -540,7 +541,7 @@ impl WorkMesh {
         let hint = (uv_a + uv_b) * 0.5;
         let uv = project_to_surface(surface, p, Some(hint), &Default::default()).uv;
         // Far from the edge in (u,v): across a seam, not beside it.
-        if !uv.is_finite() || uv.distance(hint) > 2.0 * uv_a.distance(uv_b).max(1e-300) {
+        if !uv.is_finite() || uv.distance(hint) > 2.0 * uv_a.distance(uv_b).max(TINY) {
             return false;
         }
         let old_v = self.pos.len();

@@ -1,6 +1,7 @@
 //! Sewing of face outlines before they are triangulated.
 
 use crate::collections::{CellGrid, HashMap};
+use crate::numeric::{guarded_div, TINY};
 use alloc::vec::Vec;
 use glam::DVec3;
 
@@ -110,7 +111,7 @@ fn radii_each(pos: &PerNode<DVec3>, sew_of: &dyn Fn(NodeRef) -> f64, tight: f64)
                 .enumerate()
                 .map(|(k, p)| {
                     let n = p.len();
-                    let scale = p.iter().fold(0.0f64, |m, q| m.max(q.abs().max_element())).max(1e-300);
+                    let scale = p.iter().fold(0.0f64, |m, q| m.max(q.abs().max_element())).max(TINY);
                     let length = |i: usize| {
                         let l = p[i].distance(p[(i + 1) % n]);
                         if l <= (1e-12 * scale).max(1e-3 * tight) {
@@ -223,7 +224,7 @@ fn insertions(
 ) -> (Additions, PerNode<f64>, f64) {
     let radius = radii(pos, sew, tight);
     // Nodes hashed on a grid about one loop segment long.
-    let mut grid = CellGrid::new(1.0 / mean_segment.max(reach).max(1e-300));
+    let mut grid = CellGrid::new(guarded_div(1.0, mean_segment.max(reach)));
     for (fi, f) in pos.iter().enumerate() {
         for (k, p) in f.iter().enumerate() {
             for (i, &q) in p.iter().enumerate() {
@@ -287,7 +288,7 @@ fn candidates(
                     }
                     let q = at(qn);
                     let limit = if g == fi { tight.min(r_of(qn)) } else { r_of(qn) };
-                    let s0 = ((q - pa).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
+                    let s0 = (guarded_div((q - pa).dot(ab), ab.length_squared())).clamp(0.0, 1.0);
                     if s0 <= 0.0 || s0 >= 1.0 {
                         // Beyond an end, at most as far as the end: a
                         // node the other border has too (a gap of nothing).
