@@ -641,6 +641,13 @@ impl WorkMesh {
         self.measure_slots();
         self.measures[t] = STALE;
         if self.fits_placed(surface, c, t) && self.fits_placed(surface, c, self.tris.len() - 1) {
+            // Its halves run beside the other face's node: shared, as the
+            // border edge they replace was (trim or shared).
+            let side = key(a, b);
+            if self.trim.remove(&side).is_some() | self.shared.remove(&side).is_some() {
+                self.shared.insert(key(x0, m), ());
+                self.shared.insert(key(m, x1), ());
+            }
             return true;
         }
         self.pop_triangle();
@@ -656,12 +663,14 @@ impl WorkMesh {
     }
 
     /// Removes triangle `t`; the last triangle takes its index. Its corners
-    /// stay as vertices (one no other triangle uses is simply not drawn).
+    /// stay as vertices (one no other triangle uses is simply not drawn),
+    /// and a side of it no other triangle has is no trim or shared edge any more.
     pub fn remove_triangle(&mut self, t: usize) {
         if t >= self.tris.len() {
             return;
         }
         self.wake();
+        let gone = self.tris[t];
         let last = self.tris.len() - 1;
         for k in 0..3 {
             self.detach(self.tris[t][k], self.tris[t][(k + 1) % 3], t as u32);
@@ -687,6 +696,13 @@ impl WorkMesh {
             }
         }
         self.measures.truncate(self.tris.len());
+        for k in 0..3 {
+            let side = key(gone[k], gone[(k + 1) % 3]);
+            if !self.edges.contains_key(&side) {
+                self.trim.remove(&side);
+                self.shared.remove(&side);
+            }
+        }
     }
 
     /// Whether the facet normal opposes the surface normal at the centroid's (u,v).
