@@ -25,8 +25,11 @@ mod measure;
 mod mesh;
 mod meshing;
 mod model;
+mod numeric;
 mod nurbs;
 mod options;
+#[cfg(any(feature = "repair", feature = "fit"))]
+mod predicates;
 mod quality;
 #[cfg(feature = "repair")]
 mod repair;

@@ -535,6 +535,82 @@ impl fmt::Display for RebuildLoss {
 
 impl fmt::Display for WarningKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // Each kind goes to the text of its stage (the groups of the enum).
+        match self {
+            Self::Skipped(_)
+            | Self::Forgiven(_)
+            | Self::EntityDamaged(_)
+            | Self::NoGlobal
+            | Self::BadGlobal(_)
+            | Self::TruncatedLine { .. }
+            | Self::NoTerminate
+            | Self::TerminateCount { .. }
+            | Self::Unsupported { .. }
+            | Self::Hidden { .. }
+            | Self::UnbrokenRecords { .. }
+            | Self::ShiftedRecord { .. }
+            | Self::LowerCaseSection { .. }
+            | Self::TrimFitLimit { .. }
+            | Self::TrimSpacesDisagree
+            | Self::TrimGapClosed { .. }
+            | Self::TrimSelfCrossing { .. } => self.fmt_reader(f),
+            Self::FaceNotPlaced(_)
+            | Self::ShellOpen { .. }
+            | Self::LoopSlit
+            | Self::LoopSpikes { .. }
+            | Self::LoopGapBridged { .. }
+            | Self::VertexOffCurve { .. }
+            | Self::VertexFromNeighbour { .. }
+            | Self::Joined(_)
+            | Self::AssemblyLimit { .. }
+            | Self::ItemUndefined { .. }
+            | Self::NotInRepresentation
+            | Self::LengthUnitUnknown
+            | Self::TessellatedLimit { .. }
+            | Self::RepeatedPointTriangles { .. }
+            | Self::NormalsNotVectors
+            | Self::NormalsCount { .. }
+            | Self::ItemUnsupported => self.fmt_step(f),
+            Self::UnreadFaces { .. }
+            | Self::QualityLoopsUnfilled { .. }
+            | Self::QualityNotMeshed(_)
+            | Self::PoorlyParameterized { .. }
+            | Self::FaceSkipped(_)
+            | Self::BudgetSpent(_)
+            | Self::NoTriangles { .. }
+            | Self::Unproven { .. }
+            | Self::Creased { .. }
+            | Self::FacesApart { .. }
+            | Self::NeedsStd
+            | Self::LoopsMended(_)
+            | Self::GridCapped { .. }
+            | Self::RebuildLost(_)
+            | Self::TessellatedFaces { .. }
+            | Self::TessellatedDropped { .. } => self.fmt_meshing(f),
+            Self::NotWelded { .. }
+            | Self::DegenerateLeft { .. }
+            | Self::OpenInput { .. }
+            | Self::InsideOut { .. }
+            | Self::Perturbed { .. }
+            | Self::UnhandledContacts { .. }
+            | Self::Unseeded { .. }
+            | Self::SplitFallbacks { .. }
+            | Self::EmptyResult
+            | Self::NotManifold { .. } => self.fmt_repair(f),
+            Self::DuplicatesMerged { .. }
+            | Self::Planar
+            | Self::NetGaps { .. }
+            | Self::PointsUnused { .. }
+            | Self::PolygonsUnfilled { .. }
+            | Self::SplitLimit { .. } => self.fmt_fit(f),
+        }
+    }
+}
+
+impl WarningKind {
+    /// The text of a kind both readers or the IGES reader let pass; nothing for the others, which
+    /// [`fmt::Display::fmt`] routes elsewhere.
+    fn fmt_reader(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::Skipped(e) => write!(f, "skipped: {e}"),
             Self::Forgiven(e) => write!(f, "{e}"),
@@ -571,6 +647,14 @@ impl fmt::Display for WarningKind {
             Self::TrimSelfCrossing { crossings } => {
                 write!(f, "trim loop crossed itself {crossings} times (edges meeting tangentially); cut there")
             }
+            _ => Ok(()),
+        }
+    }
+
+    /// The text of a kind the STEP reader lets pass; nothing for the others, which
+    /// [`fmt::Display::fmt`] routes elsewhere.
+    fn fmt_step(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
             Self::FaceNotPlaced(e) => write!(f, "a face could not be placed: {e}"),
             Self::ShellOpen { edges } => {
                 write!(f, "{edges} of its edges bound only one of its faces; it is open, its mesh will have a border")
@@ -618,11 +702,18 @@ impl fmt::Display for WarningKind {
             Self::NormalsNotVectors => {
                 write!(f, "a normal of no length or not three numbers; its normals are left out")
             }
-            Self::NormalsCount { normals, points } => write!(
-                f,
-                "{normals} normals for {points} points (expected 0, 1 or {points}); its normals are left out"
-            ),
+            Self::NormalsCount { normals, points } => {
+                write!(f, "{normals} normals for {points} points (expected 0, 1 or {points}); its normals are left out")
+            }
             Self::ItemUnsupported => write!(f, "not supported; skipped"),
+            _ => Ok(()),
+        }
+    }
+
+    /// The text of a kind the meshers let pass; nothing for the others, which
+    /// [`fmt::Display::fmt`] routes elsewhere.
+    fn fmt_meshing(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
             Self::UnreadFaces { count, holes: 0 } => {
                 write!(f, "{count} face(s) of the file could not be read: the mesh lacks them")
             }
@@ -692,6 +783,14 @@ impl fmt::Display for WarningKind {
                 "tessellated faces: {count} triangles that name a point twice, one past the points or one not \
                  finite left out"
             ),
+            _ => Ok(()),
+        }
+    }
+
+    /// The text of a kind mesh repair (paper 002) lets pass; nothing for the others, which
+    /// [`fmt::Display::fmt`] routes elsewhere.
+    fn fmt_repair(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
             Self::NotWelded { tolerance, why } => write!(
                 f,
                 "welding within {tolerance:e} of the diagonal would make the mesh non-manifold ({why}); vertices were not welded"
@@ -728,10 +827,20 @@ impl fmt::Display for WarningKind {
                 f,
                 "the result is not a clean 2-manifold: {nonmanifold} edges of more than two triangles, {misoriented} edges whose triangles disagree"
             ),
+            _ => Ok(()),
+        }
+    }
+
+    /// The text of a kind surface fitting (paper 004) lets pass; nothing for the others, which
+    /// [`fmt::Display::fmt`] routes elsewhere.
+    fn fmt_fit(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
             Self::DuplicatesMerged { count, distance } => {
                 write!(f, "{count} duplicate point(s) merged (closer than {distance:.3e})")
             }
-            Self::Planar => write!(f, "the points lie on one plane: the fit is the flat region of that plane they span"),
+            Self::Planar => {
+                write!(f, "the points lie on one plane: the fit is the flat region of that plane they span")
+            }
             Self::NetGaps { count } => write!(f, "{count} gap(s) of the triangle net left open"),
             Self::PointsUnused { count } => {
                 write!(f, "{count} point(s) are in no triangle of the net and are not interpolated")
@@ -740,6 +849,7 @@ impl fmt::Display for WarningKind {
             Self::SplitLimit { level } => {
                 write!(f, "some patches hit the split limit of {level} and may exceed the tolerance")
             }
+            _ => Ok(()),
         }
     }
 }
@@ -898,5 +1008,46 @@ impl fmt::Display for RebuildError {
 impl From<InterpError> for RebuildError {
     fn from(e: InterpError) -> Self {
         Self::Interp(e)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::WarningKind;
+    use alloc::string::ToString;
+
+    /// Each kind is routed to its stage's text: none comes out empty, and
+    /// one with a count names it.
+    #[test]
+    fn every_stage_gives_its_kinds_a_text() {
+        let plain = [
+            WarningKind::NoGlobal,
+            WarningKind::NoTerminate,
+            WarningKind::TrimSpacesDisagree,
+            WarningKind::LoopSlit,
+            WarningKind::NotInRepresentation,
+            WarningKind::LengthUnitUnknown,
+            WarningKind::NormalsNotVectors,
+            WarningKind::ItemUnsupported,
+            WarningKind::NeedsStd,
+            WarningKind::NoTriangles { pinched: false },
+            WarningKind::EmptyResult,
+            WarningKind::Planar,
+        ];
+        for k in plain {
+            assert!(!k.to_string().is_empty(), "{k:?}");
+        }
+        let counted = [
+            WarningKind::TruncatedLine { line: 4321 },
+            WarningKind::ShellOpen { edges: 4321 },
+            WarningKind::UnreadFaces { count: 4321, holes: 0 },
+            WarningKind::Creased { count: 4321 },
+            WarningKind::DegenerateLeft { count: 4321 },
+            WarningKind::NetGaps { count: 4321 },
+            WarningKind::SplitLimit { level: 4321 },
+        ];
+        for k in counted {
+            assert!(k.to_string().contains("4321"), "{k:?}: {k}");
+        }
     }
 }

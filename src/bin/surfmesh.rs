@@ -5,6 +5,8 @@
 mod args;
 #[path = "surfmesh/check.rs"]
 mod check;
+#[path = "surfmesh/error.rs"]
+mod error;
 #[path = "surfmesh/fit.rs"]
 mod fit;
 #[path = "surfmesh/repair.rs"]
@@ -20,6 +22,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use args::{Command, MeshArgs, OutputFormat};
+use error::CliError;
 use surfmesh::{
     mesh_model_in_units, mm_per_unit, read_model, write_glb_scaled, write_msh, write_obj, write_stl, write_unv, Error,
     Format,
@@ -38,7 +41,7 @@ fn main() -> ExitCode {
         Ok(Command::Mesh(m)) => match mesh(&m) {
             Ok(()) => ExitCode::SUCCESS,
             Err(message) => {
-                eprintln!("surfmesh: {}: {}", m.input.display(), one_line(&message));
+                eprintln!("surfmesh: {}: {}", m.input.display(), one_line(&message.to_string()));
                 ExitCode::from(1)
             }
         },
@@ -50,23 +53,23 @@ fn main() -> ExitCode {
             Ok(true) => ExitCode::SUCCESS,
             Ok(false) => ExitCode::from(1),
             Err(message) => {
-                eprintln!("surfmesh: {}: {}", a.dir.display(), one_line(&message));
+                eprintln!("surfmesh: {}: {}", a.dir.display(), one_line(&message.to_string()));
                 ExitCode::from(1)
             }
         },
         Err(message) => {
-            eprintln!("surfmesh: {}", one_line(&message));
+            eprintln!("surfmesh: {}", one_line(&message.to_string()));
             ExitCode::from(2)
         }
     }
 }
 
 /// Exit status of a command run on `input`: its error, if any, on one line after the file's name.
-fn finish(input: &Path, result: Result<(), String>) -> ExitCode {
+fn finish(input: &Path, result: Result<(), CliError>) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
-            eprintln!("surfmesh: {}: {}", input.display(), one_line(&message));
+            eprintln!("surfmesh: {}: {}", input.display(), one_line(&message.to_string()));
             ExitCode::from(1)
         }
     }
@@ -79,18 +82,18 @@ fn one_line(message: &str) -> String {
 
 /// `surfmesh mesh`: everything after the arguments; the error is the message
 /// printed after the input file's name.
-fn mesh(m: &MeshArgs) -> Result<(), String> {
-    let bytes = fs::read(&m.input).map_err(|e| format!("cannot read: {e}"))?;
+fn mesh(m: &MeshArgs) -> Result<(), CliError> {
+    let bytes = fs::read(&m.input).map_err(CliError::read)?;
     let format = match m.format {
         Some(f) => f,
         None => input_format(&m.input, &bytes)?,
     };
 
     let start = Instant::now();
-    let model = read_model(&bytes, format).map_err(|e| e.to_string())?;
+    let model = read_model(&bytes, format)?;
     let parse_ms = millis(start);
     let start = Instant::now();
-    let mut result = mesh_model_in_units(&model, &m.options, m.units, &mut |_, _| true).map_err(|e| e.to_string())?;
+    let mut result = mesh_model_in_units(&model, &m.options, m.units, &mut |_, _| true)?;
     let report = &mut result.report;
     report.time_ms = millis(start);
     report.parse_ms = parse_ms;
@@ -99,8 +102,7 @@ fn mesh(m: &MeshArgs) -> Result<(), String> {
         model.warnings.iter().filter(|w| !report.warnings.contains(w)).cloned().collect();
     report.warnings.splice(0..0, missing);
 
-    let report_json = serde_json::to_string_pretty(&result.report)
-        .map_err(|e| Error::Internal(format!("report: {e}")).to_string())?;
+    let report_json = serde_json::to_string_pretty(&result.report).map_err(CliError::report)?;
     let mut files: Vec<(&Path, Vec<u8>)> = Vec::new();
     if let Some((path, kind)) = &m.output {
         let bytes = match kind {
@@ -155,10 +157,10 @@ fn mesh(m: &MeshArgs) -> Result<(), String> {
 }
 
 /// Input format from the file's extension, else from its first bytes.
-fn input_format(path: &Path, bytes: &[u8]) -> Result<Format, String> {
+fn input_format(path: &Path, bytes: &[u8]) -> Result<Format, CliError> {
     let by_name = path.extension().and_then(|e| e.to_str()).and_then(|e| Format::from_name(e).ok());
     by_name.or_else(|| Format::detect(bytes)).ok_or_else(|| {
-        Error::Format("cannot tell the input format; give --format json, iges or step".into()).to_string()
+        CliError::Core(Error::Format("cannot tell the input format; give --format json, iges or step".into()))
     })
 }
 
@@ -172,7 +174,7 @@ fn millis(start: Instant) -> f64 {
 /// and is not a regular file (`/dev/null`, a pipe, a terminal) is written to
 /// directly after the regular files are in place: renaming over it would
 /// replace the device with a plain file.
-fn write_all_or_nothing(files: &[(&Path, Vec<u8>)]) -> Result<(), String> {
+fn write_all_or_nothing(files: &[(&Path, Vec<u8>)]) -> Result<(), CliError> {
     // (temporary file, file it replaces, path as the user gave it)
     let mut staged: Vec<(PathBuf, PathBuf, &Path)> = Vec::new();
     let mut streams: Vec<(&Path, &[u8])> = Vec::new();
@@ -192,13 +194,11 @@ fn write_all_or_nothing(files: &[(&Path, Vec<u8>)]) -> Result<(), String> {
                 .write(true)
                 .create_new(true)
                 .open(&temp)
-                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-            file.write_all(bytes)
-                .and_then(|()| file.sync_all())
-                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+                .map_err(|e| CliError::write(path, e))?;
+            file.write_all(bytes).and_then(|()| file.sync_all()).map_err(|e| CliError::write(path, e))?;
         }
         for (temp, target, path) in &staged {
-            fs::rename(temp, target).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            fs::rename(temp, target).map_err(|e| CliError::write(path, e))?;
         }
         Ok(())
     })();
@@ -213,7 +213,7 @@ fn write_all_or_nothing(files: &[(&Path, Vec<u8>)]) -> Result<(), String> {
             .write(true)
             .open(path)
             .and_then(|mut out| out.write_all(bytes))
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            .map_err(|e| CliError::write(path, e))?;
     }
     Ok(())
 }

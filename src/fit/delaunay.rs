@@ -1,9 +1,17 @@
 //! A small 2-D Delaunay triangulation (Bowyer–Watson) for one point's
 //! neighbourhood projected on its tangent plane: the local view of the
 //! surface from which the triangle net takes that point's umbrella.
+//!
+//! Numbers: the in-circle and orientation decisions are exact
+//! ([`crate::predicates`]), so the cavities of one insertion agree and the
+//! result is a triangulation even for cocircular points (a grid); only the
+//! merging of near-duplicate points uses a tolerance (1e-9 of the spread).
 
 use alloc::vec::Vec;
+use core::cmp::Ordering;
 use glam::DVec2;
+
+use crate::predicates::{incircle, orient2d};
 
 /// Delaunay triangles (counter-clockwise index triples into `pts`) of at most
 /// a few dozen points. Points closer than `1e-9` × the spread to an earlier one
@@ -40,7 +48,7 @@ pub(crate) fn triangulate(pts: &[DVec2]) -> Vec<[usize; 3]> {
         }
         bad.clear();
         for (t, tri) in tris.iter().enumerate() {
-            if in_circle(v[tri[0]], v[tri[1]], v[tri[2]], p) > 0.0 {
+            if incircle(v[tri[0]], v[tri[1]], v[tri[2]], p) == Ordering::Greater {
                 bad.push(t);
             }
         }
@@ -64,7 +72,7 @@ pub(crate) fn triangulate(pts: &[DVec2]) -> Vec<[usize; 3]> {
             tris.swap_remove(t);
         }
         for e in &hole {
-            if orient(v[e[0]], v[e[1]], p) > 0.0 {
+            if orient2d(v[e[0]], v[e[1]], p) == Ordering::Greater {
                 tris.push([e[0], e[1], i]);
             }
         }
@@ -76,13 +84,6 @@ pub(crate) fn triangulate(pts: &[DVec2]) -> Vec<[usize; 3]> {
 /// Twice the signed area of `abc` (positive when counter-clockwise).
 pub(crate) fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
     (b - a).perp_dot(c - a)
-}
-
-/// Positive when `d` lies inside the circle through the counter-clockwise `a, b, c`.
-fn in_circle(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> f64 {
-    let (ad, bd, cd) = (a - d, b - d, c - d);
-    let (a2, b2, c2) = (ad.length_squared(), bd.length_squared(), cd.length_squared());
-    ad.x * (bd.y * c2 - b2 * cd.y) - ad.y * (bd.x * c2 - b2 * cd.x) + a2 * (bd.x * cd.y - bd.y * cd.x)
 }
 
 #[cfg(test)]
@@ -98,6 +99,23 @@ mod tests {
         assert!(t.iter().all(|t| orient(pts[t[0]], pts[t[1]], pts[t[2]]) > 0.0));
     }
 
+    /// A grid's points lie four on a circle: exact tests still give a
+    /// triangulation of the square, two triangles a cell, every circle empty.
+    #[test]
+    fn a_grid_of_cocircular_points_gives_two_triangles_a_cell() {
+        let pts: Vec<DVec2> = (0..25).map(|k| DVec2::new(f64::from(k % 5), f64::from(k / 5)) * 0.1).collect();
+        let t = triangulate(&pts);
+        assert_eq!(t.len(), 32);
+        let area: f64 = t.iter().map(|t| orient(pts[t[0]], pts[t[1]], pts[t[2]]) / 2.0).sum();
+        assert!((area - 0.16).abs() < 1e-12, "area {area}");
+        for tri in &t {
+            assert_eq!(orient2d(pts[tri[0]], pts[tri[1]], pts[tri[2]]), Ordering::Greater);
+            for p in &pts {
+                assert_ne!(incircle(pts[tri[0]], pts[tri[1]], pts[tri[2]], *p), Ordering::Greater);
+            }
+        }
+    }
+
     #[test]
     fn random_points_give_an_empty_circle_triangulation_of_the_hull() {
         let mut rnd = crate::testing::uniform(99u64);
@@ -109,7 +127,7 @@ mod tests {
         for tri in &t {
             for (i, p) in pts.iter().enumerate() {
                 if !tri.contains(&i) {
-                    assert!(in_circle(pts[tri[0]], pts[tri[1]], pts[tri[2]], *p) <= 1e-12);
+                    assert_ne!(incircle(pts[tri[0]], pts[tri[1]], pts[tri[2]], *p), Ordering::Greater);
                 }
             }
         }

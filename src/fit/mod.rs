@@ -4,6 +4,11 @@
 //! then the patches tessellated within a chordal tolerance.
 //!
 //! [`fit_points`] runs it all; [`read_points`] reads xyz, csv and ply files.
+//!
+//! Numbers ([`crate::numeric`]): the tangent-plane Delaunay triangulations
+//! decide exactly ([`crate::predicates`]); duplicate points and colinear
+//! input are found within tolerances relative to the points' spread, and
+//! the tessellation holds the chordal tolerance.
 
 // Comparisons are written `!(x > 0.0)` on purpose: they reject NaN too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -35,6 +40,7 @@ pub use bezier::{Cubic, PatchPoint, TriPatch};
 pub use points::{read_points, PointFormat, MAX_FILE_POINTS};
 
 use crate::mesh::{edge_counts, Mesh};
+use crate::numeric::TINY;
 use crate::options::{OptionsError, Tolerance};
 use crate::Error;
 use kdtree::KdTree;
@@ -332,7 +338,7 @@ pub fn fit_points(points: &[DVec3], options: &FitOptions) -> Result<FitResult, E
     let (normals, net) = triangle_net(&verts, options, &mut warnings)?;
     let surface = polygons(verts, normals, &net.tris, options, &mut warnings);
     let (tol, mesh) = tessellated(&surface, options, diag, &mut warnings)?;
-    let counts = edge_counts(&mesh, 1e-12 * diag.max(1e-300), 0.0);
+    let counts = edge_counts(&mesh, 1e-12 * diag.max(TINY), 0.0);
     let mut sides = Vec::new();
     for poly in &surface.polygons {
         let n = poly.corners.len();

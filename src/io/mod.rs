@@ -1,4 +1,9 @@
 //! Readers (bytes in, [`Model`] or [`crate::Mesh`] out) and mesh writers (bytes out).
+//!
+//! Numbers ([`crate::numeric`]): readers decide by tolerances relative to
+//! the size of what they compare (a curve closed within 1e-9 of its box's
+//! diagonal, a degenerate frame or transform by its determinant) or by the
+//! file's own modelling tolerance where it gives one; no exact predicates.
 
 #[cfg(feature = "writers")]
 mod glb;

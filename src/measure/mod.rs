@@ -16,6 +16,10 @@
 //!   triangles. Holes and dropped faces show up here and nowhere else.
 //! - **Edges** after welding coincident vertices ([`crate::edge_counts`]) and
 //!   **angles** ([`crate::angle_stats`]).
+//!
+//! Numbers ([`crate::numeric`]): distances are floats from Newton
+//! projections (their own stopping tolerance); vertices weld within a
+//! thousandth of the tolerance unless given; no exact predicates.
 
 mod bvh;
 mod index;
@@ -23,6 +27,7 @@ mod region;
 #[cfg(test)]
 mod tests;
 
+use crate::numeric::TINY;
 use alloc::vec::Vec;
 use glam::DVec3;
 use serde::Serialize;
@@ -224,7 +229,7 @@ fn coverage(model: &Model, plans: &[FacePlan], mesh: &Mesh, target: usize, out: 
             out.coverage_samples += 1;
             // The previous sample's triangle bounds the search (samples come in order).
             let seed = last.map(|t| (tri_distance(t, p), t));
-            let limit = seed.map_or(f64::INFINITY, |(d, _)| d * (1.0 + 1e-12) + 1e-300);
+            let limit = seed.map_or(f64::INFINITY, |(d, _)| d * (1.0 + 1e-12) + TINY);
             let found = bvh.nearest(p, limit, |t| tri_distance(t, p)).or(seed);
             let d = match found {
                 Some((d, t)) => {

@@ -1,4 +1,7 @@
 //! Triangle meshes and what is measured on them.
+//!
+//! Numbers ([`crate::numeric`]): welding and the edge census use the weld
+//! distance they are given; angles are floats; no exact predicates.
 
 mod metrics;
 mod weld;

@@ -1,5 +1,9 @@
 //! The model to mesh: faces made of a surface and trim loops in its (u,v).
+//!
+//! Numbers ([`crate::numeric`]): boxes and bodies are found with tolerances
+//! relative to the model's size; no exact predicates.
 
+use crate::numeric::TINY;
 use alloc::boxed::Box;
 use alloc::string::String;
 use alloc::vec::Vec;
@@ -250,7 +254,7 @@ fn offset_derivs(base: &FaceSurface, d: f64, uv: DVec2) -> SurfaceDerivs {
         let (e, f, g) = (b.su.dot(b.su), b.su.dot(b.sv), b.sv.dot(b.sv));
         let (l, m, nn) = (b.suu.dot(n), b.suv.dot(n), b.svv.dot(n));
         let den = e * g - f * f;
-        let (nu, nv) = if den > 1e-24 * (e * g).max(1e-300) && den.is_finite() {
+        let (nu, nv) = if den > 1e-24 * (e * g).max(TINY) && den.is_finite() {
             (
                 (b.su * (f * m - g * l) + b.sv * (f * l - e * m)) / den,
                 (b.su * (f * nn - g * m) + b.sv * (f * m - e * nn)) / den,

@@ -1,5 +1,6 @@
 //! Rational B-spline curves in 2-D (z = 0) and 3-D.
 
+use crate::numeric::guarded_div;
 use alloc::collections::BinaryHeap;
 use alloc::vec::Vec;
 use core::cmp::Ordering;
@@ -349,7 +350,7 @@ impl NurbsCurve {
             let f = c.d1.dot(r);
             let df = c.d1.length_squared() + c.d2.dot(r);
             // Newton where the model has a minimum, a gradient step elsewhere.
-            let mut step = if df > 0.0 { -f / df } else { -f / c.d1.length_squared().max(1e-300) };
+            let mut step = if df > 0.0 { -f / df } else { guarded_div(-f, c.d1.length_squared()) };
             if !step.is_finite() {
                 break;
             }

@@ -1,4 +1,9 @@
 //! NURBS geometry: knot vectors, basis functions, curves, surfaces, projection.
+//!
+//! Numbers ([`crate::numeric`]): evaluation is plain floating point;
+//! projection stops by [`ProjectionOptions::parameter_tolerance`] (a
+//! fraction of the domain), knot and weight checks compare with fractions
+//! of the values' size, and divisions by a derivative's length are guarded.
 
 pub(crate) mod analytic;
 mod bbox;

@@ -1,5 +1,6 @@
 //! Closest-point projection onto a surface (Newton with safeguards).
 
+use crate::numeric::{guarded_div, TINY};
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
@@ -231,7 +232,7 @@ fn newton(
     enough: f64,
 ) -> Projection {
     let [lo, hi] = surface.domain();
-    let size = (hi - lo).max(DVec2::splat(1e-300));
+    let size = (hi - lo).max(DVec2::splat(TINY));
     let mut uv = start.clamp(lo, hi);
     let mut d = surface.derivs(uv);
     let mut point = d.point;
@@ -307,7 +308,7 @@ fn try_step(
     breaks: &[Vec<f64>; 2],
 ) -> Option<(f64, DVec2, DVec3)> {
     let [lo, hi] = surface.domain();
-    let size = (hi - lo).max(DVec2::splat(1e-300));
+    let size = (hi - lo).max(DVec2::splat(TINY));
     let r = point - target;
     let g = DVec2::new(d.su.dot(r), d.sv.dot(r));
     let j00 = d.su.length_squared() + d.suu.dot(r);
@@ -318,8 +319,8 @@ fn try_step(
         DVec2::new(-(j11 * g.x - j01 * g.y) / det, -(j00 * g.y - j01 * g.x) / det)
     } else {
         // Not positive definite: scaled gradient descent.
-        let a = d.su.length_squared().max(1e-300);
-        let b = d.sv.length_squared().max(1e-300);
+        let a = d.su.length_squared().max(TINY);
+        let b = d.sv.length_squared().max(TINY);
         DVec2::new(-g.x / a, -g.y / b)
     };
     if !step.is_finite() {
@@ -344,8 +345,8 @@ fn try_step(
     }
     let step = match hold {
         [true, true] => DVec2::ZERO,
-        [true, false] => DVec2::new(0.0, if j11 > 0.0 { -g.y / j11 } else { -g.y / d.sv.length_squared().max(1e-300) }),
-        [false, true] => DVec2::new(if j00 > 0.0 { -g.x / j00 } else { -g.x / d.su.length_squared().max(1e-300) }, 0.0),
+        [true, false] => DVec2::new(0.0, if j11 > 0.0 { -g.y / j11 } else { guarded_div(-g.y, d.sv.length_squared()) }),
+        [false, true] => DVec2::new(if j00 > 0.0 { -g.x / j00 } else { guarded_div(-g.x, d.su.length_squared()) }, 0.0),
         [false, false] => step,
     };
     if !step.is_finite() {

@@ -3,6 +3,7 @@
 //! parameter anywhere in the period. Trim loops that straddle the seam then
 //! fit inside the domain without being cut.
 
+use crate::numeric::TINY;
 use alloc::vec::Vec;
 use glam::{DVec3, DVec4};
 
@@ -35,7 +36,7 @@ pub fn rotate_seam(s: &NurbsSurface, along_u: bool, c: f64) -> Option<NurbsSurfa
     // seam: they must match up to one common weight factor.
     let end_r = row(&right, n_rows_r - 1, n_other);
     let start_l = row(&left, 0, n_other);
-    let size = s.bbox().diagonal().max(1e-300);
+    let size = s.bbox().diagonal().max(TINY);
     let factor = end_r[0].w / start_l[0].w;
     for (a, b) in end_r.iter().zip(&start_l) {
         let (pa, pb) = (a.truncate() / a.w, b.truncate() / b.w);
@@ -94,7 +95,7 @@ pub fn unroll(s: &NurbsSurface, along_u: bool, a: f64, b: f64) -> Option<NurbsSu
     };
     // The last row must be the first up to one common weight factor.
     let (first, last) = (row(0), row(n_rows - 1));
-    let size = s.bbox().diagonal().max(1e-300);
+    let size = s.bbox().diagonal().max(TINY);
     let factor = last[0].w / first[0].w;
     for (x, y) in last.iter().zip(&first) {
         let (px, py) = (x.truncate() / x.w, y.truncate() / y.w);

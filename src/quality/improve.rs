@@ -9,6 +9,7 @@
 //! touched stays counter-clockwise in (u,v) (so nodes stay inside the face's
 //! region) and its facet normal stays on the surface normal's side.
 
+use crate::numeric::TINY;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
@@ -90,7 +91,7 @@ pub(crate) fn improve(
         lo = lo.min(*q);
         hi = hi.max(*q);
     }
-    let span = (hi - lo).max_element().max(1e-300);
+    let span = (hi - lo).max_element().max(TINY);
     let hmax = mesh.h.iter().copied().fold(0.0, f64::max);
     let alive = alloc::vec![true; mesh.tris.len()];
     let nrm = mesh.uv.iter().map(|&q| surface.normal(q)).collect();

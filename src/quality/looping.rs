@@ -28,6 +28,7 @@
 //! a clearance of a fifth of the local size from other nodes (dropped when no
 //! line qualifies); and the node count is bounded.
 
+use crate::numeric::{guarded_div, TINY};
 use crate::warning::QualityError;
 use alloc::vec::Vec;
 use core::f64::consts::{FRAC_PI_2, FRAC_PI_3, PI, TAU};
@@ -207,7 +208,7 @@ fn angles(pos: &[DVec2], lp: &[u32]) -> (Vec<f64>, Vec<f64>) {
 /// Number of segments the density wants along a line of length `len`
 /// between sizes `ha` and `hb` (N = ∫ ds / h, h linear).
 fn wanted_segments(len: f64, ha: f64, hb: f64) -> f64 {
-    let (ha, hb) = (ha.max(1e-300), hb.max(1e-300));
+    let (ha, hb) = (ha.max(TINY), hb.max(TINY));
     if (hb - ha).abs() <= 1e-9 * ha {
         len / ha
     } else {
@@ -222,7 +223,7 @@ fn division(n: usize, ha: f64, hb: f64) -> Vec<f64> {
     (1..n)
         .map(|k| {
             let f = k as f64 / n as f64;
-            if (hb - ha).abs() <= 1e-9 * ha.max(1e-300) {
+            if (hb - ha).abs() <= 1e-9 * ha.max(TINY) {
                 f
             } else {
                 let hk = ha * libm::pow(hb / ha, f);
@@ -322,7 +323,7 @@ impl Mesher {
         let m = lp.len();
         let (theta, base) = angles(&self.pos, lp);
         let concave = theta.iter().any(|&t| t > PI + 1e-9);
-        let d = box_diag(&self.pos, lp).max(1e-300);
+        let d = box_diag(&self.pos, lp).max(TINY);
         let [c1, c2, c3, c4] = self.w;
         let balance = if m > BALANCE_ABOVE { m / 6 } else { 0 };
         let mut cands: Vec<Cand> = Vec::new();
@@ -443,12 +444,12 @@ impl Mesher {
                         continue;
                     }
                     let size = 0.5 * (self.h[a as usize] + self.h[b as usize]);
-                    cands.push((len / size.max(1e-300), hi, ia, ib));
+                    cands.push((guarded_div(len, size), hi, ia, ib));
                 }
             }
         }
         cands.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-        let d = box_diag(&self.pos, &outer).max(1e-300);
+        let d = box_diag(&self.pos, &outer).max(TINY);
         let mut found = None;
         'search: for clearance in [0.2, 0.0] {
             for &(_, hi, ia, ib) in cands.iter().take(MAX_VALIDATIONS) {

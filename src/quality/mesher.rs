@@ -1,5 +1,6 @@
 //! The quality mesher (paper 003): boundary, mapping, filling, improvement.
 
+use crate::numeric::TINY;
 use alloc::format;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
@@ -360,7 +361,7 @@ fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
             + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
     };
     let d = det(a);
-    if !(d.abs() > 1e-300 && d.is_finite()) {
+    if !(d.abs() > TINY && d.is_finite()) {
         return None;
     }
     let mut out = [0.0; 3];

@@ -13,6 +13,11 @@
 //! ([`crate::QualityReport`]) are in every build; the mesher itself is the
 //! `quality` feature (the npm package's viewer build leaves it out, and a
 //! quality request there is an error saying so).
+//!
+//! Numbers ([`crate::numeric`]): sizes and scores are floats measured in
+//! model space against the element size; loop splits and cut lines are
+//! accepted by float tests with tolerances relative to the loop's size;
+//! the `delaunay` method's triangulation is spade's (exact predicates).
 
 #[cfg(feature = "quality")]
 mod boundary;

@@ -14,9 +14,9 @@ use glam::{DVec2, DVec3};
 
 use super::cdt::{triangulate, Cdt, Conflict};
 use super::intersect::{crossing_parameter, position, side_at, triple_exists, Intersections};
-use super::predicates::{orient2d, side};
 use super::topology::{key, NONE};
 use super::tritri::{drop_axis, project, PointKey};
+use crate::predicates::{orient2d, side};
 
 /// How close (as a fraction of the triangle) a point may come to its edges
 /// in the 2-D picture; closer ones are pushed in (the 3-D position is kept).

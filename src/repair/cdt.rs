@@ -12,8 +12,8 @@ use alloc::vec::Vec;
 use core::cmp::Ordering;
 use glam::DVec2;
 
-use super::predicates::orient2d;
 use super::topology::NONE;
+use crate::predicates::orient2d;
 
 /// Why a sub-triangulation failed (the 2-D picture after rounding contradicts
 /// the exact topology: a point outside, two points on one spot, crossing

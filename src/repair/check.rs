@@ -8,10 +8,10 @@ use glam::DVec3;
 use core::cmp::Ordering;
 
 use super::broad::bvh_pairs;
-use super::predicates::orient3d;
 use super::topology::{edge, key};
 use super::tritri::{contact, Contact, Tri};
 use crate::nurbs::Aabb;
+use crate::predicates::orient3d;
 use crate::{Error, Mesh};
 
 /// Edge census of a triangle list (by vertex index, no welding).

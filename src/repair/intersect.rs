@@ -9,10 +9,10 @@ use core::cmp::Ordering;
 use glam::DVec3;
 
 use super::broad::{bvh_pairs, kd_pairs};
-use super::predicates::{side, side_of_crossing};
 use super::tritri::{contact, Contact, PointKey, Tri};
 use super::Bucketing;
 use crate::nurbs::Aabb;
+use crate::predicates::{side, side_of_crossing};
 use crate::Error;
 
 /// One intersection segment: the two triangles (lower id first) and its ends

@@ -13,6 +13,12 @@
 //! the triangles it serves carry a handful of points each (spade's set-up
 //! would dominate) and because it must keep points that rounding puts on one
 //! spot apart by their names, which spade would merge.
+//!
+//! Numbers ([`crate::numeric`]): which side of a plane, and orientation
+//! in a triangle's plane, are exact ([`crate::predicates`]), so the
+//! intersection topology is consistent (paper 002 §3); welding, the zero
+//! length and the zero angle of degenerate triangles, and the perturbation
+//! of symmetric input are tolerances of [`RepairOptions`].
 
 mod arrange;
 mod broad;
@@ -21,7 +27,6 @@ mod check;
 mod degenerate;
 mod intersect;
 mod offset;
-mod predicates;
 mod region;
 mod steps;
 mod topology;

@@ -8,8 +8,8 @@
 use core::cmp::Ordering;
 use glam::{DVec2, DVec3};
 
-use super::predicates::{orient2d, orient3d, side};
 use super::topology::key;
+use crate::predicates::{orient2d, orient3d, side};
 
 /// A point of the intersection arrangement, named by how it arises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

@@ -3,6 +3,10 @@
 //! model-space distance, with their trim loops re-expressed on the new surface.
 //! The rebuilt face is checked against the original, so a mesh within
 //! `tolerance − fit error` of the new face is within tolerance of the original.
+//!
+//! Numbers ([`crate::numeric`]): the step-ratio test and the fit error are
+//! floats against the tolerance (a rebuild must stay within a tenth of it);
+//! no exact predicates.
 
 mod fit;
 mod interp;

@@ -1,6 +1,7 @@
 //! One face: iso-parametric grid (paper 000 §3.1), trimmed band by CDT
 //! (§3.2), then refinement until every triangle is proven within limits.
 
+use crate::numeric::TINY;
 use alloc::format;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
@@ -387,7 +388,7 @@ fn align_to_grid(surface: &dyn Surface, loops: &mut super::trim::Loops<'_>, pu: 
     use super::trim::Polyline;
     let span = (pu.last().copied().unwrap_or(0.0) - pu.first().copied().unwrap_or(0.0)).abs()
         + (pv.last().copied().unwrap_or(0.0) - pv.first().copied().unwrap_or(0.0)).abs();
-    let eps = 1e-9 * span.max(1e-300);
+    let eps = 1e-9 * span.max(TINY);
     for poly in &mut loops.polys {
         let n = poly.uv.len();
         let mut out = Polyline { uv: Vec::with_capacity(n), at: Vec::with_capacity(n), seg: Vec::with_capacity(n) };
@@ -594,7 +595,7 @@ pub(super) fn check_grid(index: usize, pu: &[f64], pv: &[f64], budget: usize) ->
 fn weld_nodes(surface: &dyn Surface, nodes: &[DVec2], wm: &mut WorkMesh) -> (Vec<u32>, Vec<u32>) {
     let pts: Vec<DVec3> = nodes.iter().map(|&q| surface.point(q)).collect();
     let diag = crate::nurbs::Aabb::from_points(pts.iter().copied()).diagonal();
-    let (map, count) = crate::mesh::weld_positions(&pts, 1e-10 * diag.max(1e-300));
+    let (map, count) = crate::mesh::weld_positions(&pts, 1e-10 * diag.max(TINY));
     let mut vert = alloc::vec![u32::MAX; count];
     let mut multiplicity = alloc::vec![0u32; count];
     let mut out = Vec::with_capacity(nodes.len());

@@ -302,7 +302,7 @@ fn ear(p: &[DVec3], first: usize, width: f64) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tessellate::refine::{Criteria, WorkMesh};
+    use crate::tessellate::refine::{Criteria, Known, WorkMesh};
     use glam::DVec2;
 
     /// The plane z = 0 over [-20, 20]², u = x and v = y.
@@ -381,14 +381,20 @@ mod tests {
             )
         };
         let beside = |far: f64| mesh(&[(10.03, 5.0, 2), (far, 5.0, NONE), (10.0, 10.0, 3)], &[[0, 1, 2]]);
+        // The flap's two border sides are shared edges of the square's mesh.
+        let mut flapped = square();
+        flapped.shared.insert((1, 2), ());
+        flapped.shared.insert((2, 3), ());
         let mut faces = alloc::vec![
-            work(square()),
+            work(flapped),
             work(beside(15.0)),
             work(mesh(&[(10.0, 10.0, 3), (10.0, 15.0, NONE), (10.03, 5.0, 2)], &[[0, 1, 2]]))
         ];
         assert_eq!(border_uses(&faces).get(&(2, 3)), Some(&3));
         assert_eq!(remove_flaps(&mut faces, 0.1), 1);
         assert_eq!(faces[0].mesh.tris.len(), 2);
+        // Its sides went with it: no shared edge is left that no triangle has.
+        assert_eq!(faces[0].mesh.check_invariants_but(Known::CLOSED), Ok(()));
         let uses = border_uses(&faces);
         assert_eq!(uses.get(&(2, 3)), Some(&2));
         assert_eq!(uses.get(&(1, 3)), Some(&1));

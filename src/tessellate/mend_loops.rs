@@ -12,6 +12,7 @@
 //! nodes closer than that are one, and a node that near a segment lies on
 //! it. Winding numbers are counted exactly along axis-parallel rays.
 
+use crate::numeric::TINY;
 use alloc::vec::Vec;
 use glam::DVec2;
 
@@ -299,7 +300,7 @@ fn candidate_pairs(pts: &[(DVec2, DVec2)]) -> Vec<(usize, usize)> {
         hi = hi.max(a.max(b));
     }
     let cells = (crate::math::sqrt(pts.len() as f64) as usize).clamp(1, 256);
-    let size = ((hi - lo) / cells as f64).max(DVec2::splat(1e-300));
+    let size = ((hi - lo) / cells as f64).max(DVec2::splat(TINY));
     let cell = |p: DVec2| {
         let c = ((p - lo) / size).floor();
         (c.x.clamp(0.0, (cells - 1) as f64) as usize, c.y.clamp(0.0, (cells - 1) as f64) as usize)
@@ -396,7 +397,7 @@ impl Bands {
             hi = hi.max(a.max(b));
         }
         let count = (crate::math::sqrt(ends.len() as f64) as usize).clamp(1, 1024);
-        let step = ((hi - lo) / count as f64).max(DVec2::splat(1e-300));
+        let step = ((hi - lo) / count as f64).max(DVec2::splat(TINY));
         let (mut rows, mut cols) = (alloc::vec![Vec::new(); count], alloc::vec![Vec::new(); count]);
         let band = |x: f64, lo: f64, step: f64| (((x - lo) / step).floor().max(0.0) as usize).min(count - 1);
         for (k, &(a, b)) in ends.iter().enumerate() {

@@ -2,6 +2,15 @@
 //!
 //! [`mesh_fast`] reads as the pipeline: each stage is one method of
 //! [`pipeline::Plan`], with its paper section in its doc comment.
+//!
+//! Numbers ([`crate::numeric`]): nothing here is decided by an exact
+//! predicate (spade's CDT decides its own triangulation exactly). Every test
+//! takes a tolerance: deviation and normal turn against the chordal
+//! tolerance and angle limit (with refinement's safety factor); sewing within
+//! the sewing distance (at most 0.4 of the tolerance), seams within `tight`;
+//! a triangle is folded in (u,v) by the sign of its float area (a flat one
+//! counts as folded); a node is a segment's end within 1e-9 of its length,
+//! and two points are one within 1e-12 of their coordinates' size.
 
 #[cfg(feature = "std")]
 mod band;

@@ -11,7 +11,6 @@ use super::measure::{measure_projection, measure_triangle, sample_count, TriMeas
 use crate::math::angle_between;
 use crate::nurbs::{project_to_surface, regular_normal, NurbsCurve, Surface};
 
-#[cfg(any(test, debug_assertions))]
 mod check;
 mod edges;
 #[cfg(feature = "std")]
@@ -19,6 +18,7 @@ mod lift;
 mod limits;
 mod mend;
 
+pub(crate) use check::Known;
 pub(crate) use edges::EdgeList;
 pub(crate) use limits::{Criteria, Lift, Outcome};
 use limits::{Packed, STALE};
@@ -107,6 +107,57 @@ struct SplitSide {
 
 fn key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
+}
+
+/// The parameter between `ta` and `tb` of trim curve `c` whose point is as
+/// far from `pa` as from `pb` (bisection), or None when the ends do not
+/// bracket it. Refinement halves a trim edge in model space: a curve whose
+/// parameter crowds (most of its range on a short stretch) would otherwise
+/// be split next to one end, again and again.
+fn model_middle(surface: &dyn Surface, c: &NurbsCurve, pa: DVec3, pb: DVec3, ta: f64, tb: f64) -> Option<f64> {
+    let side = |t: f64| {
+        let p = surface.point(c.point(t).truncate());
+        p.distance(pa) - p.distance(pb)
+    };
+    let (mut lo, mut hi) = (ta, tb);
+    if !(side(lo) < 0.0 && side(hi) > 0.0) {
+        return None;
+    }
+    for _ in 0..48 {
+        let mid = 0.5 * (lo + hi);
+        if side(mid) < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
+/// Whether a new vertex at `uv_m` on the first side of (u,v) triangle `u`
+/// folds either child (or leaves it flat) where the triangle is not.
+fn split_folds(u: [DVec2; 3], uv_m: DVec2) -> bool {
+    let whole = uv_area(u);
+    whole != 0.0 && (uv_area([u[0], uv_m, u[2]]) * whole <= 0.0 || uv_area([uv_m, u[1], u[2]]) * whole <= 0.0)
+}
+
+/// A sewing target whose (u,v) would fold the children of a split (a thin
+/// triangle on a curved border) goes in at the edge's own point instead, on
+/// this face's surface: the children keep their (u,v) orientation and face
+/// the surface's way. Returns that place and normal, or None when no child
+/// folds. Settling later moves the node halfway to where the other face
+/// has it; put there at once, a node off its (u,v) folded the thin children
+/// in space, and refinement split those folds down to slivers (99 on one
+/// cylinder of a valve body).
+fn unfold_target(surface: &dyn Surface, plan: &mut [SplitSide]) -> Option<(DVec3, DVec3)> {
+    if !plan.iter().any(|s| split_folds(s.uv, s.uv_m)) {
+        return None;
+    }
+    for s in plan.iter_mut() {
+        s.uv_m = s.guess;
+    }
+    let uv = plan.first()?.guess;
+    Some((surface.point(uv), surface.normal(uv)))
 }
 
 /// Makes room for `extra` more elements, growing by a quarter: every face's
@@ -500,39 +551,50 @@ impl WorkMesh {
             None => *self.edges.get(&key(a, b))?,
         };
         let trim = self.trim.get(&key(a, b)).copied();
-        let mut trim_at = None;
-        if let Some(te) = trim {
-            if let Some(c) = curves.get(te.curve as usize) {
-                let (ta, tb) = if a < b { (te.t_lo, te.t_hi) } else { (te.t_hi, te.t_lo) };
-                let mut tm = ta + (tb - ta) * frac;
-                if target.is_none() && frac == 0.5 {
-                    // Refinement halves the edge in model space: a trim curve
-                    // whose parameter crowds (most of its range on a short
-                    // stretch) would otherwise be split next to one end,
-                    // again and again.
-                    let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
-                    let side = |t: f64| {
-                        let p = surface.point(c.point(t).truncate());
-                        p.distance(pa) - p.distance(pb)
-                    };
-                    let (mut lo, mut hi) = (ta, tb);
-                    if side(lo) < 0.0 && side(hi) > 0.0 {
-                        for _ in 0..48 {
-                            let mid = 0.5 * (lo + hi);
-                            if side(mid) < 0.0 {
-                                lo = mid;
-                            } else {
-                                hi = mid;
-                            }
-                        }
-                        tm = 0.5 * (lo + hi);
-                    }
-                }
-                trim_at = Some((c.point(tm).truncate(), ta, tm, tb));
-            }
+        // The split's (u,v) and the curve parameters at a, the split and b.
+        let trim_at = trim.and_then(|te| {
+            let c = curves.get(te.curve as usize)?;
+            let (ta, tb) = if a < b { (te.t_lo, te.t_hi) } else { (te.t_hi, te.t_lo) };
+            let halving = target.is_none() && frac == 0.5;
+            let middle = if halving {
+                model_middle(surface, c, self.pos[a as usize], self.pos[b as usize], ta, tb)
+            } else {
+                None
+            };
+            let tm = middle.unwrap_or(ta + (tb - ta) * frac);
+            Some((c.point(tm).truncate(), ta, tm, tb))
+        });
+        let (mut plan, mut p, mut normal) = self.plan_split(surface, adj, a, b, frac, trim_at.map(|s| s.0), target)?;
+        if target.is_some() {
+            (p, normal) = unfold_target(surface, &mut plan).unwrap_or((p, normal));
+        } else if self.splits_nothing(a, b, p, &plan) {
+            return None;
         }
-        // First where the new vertex goes in each triangle on the edge, then
-        // (when it is a real split) the change.
+        let m = self.apply_split(a, b, p, normal, plan, out);
+        if let (Some(te), Some((_, ta, tm, tb))) = (trim, trim_at) {
+            self.trim.remove(&key(a, b));
+            self.mark_trim(a, m, te.curve, ta, tm);
+            self.mark_trim(m, b, te.curve, tm, tb);
+        }
+        Some(m)
+    }
+
+    /// Where the new vertex of a split of edge `a-b` goes in each triangle
+    /// on it (`adj`), and its place and normal: at `trim_uv` on a trim edge,
+    /// else at `target` (in each triangle's own (u,v) of it: across a seam or
+    /// at a pole the charts differ), else on the surface at the edge's own
+    /// (u,v) point at `frac`. None when no triangle has the edge.
+    #[allow(clippy::too_many_arguments)]
+    fn plan_split(
+        &self,
+        surface: &dyn Surface,
+        adj: [u32; 2],
+        a: u32,
+        b: u32,
+        frac: f64,
+        trim_uv: Option<DVec2>,
+        target: Option<DVec3>,
+    ) -> Option<(Vec<SplitSide>, DVec3, DVec3)> {
         let mut plan: Vec<SplitSide> = Vec::with_capacity(2);
         let mut m_pos: Option<DVec3> = None;
         let mut m_normal = DVec3::ZERO;
@@ -544,8 +606,8 @@ impl WorkMesh {
             let (u0, u1, u2) = (tuv[i], tuv[(i + 1) % 3], tuv[(i + 2) % 3]);
             let f = if x0 == a { frac } else { 1.0 - frac };
             let guess = u0.lerp(u1, f);
-            let uv_m = match (trim_at, m_pos.or(target)) {
-                (Some((uv, ..)), _) => uv,
+            let uv_m = match (trim_uv, m_pos.or(target)) {
+                (Some(uv), _) => uv,
                 (None, None) => guess,
                 (None, Some(p)) => {
                     // Another chart (seam or pole), or a sewing target: this triangle's (u,v) of the point.
@@ -562,44 +624,35 @@ impl WorkMesh {
             }
             plan.push(SplitSide { t, corners: [x0, x1, x2], uv: [u0, u1, u2], uv_m, guess });
         }
-        let mut p = m_pos?;
-        let folds = |u: [DVec2; 3], uv_m: DVec2| {
-            let whole = uv_area(u);
-            whole != 0.0 && (uv_area([u[0], uv_m, u[2]]) * whole <= 0.0 || uv_area([uv_m, u[1], u[2]]) * whole <= 0.0)
-        };
-        if target.is_some() {
-            // A sewing target whose (u,v) would fold the children (a thin
-            // triangle on a curved border) goes in at the edge's own point,
-            // on this face's surface: the children keep their (u,v)
-            // orientation and face the surface's way. Settling later moves
-            // the node halfway to where the other face has it; put there at
-            // once, a node off its (u,v) folded the thin children in space,
-            // and refinement split those folds down to slivers (99 on one
-            // cylinder of a valve body).
-            if plan.iter().any(|s| folds(s.uv, s.uv_m)) {
-                for s in &mut plan {
-                    s.uv_m = s.guess;
-                }
-                p = surface.point(plan[0].guess);
-                m_normal = surface.normal(plan[0].guess);
-            }
-        }
-        if target.is_none() {
-            // A point that is not strictly inside the edge, or lands on a
-            // triangle's third corner, or children that fold in (u,v) (a
-            // curve whose parameters no longer match the ends, corners of one
-            // (u,v) at a collapsed border) would split nothing and be split
-            // again forever: the edge stays as it is.
-            let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
-            let near = 1e-6 * pa.distance(pb);
-            let bad = !(p.distance(pa) > near && p.distance(pb) > near)
-                || plan.iter().any(|s| p.distance(self.pos[s.corners[2] as usize]) <= near || folds(s.uv, s.uv_m));
-            if bad {
-                return None;
-            }
-        }
+        Some((plan, m_pos?, m_normal))
+    }
+
+    /// Whether a split of `a-b` at `p` would split nothing and be split again
+    /// forever: a point not strictly inside the edge, or on a triangle's
+    /// third corner, or children that fold in (u,v) (a curve whose
+    /// parameters no longer match the ends, corners of one (u,v) at a
+    /// collapsed border). Such an edge stays as it is.
+    fn splits_nothing(&self, a: u32, b: u32, p: DVec3, plan: &[SplitSide]) -> bool {
+        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        let near = 1e-6 * pa.distance(pb);
+        !(p.distance(pa) > near && p.distance(pb) > near)
+            || plan.iter().any(|s| p.distance(self.pos[s.corners[2] as usize]) <= near || split_folds(s.uv, s.uv_m))
+    }
+
+    /// Makes the split `plan` of edge `a-b`: a new vertex at `p`, each
+    /// triangle on the edge halved, the border, shared and trim tables
+    /// following. The changed triangles go to `out`; returns the vertex.
+    fn apply_split(
+        &mut self,
+        a: u32,
+        b: u32,
+        p: DVec3,
+        normal: DVec3,
+        plan: Vec<SplitSide>,
+        out: &mut Vec<u32>,
+    ) -> u32 {
         self.room(1, plan.len());
-        let m = self.push_vertex(p, m_normal);
+        let m = self.push_vertex(p, normal);
         for SplitSide { t, corners: [x0, x1, x2], uv: [u0, u1, u2], uv_m, .. } in plan {
             // Replace t by [x0, m, x2] and add [m, x1, x2].
             self.detach(x0, x1, t);
@@ -631,12 +684,7 @@ impl WorkMesh {
             self.shared.insert(key(a, m), ());
             self.shared.insert(key(m, b), ());
         }
-        if let (Some(te), Some((_, ta, tm, tb))) = (trim, trim_at) {
-            self.trim.remove(&key(a, b));
-            self.mark_trim(a, m, te.curve, ta, tm);
-            self.mark_trim(m, b, te.curve, tm, tb);
-        }
-        Some(m)
+        m
     }
 
     /// Measures every triangle and splits the failing ones until all pass or

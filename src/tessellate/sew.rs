@@ -13,6 +13,7 @@
 //! and no T-junction, and each face's triangles are proven after its last split.
 
 use crate::collections::HashMap;
+use crate::numeric::guarded_div;
 use alloc::vec::Vec;
 use glam::DVec3;
 
@@ -259,7 +260,7 @@ fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) {
 fn nearest_on_border(f: &FaceWork<'_>, a: u32, b: u32, q: DVec3) -> f64 {
     let (pa, pb) = (f.mesh.pos[a as usize], f.mesh.pos[b as usize]);
     let ab = pb - pa;
-    let s0 = ((q - pa).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
+    let s0 = (guarded_div((q - pa).dot(ab), ab.length_squared())).clamp(0.0, 1.0);
     let dist =
         |s: f64| f.mesh.boundary_point(f.surface, &f.curves, a, b, s).map_or(f64::INFINITY, |(_, p)| p.distance(q));
     nearest_fraction(&dist, s0).0

@@ -17,6 +17,7 @@
 //! vertices, so welding leaves no crack.
 
 use crate::collections::{CellGrid, HashMap};
+use crate::numeric::guarded_div;
 use alloc::vec::Vec;
 use glam::DVec3;
 
@@ -347,7 +348,7 @@ mod pin {
                         if b != body || p.distance(pa) <= reach || p.distance(pb) <= reach {
                             continue;
                         }
-                        let s0 = ((p - pa).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
+                        let s0 = (guarded_div((p - pa).dot(ab), ab.length_squared())).clamp(0.0, 1.0);
                         let (s, d) = nearest_fraction(&|s: f64| on_curve(s).distance(p), s0);
                         if d <= reach && s > 1e-9 && s < 1.0 - 1e-9 {
                             adds[i].push((s, ta + (tb - ta) * s));
@@ -458,7 +459,7 @@ pub(crate) fn snap_borders(works: &mut [FaceWork<'_>], facets: &Facets<'_>, bodi
                 .filter(|&q| !taken[q as usize] && lone[q as usize].0 == body)
                 .filter_map(|q| {
                     let p = lone[q as usize].1;
-                    let s = (p - pa).dot(ab) / ab.length_squared().max(1e-300);
+                    let s = guarded_div((p - pa).dot(ab), ab.length_squared());
                     let d = p.distance(pa + ab * s.clamp(0.0, 1.0));
                     (s > 0.0 && s < 1.0 && d <= reach).then_some((s, q))
                 })
@@ -470,7 +471,7 @@ pub(crate) fn snap_borders(works: &mut [FaceWork<'_>], facets: &Facets<'_>, bodi
             for &(_, q) in on.iter().rev() {
                 let p = lone[q as usize].1;
                 let (ps, pe) = (pa, w.mesh.pos[end as usize]);
-                let frac = ((p - ps).dot(pe - ps) / ps.distance_squared(pe).max(1e-300)).clamp(1e-6, 1.0 - 1e-6);
+                let frac = (guarded_div((p - ps).dot(pe - ps), ps.distance_squared(pe))).clamp(1e-6, 1.0 - 1e-6);
                 let Some(m) = w.mesh.split_edge_at(w.surface, &w.curves, a, end, frac, Some(p), &mut changed) else {
                     continue;
                 };
@@ -607,7 +608,7 @@ pub(crate) fn split_rims(works: &mut [FaceWork<'_>], facets: &mut Facets<'_>, bo
                     .map(|v| verts[v as usize])
                     .filter(|v| v.0 == r.body && !is_rim.contains(&bits(v.1)))
                     .filter(|v| {
-                        let s = (v.1 - pa).dot(ab) / ab.length_squared().max(1e-300);
+                        let s = guarded_div((v.1 - pa).dot(ab), ab.length_squared());
                         s > 1e-9 && s < 1.0 - 1e-9 && v.1.distance(pa + ab * s) <= reach
                     })
                     .map(|v| v.1)
@@ -706,7 +707,7 @@ impl FacetMesh {
                 self.pos.push(p);
                 if with_normals {
                     let (pa, pb) = (self.pos[a], self.pos[b]);
-                    let s = ((p - pa).dot(pb - pa) / pa.distance_squared(pb).max(1e-300)).clamp(0.0, 1.0);
+                    let s = (guarded_div((p - pa).dot(pb - pa), pa.distance_squared(pb))).clamp(0.0, 1.0);
                     let n = self.normals[a].lerp(self.normals[b], s).try_normalize().unwrap_or(self.normals[a]);
                     self.normals.push(n);
                 }

@@ -1,6 +1,7 @@
 //! Trim loops: discretization by the chord test, outer/hole classification,
 //! crossing checks and inside tests (paper 000 §3.2).
 
+use crate::numeric::TINY;
 use alloc::format;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
@@ -149,66 +150,7 @@ pub(crate) fn prepare_loops<'a>(
     let mut areas = Vec::new();
     let (mut kept, mut flat) = (Vec::new(), Vec::new());
     for (li, lp) in loops.iter().enumerate() {
-        let mut poly = Polyline::default();
-        for c in &lp.curves {
-            let ci = out.curves.len() as u32;
-            out.curves.push(c);
-            let on_surface = |t: f64| {
-                let d = c.derivs(t);
-                let uv = d.point.truncate();
-                let s = surface.derivs(uv);
-                let tangent = s.su * d.d1.x + s.sv * d.d1.y;
-                (s.point, surface.normal_from_tangents(uv, s.su, s.sv), tangent)
-            };
-            let by_normal = |t: f64| {
-                let (p, n, _) = on_surface(t);
-                (p, n)
-            };
-            let by_tangent = |t: f64| {
-                let (p, _, tg) = on_surface(t);
-                (p, tg)
-            };
-            let (a, b) = c.domain();
-            let evals: [&dyn Fn(f64) -> (DVec3, DVec3); 2] = [&by_normal, &by_tangent];
-            // A coarse edge is a straight (u,v) segment in the mesh: its
-            // image must stay as close to its chord as the curve does.
-            let straight = |ta: f64, tb: f64| {
-                let (ua, ub) = (c.point(ta).truncate(), c.point(tb).truncate());
-                let (pa, pb) = (surface.point(ua), surface.point(ub));
-                (1..8).all(|k| {
-                    let p = surface.point(ua.lerp(ub, k as f64 / 8.0));
-                    super::params::dist_to_segment(p, pa, pb) <= lim.tol
-                })
-            };
-            let (ts, _) = if surface.even_parameters() {
-                super::params::subdivide_even(&evals, a, b, lim)
-            } else {
-                subdivide(&evals, &initial_breaks(&c.knots().breakpoints(), a, b, 16), lim)
-            };
-            let ts = super::params::coarsen(&evals, &straight, &ts, lim);
-            // The last node of each curve is the first of the next: drop it.
-            for &t in &ts[..ts.len().saturating_sub(1)] {
-                poly.uv.push(c.point(t).truncate());
-                poly.at.push(CurveRef { curve: ci, t });
-            }
-            if poly.uv.len() > MAX_PARAMS * 8 {
-                return Err(Error::Limit(format!(
-                    "face {face} loop {li}: more than {} boundary nodes",
-                    MAX_PARAMS * 8
-                )));
-            }
-        }
-        dedup_closed(&mut poly);
-        merge_close(&mut poly, surface, lim.min_edge);
-        let n = poly.at.len();
-        poly.seg = (0..n)
-            .map(|i| {
-                let (a, b) = (poly.at[i], poly.at[(i + 1) % n]);
-                let end = out.curves.get(a.curve as usize).map_or(b.t, |c| c.domain().1);
-                let tb = if b.curve == a.curve && b.t > a.t { b.t } else { end };
-                (a.curve, a.t, tb)
-            })
-            .collect();
+        let poly = discretize_loop(face, li, lp, surface, lim, &mut out.curves)?;
         let area = if poly.uv.len() < 3 { 0.0 } else { signed_area(&poly.uv) };
         if area == 0.0 || !area.is_finite() {
             // A loop of no area bounds nothing: dropped when others remain.
@@ -222,7 +164,106 @@ pub(crate) fn prepare_loops<'a>(
     if let Some(&li) = flat.first().filter(|_| out.polys.is_empty()) {
         return Err(Error::Mesh { face, message: format!("loop {li} encloses no area") });
     }
-    // Outer = largest area; counter-clockwise. Holes clockwise.
+    let (order, file_ccw) = orient_loops(&mut out, areas, kept);
+    untangle(face, &mut out, &order, &file_ccw)?;
+    if !flat.is_empty() {
+        let m = out.mended.get_or_insert(Mended {
+            loops_before: loops.len(),
+            loops_after: out.polys.len(),
+            ..Mended::default()
+        });
+        m.flat = flat.len();
+    }
+    Ok(out)
+}
+
+/// Loop `li` of face `face` as a polyline in (u,v) (paper 000 §3.2): each
+/// curve discretized by the chord test, its curves appended to `curves`,
+/// repeated and nanometre-close nodes merged, each segment tied to the
+/// stretch of curve it follows.
+///
+/// # Errors
+/// [`Error::Limit`] when the loop takes more nodes than the grid may have.
+fn discretize_loop<'a>(
+    face: usize,
+    li: usize,
+    lp: &'a TrimLoop,
+    surface: &dyn Surface,
+    lim: &Limits,
+    curves: &mut Vec<&'a crate::NurbsCurve>,
+) -> Result<Polyline, Error> {
+    let mut poly = Polyline::default();
+    for c in &lp.curves {
+        let ci = curves.len() as u32;
+        curves.push(c);
+        let ts = curve_parameters(c, surface, lim);
+        // The last node of each curve is the first of the next: drop it.
+        for &t in &ts[..ts.len().saturating_sub(1)] {
+            poly.uv.push(c.point(t).truncate());
+            poly.at.push(CurveRef { curve: ci, t });
+        }
+        if poly.uv.len() > MAX_PARAMS * 8 {
+            return Err(Error::Limit(format!("face {face} loop {li}: more than {} boundary nodes", MAX_PARAMS * 8)));
+        }
+    }
+    dedup_closed(&mut poly);
+    merge_close(&mut poly, surface, lim.min_edge);
+    let n = poly.at.len();
+    poly.seg = (0..n)
+        .map(|i| {
+            let (a, b) = (poly.at[i], poly.at[(i + 1) % n]);
+            let end = curves.get(a.curve as usize).map_or(b.t, |c| c.domain().1);
+            let tb = if b.curve == a.curve && b.t > a.t { b.t } else { end };
+            (a.curve, a.t, tb)
+        })
+        .collect();
+    Ok(poly)
+}
+
+/// The parameters of trim curve `c` where its polyline has nodes: split
+/// until each piece's image on the surface is within the tolerance of its
+/// chord and turns less than the angle limit (by normal and by tangent),
+/// then coarsened where a longer (u,v) segment still stays that close.
+fn curve_parameters(c: &crate::NurbsCurve, surface: &dyn Surface, lim: &Limits) -> Vec<f64> {
+    let on_surface = |t: f64| {
+        let d = c.derivs(t);
+        let uv = d.point.truncate();
+        let s = surface.derivs(uv);
+        let tangent = s.su * d.d1.x + s.sv * d.d1.y;
+        (s.point, surface.normal_from_tangents(uv, s.su, s.sv), tangent)
+    };
+    let by_normal = |t: f64| {
+        let (p, n, _) = on_surface(t);
+        (p, n)
+    };
+    let by_tangent = |t: f64| {
+        let (p, _, tg) = on_surface(t);
+        (p, tg)
+    };
+    let (a, b) = c.domain();
+    let evals: [&dyn Fn(f64) -> (DVec3, DVec3); 2] = [&by_normal, &by_tangent];
+    // A coarse edge is a straight (u,v) segment in the mesh: its
+    // image must stay as close to its chord as the curve does.
+    let straight = |ta: f64, tb: f64| {
+        let (ua, ub) = (c.point(ta).truncate(), c.point(tb).truncate());
+        let (pa, pb) = (surface.point(ua), surface.point(ub));
+        (1..8).all(|k| {
+            let p = surface.point(ua.lerp(ub, k as f64 / 8.0));
+            super::params::dist_to_segment(p, pa, pb) <= lim.tol
+        })
+    };
+    let (ts, _) = if surface.even_parameters() {
+        super::params::subdivide_even(&evals, a, b, lim)
+    } else {
+        subdivide(&evals, &initial_breaks(&c.knots().breakpoints(), a, b, 16), lim)
+    };
+    super::params::coarsen(&evals, &straight, &ts, lim)
+}
+
+/// Puts the outer loop (largest area) first, counter-clockwise, and the
+/// holes clockwise after it. Returns the file's loop number of each
+/// polyline and whether the file had it counter-clockwise.
+fn orient_loops(out: &mut Loops<'_>, mut areas: Vec<f64>, kept: Vec<usize>) -> (Vec<usize>, Vec<bool>) {
     let outer = (0..areas.len()).max_by(|&i, &j| areas[i].abs().total_cmp(&areas[j].abs())).unwrap_or(0);
     out.polys.swap(0, outer);
     areas.swap(0, outer);
@@ -243,11 +284,22 @@ pub(crate) fn prepare_loops<'a>(
                 .collect();
         }
     }
-    if let Some(x) = split_crossings(&mut out) {
-        let mm = super::mend_loops::mend(&mut out, &file_ccw);
+    (order, file_ccw)
+}
+
+/// Loops that cross, touch, or lie beside the outer loop are mended to the
+/// region they wind round ([`super::mend_loops`]); `order` and `file_ccw`
+/// as [`orient_loops`] gives them.
+///
+/// # Errors
+/// [`Error::Mesh`] naming the loops when mending leaves a crossing or
+/// cannot make a region of them.
+fn untangle(face: usize, out: &mut Loops<'_>, order: &[usize], file_ccw: &[bool]) -> Result<(), Error> {
+    if let Some(x) = split_crossings(out) {
+        let mm = super::mend_loops::mend(out, file_ccw);
         match mm {
-            Some(m) if first_crossing(&out).is_none() => out.mended = Some(m),
-            _ => return Err(crossing_error(face, &x, &order)),
+            Some(m) if first_crossing(out).is_none() => out.mended = Some(m),
+            _ => return Err(crossing_error(face, &x, order)),
         }
     }
     if out.mended.is_none() {
@@ -257,8 +309,8 @@ pub(crate) fn prepare_loops<'a>(
             if !only_outer.contains(probe) {
                 // A loop beside the outer one: a region of its own, or a
                 // hole of nothing; mending keeps what the loops wind round.
-                match super::mend_loops::mend(&mut out, &file_ccw) {
-                    Some(m) if first_crossing(&out).is_none() => {
+                match super::mend_loops::mend(out, file_ccw) {
+                    Some(m) if first_crossing(out).is_none() => {
                         out.mended = Some(m);
                         break;
                     }
@@ -272,15 +324,7 @@ pub(crate) fn prepare_loops<'a>(
             }
         }
     }
-    if !flat.is_empty() {
-        let m = out.mended.get_or_insert(Mended {
-            loops_before: loops.len(),
-            loops_after: out.polys.len(),
-            ..Mended::default()
-        });
-        m.flat = flat.len();
-    }
-    Ok(out)
+    Ok(())
 }
 
 /// Drops a node that lies within `eps` of the next one in model space and
@@ -465,7 +509,7 @@ pub(crate) fn crossings(loops: &Loops<'_>, mut stop: impl FnMut(&Crossing) -> bo
     }
     let (lo, hi) = loops.bounds();
     let cells = (crate::math::sqrt(segs.len() as f64) as usize).clamp(1, 512);
-    let size = (hi - lo).max(DVec2::splat(1e-300)) / cells as f64;
+    let size = (hi - lo).max(DVec2::splat(TINY)) / cells as f64;
     let cell_of = |p: DVec2| {
         let c = ((p - lo) / size).floor();
         (c.x.clamp(0.0, (cells - 1) as f64) as usize, c.y.clamp(0.0, (cells - 1) as f64) as usize)

@@ -1,6 +1,7 @@
 //! Command-line parsing, by hand: the grammar is small and this keeps the
 //! binary free of extra dependencies.
 
+use crate::error::CliError;
 use std::ffi::OsString;
 use std::path::PathBuf;
 
@@ -105,10 +106,10 @@ Exit status: 0 success, 1 bad input or failed run, 2 usage error.
 ///
 /// # Errors
 /// A one-line message for a usage error.
-pub fn parse(args: Vec<OsString>) -> Result<Command, String> {
+pub fn parse(args: Vec<OsString>) -> Result<Command, CliError> {
     let mut args = args.into_iter();
     let Some(first) = args.next() else {
-        return Err("no command given; try 'surfmesh --help'".into());
+        return Err(CliError::usage("no command given; try 'surfmesh --help'"));
     };
     match first.to_str() {
         Some("-h" | "--help" | "help") => Ok(Command::Help),
@@ -119,11 +120,11 @@ pub fn parse(args: Vec<OsString>) -> Result<Command, String> {
         Some("fit") => crate::fit::parse(args).map(Command::Fit),
         Some("reparam") => crate::reparam::parse(args).map(Command::Reparam),
         Some("check") => crate::check::parse(args).map(Command::Check),
-        _ => Err(format!("unknown command '{}'; try 'surfmesh --help'", first.to_string_lossy())),
+        _ => Err(CliError::usage(format!("unknown command '{}'; try 'surfmesh --help'", first.to_string_lossy()))),
     }
 }
 
-fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, String> {
+fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, CliError> {
     let mut input: Option<PathBuf> = None;
     let mut format = None;
     let mut options = MeshOptions::default();
@@ -136,7 +137,7 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
     while let Some(arg) = args.next() {
         let Some(text) = arg.to_str().filter(|t| t.starts_with('-') && t.len() > 1) else {
             if input.replace(PathBuf::from(&arg)).is_some() {
-                return Err(format!("more than one input file ('{}')", arg.to_string_lossy()));
+                return Err(CliError::usage(format!("more than one input file ('{}')", arg.to_string_lossy())));
             }
             continue;
         };
@@ -146,7 +147,8 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
             _ => (text, None),
         };
         let name = name.to_owned();
-        let mut value = || inline.clone().or_else(|| args.next()).ok_or_else(|| format!("{name} needs a value"));
+        let mut value =
+            || inline.clone().or_else(|| args.next()).ok_or_else(|| CliError::usage(format!("{name} needs a value")));
         match name.as_str() {
             "-h" | "--help" => return Ok(Command::Help),
             "--tol" => tol = Some(number(&name, value()?)?),
@@ -164,7 +166,9 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
             "--reparam" => options = options.with_reparam(word::<Reparam>(value()?)?),
             "--format" => {
                 let v = value()?;
-                format = Some(Format::from_name(&v.to_string_lossy()).map_err(|e| format!("--format: {e}"))?);
+                format = Some(
+                    Format::from_name(&v.to_string_lossy()).map_err(|e| CliError::usage(format!("--format: {e}")))?,
+                );
             }
             "-o" | "--output" => {
                 let path = PathBuf::from(value()?);
@@ -173,46 +177,47 @@ fn parse_mesh(mut args: impl Iterator<Item = OsString>) -> Result<Command, Strin
             }
             "--report" => report = Some(PathBuf::from(value()?)),
             "--units" => {
-                units = Units::from_name(&value()?.to_string_lossy()).map_err(|e| e.to_string())?;
+                units = Units::from_name(&value()?.to_string_lossy())?;
             }
-            _ => return Err(format!("unknown option '{text}'; try 'surfmesh --help'")),
+            _ => return Err(CliError::usage(format!("unknown option '{text}'; try 'surfmesh --help'"))),
         }
     }
-    let input = input.ok_or("mesh needs an INPUT file; try 'surfmesh --help'")?;
+    let input = input.ok_or_else(|| CliError::usage("mesh needs an INPUT file; try 'surfmesh --help'"))?;
     options = match (tol, tol_rel) {
-        (Some(_), Some(_)) => return Err("give --tol or --tol-rel, not both".into()),
+        (Some(_), Some(_)) => return Err(CliError::usage("give --tol or --tol-rel, not both")),
         (Some(t), None) => options.with_tolerance(t),
         (None, Some(r)) => options.with_relative_tolerance(r),
         (None, None) => options,
     };
     quality = match (size, size_rel) {
-        (Some(_), Some(_)) => return Err("give --size or --size-rel, not both".into()),
+        (Some(_), Some(_)) => return Err(CliError::usage("give --size or --size-rel, not both")),
         (Some(h), None) => quality.with_size(h),
         (None, Some(r)) => quality.with_relative_size(r),
         (None, None) => quality,
     };
     if options.mode != MeshMode::Quality && quality != options.quality {
-        return Err("--size, --size-rel, --method, --weights and --passes need --mode quality".into());
+        return Err(CliError::usage("--size, --size-rel, --method, --weights and --passes need --mode quality"));
     }
     options = options.with_quality(quality);
-    options.validate().map_err(|e| e.to_string())?;
+    options.validate()?;
     if let (Some((out, _)), Some(rep)) = (&output, &report) {
         if out == rep {
-            return Err("-o and --report name the same file".into());
+            return Err(CliError::usage("-o and --report name the same file"));
         }
     }
     Ok(Command::Mesh(MeshArgs { input, format, options, units, output, report }))
 }
 
 /// A count given to option `name`.
-fn count(name: &str, value: OsString) -> Result<usize, String> {
+fn count(name: &str, value: OsString) -> Result<usize, CliError> {
     let n = value.to_str().and_then(|s| s.parse().ok());
-    n.ok_or_else(|| format!("{name}: '{}' is not a count", value.to_string_lossy()))
+    n.ok_or_else(|| CliError::usage(format!("{name}: '{}' is not a count", value.to_string_lossy())))
 }
 
 /// The four weights c1..c4 given to option `name`, separated by commas.
-fn weights(name: &str, value: OsString) -> Result<[f64; 4], String> {
-    let bad = || format!("{name}: '{}' is not four numbers separated by commas", value.to_string_lossy());
+fn weights(name: &str, value: OsString) -> Result<[f64; 4], CliError> {
+    let bad =
+        || CliError::usage(format!("{name}: '{}' is not four numbers separated by commas", value.to_string_lossy()));
     let c: Vec<f64> = value
         .to_str()
         .unwrap_or("")
@@ -225,18 +230,18 @@ fn weights(name: &str, value: OsString) -> Result<[f64; 4], String> {
 
 /// An option's value parsed by its enum's `FromStr` (the JS binding's
 /// parser too); the error names the option as the CLI spells it.
-pub fn word<T: std::str::FromStr<Err = surfmesh::UnknownWord>>(value: OsString) -> Result<T, String> {
-    value.to_str().unwrap_or("").parse::<T>().map_err(|e| format!("--{e}"))
+pub fn word<T: std::str::FromStr<Err = surfmesh::UnknownWord>>(value: OsString) -> Result<T, CliError> {
+    value.to_str().unwrap_or("").parse::<T>().map_err(|e| CliError::usage(format!("--{e}")))
 }
 
-fn number(name: &str, value: OsString) -> Result<f64, String> {
+fn number(name: &str, value: OsString) -> Result<f64, CliError> {
     value
         .to_str()
         .and_then(|s| s.parse::<f64>().ok())
-        .ok_or_else(|| format!("{name}: '{}' is not a number", value.to_string_lossy()))
+        .ok_or_else(|| CliError::usage(format!("{name}: '{}' is not a number", value.to_string_lossy())))
 }
 
-pub fn output_format(path: &std::path::Path) -> Result<OutputFormat, String> {
+pub fn output_format(path: &std::path::Path) -> Result<OutputFormat, CliError> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     match ext.as_str() {
         "stl" => Ok(OutputFormat::Stl),
@@ -244,6 +249,9 @@ pub fn output_format(path: &std::path::Path) -> Result<OutputFormat, String> {
         "glb" => Ok(OutputFormat::Glb),
         "msh" => Ok(OutputFormat::Msh),
         "unv" => Ok(OutputFormat::Unv),
-        _ => Err(format!("-o {}: the file name must end in .stl, .obj, .glb, .msh or .unv", path.display())),
+        _ => Err(CliError::usage(format!(
+            "-o {}: the file name must end in .stl, .obj, .glb, .msh or .unv",
+            path.display()
+        ))),
     }
 }

@@ -9,6 +9,7 @@
 //! (the core has no clock to stop it) is killed at its time limit, and one
 //! that crashes costs its own row only.
 
+use crate::error::{CliError, IoAction};
 use std::ffi::OsString;
 use std::fs;
 use std::io::Read as _;
@@ -62,7 +63,7 @@ Sweeping a folder:
 ///
 /// # Errors
 /// A one-line message for a usage error.
-pub fn parse(mut args: impl Iterator<Item = OsString>) -> Result<CheckArgs, String> {
+pub fn parse(mut args: impl Iterator<Item = OsString>) -> Result<CheckArgs, CliError> {
     let mut dir: Option<PathBuf> = None;
     let (mut tol, mut tol_rel) = (None, None);
     let mut units = Units::File;
@@ -74,7 +75,7 @@ pub fn parse(mut args: impl Iterator<Item = OsString>) -> Result<CheckArgs, Stri
     while let Some(arg) = args.next() {
         let Some(text) = arg.to_str().filter(|t| t.starts_with('-') && t.len() > 1) else {
             if dir.replace(PathBuf::from(&arg)).is_some() {
-                return Err(format!("more than one folder ('{}')", arg.to_string_lossy()));
+                return Err(CliError::usage(format!("more than one folder ('{}')", arg.to_string_lossy())));
             }
             continue;
         };
@@ -83,7 +84,8 @@ pub fn parse(mut args: impl Iterator<Item = OsString>) -> Result<CheckArgs, Stri
             _ => (text, None),
         };
         let name = name.to_owned();
-        let mut value = || inline.clone().or_else(|| args.next()).ok_or_else(|| format!("{name} needs a value"));
+        let mut value =
+            || inline.clone().or_else(|| args.next()).ok_or_else(|| CliError::usage(format!("{name} needs a value")));
         match name.as_str() {
             "--tol" | "--tol-rel" | "--units" => {
                 let v = value()?;
@@ -91,50 +93,53 @@ pub fn parse(mut args: impl Iterator<Item = OsString>) -> Result<CheckArgs, Stri
                 match name.as_str() {
                     "--tol" => tol = Some(number(&name, v)?),
                     "--tol-rel" => tol_rel = Some(number(&name, v)?),
-                    _ => units = Units::from_name(&v.to_string_lossy()).map_err(|e| e.to_string())?,
+                    _ => units = Units::from_name(&v.to_string_lossy())?,
                 }
             }
             "--row" => {
                 let file = PathBuf::from(value()?);
-                let shown = args.next().ok_or("--row needs a file and its name")?;
+                let shown = args.next().ok_or_else(|| CliError::usage("--row needs a file and its name"))?;
                 row = Some((file, shown.to_string_lossy().into_owned()));
             }
             "--json" => json = Some(PathBuf::from(value()?)),
             "--timeout" => {
                 timeout = number(&name, value()?)?;
                 if !(timeout > 0.0 && timeout.is_finite()) {
-                    return Err("--timeout must be a number of seconds > 0".into());
+                    return Err(CliError::usage("--timeout must be a number of seconds > 0"));
                 }
             }
             "--jobs" => {
                 let v = value()?;
                 let n = v.to_str().and_then(|s| s.parse::<usize>().ok()).filter(|&n| n > 0);
-                jobs = Some(n.ok_or_else(|| format!("{name}: '{}' is not a count > 0", v.to_string_lossy()))?);
+                jobs =
+                    Some(n.ok_or_else(|| {
+                        CliError::usage(format!("{name}: '{}' is not a count > 0", v.to_string_lossy()))
+                    })?);
             }
-            _ => return Err(format!("unknown option '{text}' of check; try 'surfmesh --help'")),
+            _ => return Err(CliError::usage(format!("unknown option '{text}' of check; try 'surfmesh --help'"))),
         }
     }
     let dir = match (&row, dir) {
         (Some(_), None) => PathBuf::new(),
         (None, Some(d)) => d,
-        (Some(_), Some(_)) => return Err("--row takes one file, not a folder".into()),
-        (None, None) => return Err("check needs a folder; try 'surfmesh --help'".into()),
+        (Some(_), Some(_)) => return Err(CliError::usage("--row takes one file, not a folder")),
+        (None, None) => return Err(CliError::usage("check needs a folder; try 'surfmesh --help'")),
     };
     let options = match (tol, tol_rel) {
-        (Some(_), Some(_)) => return Err("give --tol or --tol-rel, not both".into()),
+        (Some(_), Some(_)) => return Err(CliError::usage("give --tol or --tol-rel, not both")),
         (Some(t), None) => MeshOptions::default().with_tolerance(t),
         (None, Some(r)) => MeshOptions::default().with_relative_tolerance(r),
         (None, None) => MeshOptions::default(),
     };
-    options.validate().map_err(|e| e.to_string())?;
+    options.validate()?;
     Ok(CheckArgs { dir, options, units, json, timeout, jobs, row, forward })
 }
 
-fn number(name: &str, value: OsString) -> Result<f64, String> {
+fn number(name: &str, value: OsString) -> Result<f64, CliError> {
     value
         .to_str()
         .and_then(|s| s.parse::<f64>().ok())
-        .ok_or_else(|| format!("{name}: '{}' is not a number", value.to_string_lossy()))
+        .ok_or_else(|| CliError::usage(format!("{name}: '{}' is not a number", value.to_string_lossy())))
 }
 
 /// One file's outcome; the field names are what `--json` writes, kept
@@ -201,16 +206,16 @@ struct Sweep<'a> {
 ///
 /// # Errors
 /// A folder that cannot be read, or a JSON file that cannot be written.
-pub fn run(a: &CheckArgs) -> Result<bool, String> {
+pub fn run(a: &CheckArgs) -> Result<bool, CliError> {
     if let Some((path, name)) = &a.row {
         // The child: this file's row on stdout.
         let format = file_format(path).unwrap_or(Format::Json);
         let row = check_file(a, path, name, format);
-        println!("{}", serde_json::to_string(&row).map_err(|e| format!("row to JSON: {e}"))?);
+        println!("{}", serde_json::to_string(&row).map_err(|e| CliError::run("row to JSON", e))?);
         return Ok(true);
     }
     let files = model_files(&a.dir)?;
-    let exe = std::env::current_exe().map_err(|e| format!("cannot find the surfmesh executable: {e}"))?;
+    let exe = std::env::current_exe().map_err(|e| CliError::run("cannot find the surfmesh executable", e))?;
     let start = Instant::now();
     let mut rows = rows_of(a, &exe, &files)?;
     rows.sort_by(|x, y| x.file.cmp(&y.file));
@@ -223,39 +228,40 @@ pub fn run(a: &CheckArgs) -> Result<bool, String> {
         };
         let units = a.units.name().unwrap_or("file");
         let sweep = Sweep { dir: a.dir.display().to_string(), tolerance, units, files: &rows };
-        let text = serde_json::to_string_pretty(&sweep).map_err(|e| format!("rows to JSON: {e}"))?;
-        fs::write(out, format!("{text}\n")).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        let text = serde_json::to_string_pretty(&sweep).map_err(|e| CliError::run("rows to JSON", e))?;
+        fs::write(out, format!("{text}\n")).map_err(|e| CliError::write(out, e))?;
     }
     Ok(rows.iter().all(|r| r.ok))
 }
 
 /// Each file's row, `--jobs` files at once (one per core by default).
 #[cfg(not(target_arch = "wasm32"))]
-fn rows_of(a: &CheckArgs, exe: &Path, files: &[(PathBuf, String, Format)]) -> Result<Vec<Row>, String> {
+fn rows_of(a: &CheckArgs, exe: &Path, files: &[(PathBuf, String, Format)]) -> Result<Vec<Row>, CliError> {
     use rayon::prelude::*;
     let mut b = rayon::ThreadPoolBuilder::new();
     if let Some(n) = a.jobs {
         b = b.num_threads(n);
     }
-    let pool = b.build().map_err(|e| format!("cannot start the workers: {e}"))?;
+    let pool = b.build().map_err(|e| CliError::run("cannot start the workers", e))?;
     Ok(pool.install(|| files.par_iter().map(|(path, name, format)| in_child(a, exe, path, name, *format)).collect()))
 }
 
 /// One file at a time: a wasm32 build of the command line (compiled only
 /// because the wasm tests' harness builds the package's binaries) has no rayon.
 #[cfg(target_arch = "wasm32")]
-fn rows_of(a: &CheckArgs, exe: &Path, files: &[(PathBuf, String, Format)]) -> Result<Vec<Row>, String> {
+fn rows_of(a: &CheckArgs, exe: &Path, files: &[(PathBuf, String, Format)]) -> Result<Vec<Row>, CliError> {
     Ok(files.iter().map(|(path, name, format)| in_child(a, exe, path, name, *format)).collect())
 }
 
 /// The model files under `dir` (hidden files and folders left out), each
 /// with its name relative to `dir` and its format: a model extension, else
 /// what its first bytes say (so notes such as SOURCES.md stay out).
-fn model_files(dir: &Path) -> Result<Vec<(PathBuf, String, Format)>, String> {
+fn model_files(dir: &Path) -> Result<Vec<(PathBuf, String, Format)>, CliError> {
     let mut out = Vec::new();
     let mut stack = vec![(dir.to_path_buf(), String::new())];
     while let Some((d, prefix)) = stack.pop() {
-        let entries = fs::read_dir(&d).map_err(|e| format!("cannot read the folder {}: {e}", d.display()))?;
+        let entries =
+            fs::read_dir(&d).map_err(|source| CliError::Io { action: IoAction::ReadFolder(d.clone()), source })?;
         for entry in entries.flatten() {
             let name = entry.file_name().to_string_lossy().into_owned();
             if name.starts_with('.') {

@@ -1,12 +1,13 @@
 //! `surfmesh fit`: a G¹ surface through the points of an xyz, csv or ply
 //! file (paper 004), written as a mesh and, on request, its patches as JSON.
 
+use crate::error::CliError;
 use std::ffi::OsString;
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use surfmesh::{fit_points, read_points, write_glb, write_obj, write_stl, Error, FitOptions, PointFormat};
+use surfmesh::{fit_points, read_points, write_glb, write_obj, write_stl, FitOptions, PointFormat};
 
 use crate::args::{output_format, OutputFormat};
 
@@ -43,7 +44,7 @@ Surfaces through scattered points (paper 004):
 ///
 /// # Errors
 /// A one-line message for a usage error.
-pub fn parse(mut args: impl Iterator<Item = OsString>) -> Result<FitArgs, String> {
+pub fn parse(mut args: impl Iterator<Item = OsString>) -> Result<FitArgs, CliError> {
     let mut input: Option<PathBuf> = None;
     let mut format = None;
     let mut options = FitOptions::default();
@@ -52,7 +53,7 @@ pub fn parse(mut args: impl Iterator<Item = OsString>) -> Result<FitArgs, String
     while let Some(arg) = args.next() {
         let Some(text) = arg.to_str().filter(|t| t.starts_with('-') && t.len() > 1) else {
             if input.replace(PathBuf::from(&arg)).is_some() {
-                return Err(format!("more than one input file ('{}')", arg.to_string_lossy()));
+                return Err(CliError::usage(format!("more than one input file ('{}')", arg.to_string_lossy())));
             }
             continue;
         };
@@ -61,7 +62,8 @@ pub fn parse(mut args: impl Iterator<Item = OsString>) -> Result<FitArgs, String
             _ => (text, None),
         };
         let name = name.to_owned();
-        let mut value = || inline.clone().or_else(|| args.next()).ok_or_else(|| format!("{name} needs a value"));
+        let mut value =
+            || inline.clone().or_else(|| args.next()).ok_or_else(|| CliError::usage(format!("{name} needs a value")));
         match name.as_str() {
             "--tol" => tol = Some(number(&name, value()?)?),
             "--tol-rel" => tol_rel = Some(number(&name, value()?)?),
@@ -69,12 +71,15 @@ pub fn parse(mut args: impl Iterator<Item = OsString>) -> Result<FitArgs, String
                 let v = value()?;
                 let n = v.to_str().and_then(|s| s.parse().ok());
                 options = options.with_max_polygon_sides(
-                    n.ok_or_else(|| format!("{name}: '{}' is not a count", v.to_string_lossy()))?,
+                    n.ok_or_else(|| CliError::usage(format!("{name}: '{}' is not a count", v.to_string_lossy())))?,
                 );
             }
             "--format" => {
                 let v = value()?;
-                format = Some(PointFormat::from_name(&v.to_string_lossy()).map_err(|e| format!("--format: {e}"))?);
+                format = Some(
+                    PointFormat::from_name(&v.to_string_lossy())
+                        .map_err(|e| CliError::usage(format!("--format: {e}")))?,
+                );
             }
             "-o" | "--output" => {
                 let path = PathBuf::from(value()?);
@@ -83,45 +88,44 @@ pub fn parse(mut args: impl Iterator<Item = OsString>) -> Result<FitArgs, String
             }
             "--patches" => patches = Some(PathBuf::from(value()?)),
             "--report" => report = Some(PathBuf::from(value()?)),
-            _ => return Err(format!("unknown option '{text}' for fit; try 'surfmesh --help'")),
+            _ => return Err(CliError::usage(format!("unknown option '{text}' for fit; try 'surfmesh --help'"))),
         }
     }
-    let input = input.ok_or("fit needs a POINTS file; try 'surfmesh --help'")?;
+    let input = input.ok_or_else(|| CliError::usage("fit needs a POINTS file; try 'surfmesh --help'"))?;
     options = match (tol, tol_rel) {
-        (Some(_), Some(_)) => return Err("give --tol or --tol-rel, not both".into()),
+        (Some(_), Some(_)) => return Err(CliError::usage("give --tol or --tol-rel, not both")),
         (Some(t), None) => options.with_tolerance(t),
         (None, Some(r)) => options.with_relative_tolerance(r),
         (None, None) => options,
     };
-    options.validate().map_err(|e| e.to_string())?;
+    options.validate()?;
     let names: Vec<&PathBuf> = output.iter().map(|(p, _)| p).chain(patches.iter()).chain(report.iter()).collect();
     if names.iter().enumerate().any(|(i, a)| names[..i].contains(a)) {
-        return Err("-o, --patches and --report must name different files".into());
+        return Err(CliError::usage("-o, --patches and --report must name different files"));
     }
     Ok(FitArgs { input, format, options, output, patches, report })
 }
 
-fn number(name: &str, value: OsString) -> Result<f64, String> {
+fn number(name: &str, value: OsString) -> Result<f64, CliError> {
     value
         .to_str()
         .and_then(|s| s.parse::<f64>().ok())
-        .ok_or_else(|| format!("{name}: '{}' is not a number", value.to_string_lossy()))
+        .ok_or_else(|| CliError::usage(format!("{name}: '{}' is not a number", value.to_string_lossy())))
 }
 
 /// Runs the fit; the error is the message printed after the input file's name.
-pub fn run(a: &FitArgs) -> Result<(), String> {
-    let bytes = fs::read(&a.input).map_err(|e| format!("cannot read: {e}"))?;
+pub fn run(a: &FitArgs) -> Result<(), CliError> {
+    let bytes = fs::read(&a.input).map_err(CliError::read)?;
     let format = match a.format {
         Some(f) => f,
         None => input_format(&a.input, &bytes),
     };
-    let points = read_points(&bytes, format).map_err(|e| e.to_string())?;
+    let points = read_points(&bytes, format)?;
     let start = Instant::now();
-    let mut result = fit_points(&points, &a.options).map_err(|e| e.to_string())?;
+    let mut result = fit_points(&points, &a.options)?;
     result.report.time_ms = start.elapsed().as_secs_f64() * 1e3;
 
-    let report_json = serde_json::to_string_pretty(&result.report)
-        .map_err(|e| Error::Internal(format!("report: {e}")).to_string())?;
+    let report_json = serde_json::to_string_pretty(&result.report).map_err(CliError::report)?;
     let mut files: Vec<(&Path, Vec<u8>)> = Vec::new();
     if let Some((path, kind)) = &a.output {
         let bytes = match kind {

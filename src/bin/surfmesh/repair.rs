@@ -1,6 +1,7 @@
 //! `surfmesh offset` and `surfmesh repair` (paper 002): arguments and runs.
 //! Thin: the library does the geometry.
 
+use crate::error::CliError;
 use std::ffi::OsString;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -43,15 +44,15 @@ pub struct RepairArgs {
 /// Splits `--name=value` / `--name value` arguments; positional ones go to `input`.
 fn options(
     args: impl Iterator<Item = OsString>,
-    mut each: impl FnMut(&str, &mut dyn FnMut() -> Result<OsString, String>) -> Result<(), String>,
-) -> Result<Option<PathBuf>, String> {
+    mut each: impl FnMut(&str, &mut dyn FnMut() -> Result<OsString, CliError>) -> Result<(), CliError>,
+) -> Result<Option<PathBuf>, CliError> {
     let mut args = args.peekable();
     let mut input: Option<PathBuf> = None;
     while let Some(arg) = args.next() {
         // A negative number is a value, not an option.
         let Some(text) = arg.to_str().filter(|t| t.starts_with('-') && t.len() > 1 && t.parse::<f64>().is_err()) else {
             if input.replace(PathBuf::from(&arg)).is_some() {
-                return Err(format!("more than one input file ('{}')", arg.to_string_lossy()));
+                return Err(CliError::usage(format!("more than one input file ('{}')", arg.to_string_lossy())));
             }
             continue;
         };
@@ -59,21 +60,22 @@ fn options(
             Some((n, v)) if n.starts_with("--") => (n.to_owned(), Some(OsString::from(v))),
             _ => (text.to_owned(), None),
         };
-        let mut value = || inline.clone().or_else(|| args.next()).ok_or_else(|| format!("{name} needs a value"));
+        let mut value =
+            || inline.clone().or_else(|| args.next()).ok_or_else(|| CliError::usage(format!("{name} needs a value")));
         each(&name, &mut value)?;
     }
     Ok(input)
 }
 
-fn number(name: &str, value: OsString) -> Result<f64, String> {
+fn number(name: &str, value: OsString) -> Result<f64, CliError> {
     value
         .to_str()
         .and_then(|s| s.parse::<f64>().ok())
         .filter(|x| x.is_finite())
-        .ok_or_else(|| format!("{name}: '{}' is not a number", value.to_string_lossy()))
+        .ok_or_else(|| CliError::usage(format!("{name}: '{}' is not a number", value.to_string_lossy())))
 }
 
-pub fn parse_offset(args: impl Iterator<Item = OsString>) -> Result<OffsetArgs, String> {
+pub fn parse_offset(args: impl Iterator<Item = OsString>) -> Result<OffsetArgs, CliError> {
     let (mut distance, mut output) = (None, None);
     let input = options(args, |name, value| {
         match name {
@@ -82,17 +84,17 @@ pub fn parse_offset(args: impl Iterator<Item = OsString>) -> Result<OffsetArgs, 
                 let path = PathBuf::from(value()?);
                 output = Some((path.clone(), output_format(&path)?));
             }
-            _ => return Err(format!("unknown option '{name}' for offset; try 'surfmesh --help'")),
+            _ => return Err(CliError::usage(format!("unknown option '{name}' for offset; try 'surfmesh --help'"))),
         }
         Ok(())
     })?;
-    let input = input.ok_or("offset needs an INPUT file; try 'surfmesh --help'")?;
-    let distance = distance.ok_or("offset needs -d DIST")?;
-    let output = output.ok_or("offset needs -o OUT")?;
+    let input = input.ok_or_else(|| CliError::usage("offset needs an INPUT file; try 'surfmesh --help'"))?;
+    let distance = distance.ok_or_else(|| CliError::usage("offset needs -d DIST"))?;
+    let output = output.ok_or_else(|| CliError::usage("offset needs -o OUT"))?;
     Ok(OffsetArgs { input, distance, output })
 }
 
-pub fn parse_repair(args: impl Iterator<Item = OsString>) -> Result<RepairArgs, String> {
+pub fn parse_repair(args: impl Iterator<Item = OsString>) -> Result<RepairArgs, CliError> {
     let mut opts = RepairOptions::default();
     let (mut output, mut report) = (None, None);
     let input = options(args, |name, value| {
@@ -107,43 +109,44 @@ pub fn parse_repair(args: impl Iterator<Item = OsString>) -> Result<RepairArgs, 
                 let v = value()?;
                 let n = v.to_str().and_then(|s| s.parse().ok());
                 opts = opts.clone().with_bucket_capacity(
-                    n.ok_or_else(|| format!("{name}: '{}' is not a count", v.to_string_lossy()))?,
+                    n.ok_or_else(|| CliError::usage(format!("{name}: '{}' is not a count", v.to_string_lossy())))?,
                 );
             }
             "--weld" => opts = opts.clone().with_weld_tolerance(number(name, value()?)?),
             "--perturbation" => opts.perturbation = number(name, value()?)?,
             "--verify" => opts = opts.clone().with_verify(true),
-            _ => return Err(format!("unknown option '{name}' for repair; try 'surfmesh --help'")),
+            _ => return Err(CliError::usage(format!("unknown option '{name}' for repair; try 'surfmesh --help'"))),
         }
         Ok(())
     })?;
-    let input = input.ok_or("repair needs an INPUT file; try 'surfmesh --help'")?;
-    opts.validate().map_err(|e| e.to_string())?;
+    let input = input.ok_or_else(|| CliError::usage("repair needs an INPUT file; try 'surfmesh --help'"))?;
+    opts.validate()?;
     if let (Some((out, _)), Some(rep)) = (&output, &report) {
         if out == rep {
-            return Err("-o and --report name the same file".into());
+            return Err(CliError::usage("-o and --report name the same file"));
         }
     }
     Ok(RepairArgs { input, options: opts, output, report })
 }
 
 /// Reads a mesh file, or meshes a model file with default options and welds it.
-fn read_input(path: &Path, bytes: &[u8], models: bool) -> Result<Mesh, String> {
+fn read_input(path: &Path, bytes: &[u8], models: bool) -> Result<Mesh, CliError> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     if let Ok(f) = MeshFormat::from_name(ext) {
-        return read_mesh(bytes, f).map_err(|e| e.to_string());
+        return read_mesh(bytes, f).map_err(CliError::from);
     }
     if models {
         if let Some(f) = Format::from_name(ext).ok().or_else(|| Format::detect(bytes)) {
-            let model = read_model(bytes, f).map_err(|e| e.to_string())?;
-            let r = mesh_model(&model, &MeshOptions::default()).map_err(|e| e.to_string())?;
+            let model = read_model(bytes, f)?;
+            let r = mesh_model(&model, &MeshOptions::default())?;
             let diag = surfmesh::Aabb::from_points(r.mesh.positions.iter().copied()).diagonal();
             return Ok(weld_mesh(&r.mesh, 1e-9 * diag));
         }
     }
-    let f = MeshFormat::detect(bytes)
-        .ok_or_else(|| Error::Format("cannot tell the mesh format; name the file .stl or .obj".into()).to_string())?;
-    read_mesh(bytes, f).map_err(|e| e.to_string())
+    let f = MeshFormat::detect(bytes).ok_or_else(|| {
+        CliError::Core(Error::Format("cannot tell the mesh format; name the file .stl or .obj".into()))
+    })?;
+    read_mesh(bytes, f).map_err(CliError::from)
 }
 
 fn encode(mesh: &Mesh, kind: OutputFormat) -> Vec<u8> {
@@ -156,11 +159,11 @@ fn encode(mesh: &Mesh, kind: OutputFormat) -> Vec<u8> {
     }
 }
 
-pub fn run_offset(a: &OffsetArgs) -> Result<(), String> {
-    let bytes = fs::read(&a.input).map_err(|e| format!("cannot read: {e}"))?;
+pub fn run_offset(a: &OffsetArgs) -> Result<(), CliError> {
+    let bytes = fs::read(&a.input).map_err(CliError::read)?;
     let mesh = read_input(&a.input, &bytes, true)?;
     let start = Instant::now();
-    let out = offset_mesh(&mesh, a.distance).map_err(|e| e.to_string())?;
+    let out = offset_mesh(&mesh, a.distance)?;
     let ms = super::millis(start);
     super::write_all_or_nothing(&[(a.output.0.as_path(), encode(&out, a.output.1))])?;
     eprintln!(
@@ -173,20 +176,19 @@ pub fn run_offset(a: &OffsetArgs) -> Result<(), String> {
     Ok(())
 }
 
-pub fn run_repair(a: &RepairArgs) -> Result<(), String> {
-    let bytes = fs::read(&a.input).map_err(|e| format!("cannot read: {e}"))?;
+pub fn run_repair(a: &RepairArgs) -> Result<(), CliError> {
+    let bytes = fs::read(&a.input).map_err(CliError::read)?;
     let start = Instant::now();
     let mesh = read_input(&a.input, &bytes, false)?;
     let parse_ms = super::millis(start);
     let t0 = Instant::now();
     let mut clock = || super::millis(t0);
-    let result = repair_mesh_timed(&mesh, &a.options, &mut clock).map_err(|e| e.to_string())?;
-    let mut json =
-        serde_json::to_value(&result.report).map_err(|e| Error::Internal(format!("report: {e}")).to_string())?;
+    let result = repair_mesh_timed(&mesh, &a.options, &mut clock)?;
+    let mut json = serde_json::to_value(&result.report).map_err(CliError::report)?;
     if let Some(o) = json.as_object_mut() {
         o.insert("parse_ms".into(), parse_ms.into());
     }
-    let text = serde_json::to_string_pretty(&json).map_err(|e| Error::Internal(format!("report: {e}")).to_string())?;
+    let text = serde_json::to_string_pretty(&json).map_err(CliError::report)?;
     let mut files: Vec<(&Path, Vec<u8>)> = Vec::new();
     if let Some((path, kind)) = &a.output {
         files.push((path, encode(&result.mesh, *kind)));

@@ -9,6 +9,7 @@ use glam::{DAffine3, DVec2, DVec3};
 use super::directory::Entity;
 use super::xform::own_transform;
 use super::{Ctx, MAX_CONTROL_POINTS, MAX_DEPTH};
+use crate::numeric::TINY;
 use crate::nurbs::analytic::{circle_arc, conic_segment, ellipse_arc, line};
 use crate::nurbs::reparam::{map_points, segment};
 use crate::nurbs::{NurbsCurve, MAX_DEGREE};
@@ -120,7 +121,7 @@ fn conic(e: &Entity) -> Result<Vec<NurbsCurve>, Error> {
     let p2 = DVec2::new(e.real(10)?, e.real(11)?);
     let wrap = |r: Result<NurbsCurve, crate::NurbsError>| r.map_err(|err| e.error(alloc::format!("{err}")));
     let disc = b * b - 4.0 * a * c;
-    let scale = a.abs().max(b.abs()).max(c.abs()).max(1e-300);
+    let scale = a.abs().max(b.abs()).max(c.abs()).max(TINY);
     if disc < -1e-12 * scale * scale {
         // Ellipse: centre, axes from the quadratic form's eigenvectors.
         let det = 4.0 * a * c - b * b;
@@ -173,7 +174,7 @@ fn conic(e: &Entity) -> Result<Vec<NurbsCurve>, Error> {
     let (q0, qh, q1) = (q(m), q(m + dir * 0.5), q(m + dir));
     let qa = 2.0 * (q1 - 2.0 * qh + q0);
     let qb = q1 - q0 - qa;
-    let roots = if qa.abs() > 1e-300 {
+    let roots = if qa.abs() > TINY {
         let disc = qb * qb - 4.0 * qa * q0;
         if disc < 0.0 {
             Vec::new()
@@ -181,7 +182,7 @@ fn conic(e: &Entity) -> Result<Vec<NurbsCurve>, Error> {
             let r = libm::sqrt(disc);
             alloc::vec![(-qb - r) / (2.0 * qa), (-qb + r) / (2.0 * qa)]
         }
-    } else if qb.abs() > 1e-300 {
+    } else if qb.abs() > TINY {
         alloc::vec![-q0 / qb]
     } else {
         Vec::new()
@@ -313,7 +314,7 @@ fn bspline(ctx: &Ctx<'_>, e: &Entity) -> Result<NurbsCurve, Error> {
     let weights: Vec<f64> = (0..n).map(|i| e.real_or(wbase + i, 1.0)).collect::<Result<_, _>>()?;
     let pbase = wbase + n;
     let pts: Vec<DVec3> = (0..n).map(|i| e.vec3(pbase + 3 * i)).collect::<Result<_, _>>()?;
-    let all_equal = weights.iter().all(|&w| (w - weights[0]).abs() <= 1e-14 * w.abs().max(1e-300));
+    let all_equal = weights.iter().all(|&w| (w - weights[0]).abs() <= 1e-14 * w.abs().max(TINY));
     let w = (!polynomial && !all_equal).then_some(weights);
     let c = NurbsCurve::try_new(m, knots, pts, w).map_err(|err| e.error(alloc::format!("{err}")))?;
     let (a, b) = c.domain();

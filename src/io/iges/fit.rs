@@ -11,6 +11,7 @@ use glam::{DVec2, DVec3};
 
 use super::surfaces::{AxisMap, SurfDef};
 use crate::model::FaceSurface;
+use crate::numeric::TINY;
 use crate::nurbs::reparam::{map_points, segment};
 use crate::nurbs::{NurbsCurve, Surface};
 
@@ -252,7 +253,7 @@ impl Track {
             for i in 0..self.ts.len().saturating_sub(1) {
                 let (t0, t1) = (self.ts[i], self.ts[i + 1]);
                 let h = t1 - t0;
-                if h.is_nan() || h <= 1e-14 * (t0.abs() + t1.abs()).max(1e-300) {
+                if h.is_nan() || h <= 1e-14 * (t0.abs() + t1.abs()).max(TINY) {
                     continue;
                 }
                 // Below this chord the samples resolve the file's own noise, not the curve.
@@ -314,7 +315,7 @@ impl Track {
         if !c.control_points().all(|p| inside(p.truncate())) {
             return None;
         }
-        let size = (hi - lo).max_element().max(1e-300);
+        let size = (hi - lo).max_element().max(TINY);
         let through = self.ts.iter().zip(&self.qs).all(|(&t, q)| c.point(t).truncate().distance(*q) <= 1e-7 * size);
         through.then_some(c)
     }

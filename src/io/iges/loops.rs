@@ -12,6 +12,7 @@ use super::surfaces::{AxisMap, SurfDef};
 use super::untangle::untangle;
 use super::wrap::{chain_loop, loop_shape, resolve_windings, windows, Range, TrimError};
 use crate::model::{Face, FaceSurface, TrimLoop};
+use crate::numeric::TINY;
 use crate::nurbs::analytic::line;
 use crate::nurbs::reparam::{map_points, reversed, segment, with_end_points};
 use crate::nurbs::{Aabb, NurbsCurve, Surface};
@@ -413,7 +414,7 @@ fn sample_loop(
     for c in &pieces {
         bb.union(&c.bbox());
     }
-    let tiny = 1e-9 * bb.diagonal().max(1e-300);
+    let tiny = 1e-9 * bb.diagonal().max(TINY);
     let mut out: Vec<Track> = Vec::new();
     for c in pieces {
         for part in split_at_corners(&c) {
@@ -488,7 +489,7 @@ pub(super) fn orient_chain(pieces: &mut [NurbsCurve]) {
     for c in pieces.iter() {
         bb.union(&c.bbox());
     }
-    let hair = 1e-9 * bb.diagonal().max(1e-300);
+    let hair = 1e-9 * bb.diagonal().max(TINY);
     // First piece: the orientation whose end meets the second piece best.
     let (s0, e0) = ends(&pieces[0]);
     let (s1, e1) = ends(&pieces[1]);

@@ -20,6 +20,7 @@ use super::wrap::TrimError;
 use super::xform::{own_transform, similarity_scale};
 use super::{Ctx, MAX_CONTROL_POINTS, MAX_DEPTH};
 use crate::model::FaceSurface;
+use crate::numeric::{guarded_div, TINY};
 use crate::nurbs::analytic::{bilinear, circle_arc, extrude, revolve, ruled, ArcParam};
 use crate::nurbs::join::join;
 use crate::nurbs::reparam::{reparametrized, segment};
@@ -258,7 +259,7 @@ impl Revolution {
         let radial = w - self.axis * h;
         let (x, y) = self.frame();
         let r = radial.length();
-        let scale = self.origin.length() + w.length() + 1e-300;
+        let scale = self.origin.length() + w.length() + TINY;
         // A vertex meant to lie on the axis (a sphere's pole, a cone's apex)
         // is written a few digits short of it: within 1e-7 of its distance
         // from the origin its angle is noise, not a direction.
@@ -269,7 +270,7 @@ impl Revolution {
                 // A cone is both its nappes: past the apex the profile's
                 // radius is negative, the point half a turn round.
                 let foot = |q: DVec2| {
-                    let t = (q - *p0).dot(*d) / d.length_squared().max(1e-300);
+                    let t = guarded_div((q - *p0).dot(*d), d.length_squared());
                     (t, q.distance(*p0 + *d * t))
                 };
                 let (t, e) = foot(DVec2::new(r, h));
@@ -288,7 +289,7 @@ impl Revolution {
             Profile::Circle { c, rho, .. } => {
                 let t = libm::atan2(h - c.y, r - c.x);
                 // On the axis: exactly where the circle crosses it (a sphere's pole).
-                let cross = -c.x / rho.max(1e-300);
+                let cross = guarded_div(-c.x, *rho);
                 if on_axis && cross.abs() <= 1.0 {
                     let pole = libm::acos(cross);
                     if t < 0.0 {
@@ -426,7 +427,7 @@ pub(in crate::io) fn nurbs_def(surface: NurbsSurface) -> SurfDef {
 /// Periods of a surface whose opposite edges coincide.
 fn closed_periods(s: &NurbsSurface) -> [Option<f64>; 2] {
     let [lo, hi] = s.domain();
-    let tol = 1e-7 * s.bbox().diagonal().max(1e-300);
+    let tol = 1e-7 * s.bbox().diagonal().max(TINY);
     let mut out = [None, None];
     for axis in 0..2 {
         let other = 1 - axis;
@@ -482,7 +483,7 @@ fn bspline_surface(e: &Entity, m: &DAffine3) -> Result<SurfDef, Error> {
         }
     }
     let w0 = ws[0][0];
-    let all_equal = ws.iter().flatten().all(|&w| (w - w0).abs() <= 1e-14 * w0.abs().max(1e-300));
+    let all_equal = ws.iter().flatten().all(|&w| (w - w0).abs() <= 1e-14 * w0.abs().max(TINY));
     let weights = (!polynomial && !all_equal).then_some(ws.as_slice());
     let s = NurbsSurface::try_new([m1 as usize, m2 as usize], ku, kv, &pts, weights)
         .map_err(|err| e.error(alloc::format!("{err}")))?;
@@ -709,7 +710,7 @@ fn revolution_120(ctx: &Ctx<'_>, e: &Entity, m: DAffine3, depth: usize) -> Resul
         w - axis * w.dot(axis)
     };
     let far = profile.control_points().map(radial).max_by(|a, b| a.length_squared().total_cmp(&b.length_squared()));
-    let size = profile.bbox().diagonal().max(1e-300);
+    let size = profile.bbox().diagonal().max(TINY);
     let xref = far.map(|r| r.normalize_or_zero()).unwrap_or(DVec3::ZERO);
     let planar = xref != DVec3::ZERO
         && profile

@@ -8,6 +8,7 @@
 use alloc::vec::Vec;
 use glam::DVec2;
 
+use crate::numeric::TINY;
 use crate::nurbs::reparam::{segment, with_end_points};
 use crate::nurbs::NurbsCurve;
 
@@ -120,7 +121,7 @@ fn first_crossing(chords: &[Chord]) -> Option<(usize, usize, DVec2, f64, f64)> {
         hi = hi.max(c.a.max(c.b));
     }
     let cells = (libm::sqrt(n as f64) as usize).clamp(1, 256);
-    let size = ((hi - lo) / cells as f64).max(DVec2::splat(1e-300));
+    let size = ((hi - lo) / cells as f64).max(DVec2::splat(TINY));
     let cell = |p: DVec2| {
         let c = ((p - lo) / size).floor();
         (c.x.clamp(0.0, (cells - 1) as f64) as usize, c.y.clamp(0.0, (cells - 1) as f64) as usize)

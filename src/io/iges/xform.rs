@@ -6,6 +6,7 @@ use glam::{DAffine3, DMat3, DVec3};
 
 use super::directory::Directory;
 use super::MAX_DEPTH;
+use crate::numeric::TINY;
 use crate::Error;
 
 /// The affine map of entity `de`'s own transformation chain (identity when it has none).
@@ -40,7 +41,7 @@ pub(super) fn own_transform(dir: &Directory, de: usize) -> Result<DAffine3, Erro
         );
         let t = DVec3::new(r(4)?, r(8)?, r(12)?);
         let det = mat.determinant();
-        if !(det.is_finite() && det.abs() > 1e-300 && t.is_finite()) {
+        if !(det.is_finite() && det.abs() > TINY && t.is_finite()) {
             return Err(m.error("transformation matrix is singular or not finite"));
         }
         // The chain applies this matrix first, then the ones it points to.
@@ -56,7 +57,7 @@ pub(super) fn similarity_scale(a: &DAffine3) -> Option<f64> {
     let m = a.matrix3;
     let (x, y, z) = (m.x_axis, m.y_axis, m.z_axis);
     let s = x.length();
-    let tol = 1e-9 * s.max(1e-300);
+    let tol = 1e-9 * s.max(TINY);
     let ok = (y.length() - s).abs() <= tol
         && (z.length() - s).abs() <= tol
         && x.dot(y).abs() <= tol * s

@@ -9,6 +9,7 @@ use glam::{DAffine3, DMat3, DVec3};
 
 use super::graph::{Ent, Graph};
 use super::{MAX_CONTROL_POINTS, MAX_DEPTH};
+use crate::numeric::{guarded_div, TINY};
 use crate::nurbs::analytic::{ellipse_arc, hyperbola_arc, line, parabola_arc};
 use crate::nurbs::join::join;
 use crate::nurbs::reparam::{reversed, segment, with_end_points, RawCurve};
@@ -248,7 +249,7 @@ impl Geo<'_> {
         if is_bspline_curve(e) {
             let c = self.bspline_curve(e)?;
             let (a, b) = c.domain();
-            let closed = c.point(a).distance(c.point(b)) <= 1e-9 * c.bbox().diagonal().max(1e-300);
+            let closed = c.point(a).distance(c.point(b)) <= 1e-9 * c.bbox().diagonal().max(TINY);
             return basis(Curve3::Nurbs { c, closed });
         }
         if e.has("POLYLINE") {
@@ -290,7 +291,7 @@ impl Geo<'_> {
         if e.has("COMPOSITE_CURVE") {
             let c = self.composite(e, depth)?;
             let (a, b) = c.domain();
-            let closed = c.point(a).distance(c.point(b)) <= 1e-9 * c.bbox().diagonal().max(1e-300);
+            let closed = c.point(a).distance(c.point(b)) <= 1e-9 * c.bbox().diagonal().max(TINY);
             return basis(Curve3::Nurbs { c, closed });
         }
         Err(e.error("is not a supported curve"))
@@ -492,7 +493,7 @@ pub(super) fn frame(o: DVec3, z: DVec3, r: Option<DVec3>) -> Frame {
     let pick = |r: DVec3| {
         let x = r - z * r.dot(z);
         let len = x.length();
-        (len > 1e-10 * r.length().max(1e-300)).then(|| x / len)
+        (len > 1e-10 * r.length().max(TINY)).then(|| x / len)
     };
     let x = r
         .and_then(pick)
@@ -505,13 +506,13 @@ pub(super) fn frame(o: DVec3, z: DVec3, r: Option<DVec3>) -> Frame {
 /// The parameter of the point of `c` nearest to `p`.
 pub(super) fn param_of(c: &Curve3, p: DVec3) -> f64 {
     match c {
-        Curve3::Line { p: o, d } => (p - *o).dot(*d) / d.length_squared().max(1e-300),
+        Curve3::Line { p: o, d } => guarded_div((p - *o).dot(*d), d.length_squared()),
         Curve3::Conic { c, x, y } => {
             let w = p - *c;
-            libm::atan2(w.dot(*y) / y.length_squared().max(1e-300), w.dot(*x) / x.length_squared().max(1e-300))
+            libm::atan2(guarded_div(w.dot(*y), y.length_squared()), guarded_div(w.dot(*x), x.length_squared()))
         }
-        Curve3::Hyperbola { c, y, .. } => libm::asinh((p - *c).dot(*y) / y.length_squared().max(1e-300)),
-        Curve3::Parabola { c, y, .. } => (p - *c).dot(*y) / y.length_squared().max(1e-300),
+        Curve3::Hyperbola { c, y, .. } => libm::asinh(guarded_div((p - *c).dot(*y), y.length_squared())),
+        Curve3::Parabola { c, y, .. } => guarded_div((p - *c).dot(*y), y.length_squared()),
         Curve3::Nurbs { c, .. } => c.project(p).t,
     }
 }

@@ -9,6 +9,7 @@ use glam::DVec3;
 
 use super::curves::{move_ends, param_of, period, pieces_between, rev_all, Curve3, CurveDef, CurveError, Geo};
 use super::graph::Ent;
+use crate::numeric::TINY;
 use crate::nurbs::NurbsCurve;
 use crate::warning::WarningKind;
 use crate::Error;
@@ -299,7 +300,7 @@ fn cut(
     }
     // Ends exactly at the vertices.
     let total: f64 = pieces.iter().map(length).sum();
-    if total <= 1e-12 * ps.length().max(pe.length()).max(1e-300) {
+    if total <= 1e-12 * ps.length().max(pe.length()).max(TINY) {
         return Ok((Vec::new(), None));
     }
     // Within the uncertainty, but never a fair part of the edge itself.

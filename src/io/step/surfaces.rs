@@ -17,6 +17,7 @@ use super::curves::{bounded_pieces, Curve3, Frame, Geo};
 use super::graph::{Ent, Value};
 use super::{MAX_CONTROL_POINTS, MAX_DEPTH};
 use crate::io::iges::surfaces::{nurbs_def, Profile, Revolution, SurfDef};
+use crate::numeric::TINY;
 use crate::nurbs::analytic::{extrude, line, revolve};
 use crate::nurbs::join::join;
 use crate::nurbs::reparam::map_points;
@@ -162,7 +163,7 @@ impl Geo<'_> {
     ) -> Result<NurbsCurve, Error> {
         let def = self.curve(c, depth + 1)?;
         if let (Curve3::Line { p, d }, None) = (&def.curve, def.range) {
-            let d2 = d.length_squared().max(1e-300);
+            let d2 = d.length_squared().max(TINY);
             let along = |q: DVec3| {
                 let q = match dir {
                     // The point's foot on the line, moving along the extrusion.
@@ -171,7 +172,7 @@ impl Geo<'_> {
                         let w = q - *p;
                         let m = n.cross(*d);
                         let den = v.dot(m);
-                        if den.abs() > 1e-300 {
+                        if den.abs() > TINY {
                             q - v * (w.dot(m) / den)
                         } else {
                             q
@@ -277,7 +278,7 @@ fn revolution_of(e: Ent<'_>, curve: NurbsCurve, o: DVec3, z: DVec3) -> Result<St
         w - z * w.dot(z)
     };
     let far = curve.control_points().map(radial).max_by(|a, b| a.length_squared().total_cmp(&b.length_squared()));
-    let size = curve.bbox().diagonal().max(1e-300);
+    let size = curve.bbox().diagonal().max(TINY);
     let x = far.map(|r| r.normalize_or_zero()).unwrap_or(DVec3::ZERO);
     let planar = x != DVec3::ZERO
         && curve

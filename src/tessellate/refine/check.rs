@@ -1,8 +1,12 @@
 //! The work mesh's invariants, checked in one place (as spade's sanity check
 //! does for its triangulation). [`WorkMesh::check_invariants`] holds a face to
-//! all of them, as the tests below do; the fast mesher's pipeline holds every
-//! face to [`WorkMesh::check_tables`] after each stage in debug builds (the
-//! rest fail on real files today, in ways named in each kind's doc).
+//! all of them, as the tests below do; the fast mesher's pipeline runs the
+//! same check on every face after each stage in debug builds, so that every
+//! real file a test meshes goes through it. Some later stages still break
+//! some invariants on real files: [`Known`] names those a stage may leave,
+//! with the files that show them, and any other break fails at once.
+// Only debug builds run the checks; release builds keep the stages' sets.
+#![cfg_attr(not(debug_assertions), allow(dead_code))]
 
 use alloc::vec::Vec;
 use core::fmt;
@@ -10,10 +14,8 @@ use core::fmt;
 use super::{key, WorkMesh, NONE, UV_UNSET};
 use crate::collections::HashMap;
 
-/// An invariant of a [`WorkMesh`] found broken (the kinds only the full
-/// check finds are built by the tests alone).
+/// An invariant of a [`WorkMesh`] found broken.
 #[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(not(test), allow(dead_code))]
 pub(crate) enum Broken {
     /// The per-vertex tables differ in length.
     VertexTables { positions: usize, normals: usize, ids: usize, uvs: usize },
@@ -80,6 +82,45 @@ impl fmt::Display for Broken {
     }
 }
 
+/// The breaks of the full invariants a stage of the fast mesher may leave,
+/// as the sweeps of both corpora (1e-2 and 1e-3) found them; each later
+/// stage's set holds the earlier ones', since no stage mends what an
+/// earlier one broke. No set lets the tables ([`WorkMesh::check_tables`])
+/// disagree; one file of the wide corpus still makes them (OCC131-3 at
+/// 1e-2, see `non_manifold`), and fails a debug build there.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Known {
+    /// Edges of more than two triangles: sewing that passes one loop
+    /// through a node twice (trj3_s1-al-214 and trj7_b1-ec-214 at 1e-2;
+    /// OCC131-3 of the wide corpus, where a later split of such an edge
+    /// leaves the rim a border edge short).
+    pub non_manifold: bool,
+    /// Triangles flat or clockwise in (u,v): mending's flips and moves
+    /// (trj3_s1-al-214, trj7_b1-ec-214, ship_kcs, trj6_pm4-ec-203), and
+    /// improving's flips across an iso-line, whose three corners share a u
+    /// or a v (asmo_car, bug33398_valve, OCC26308-Face; thousands on the
+    /// wide corpus at 1e-3).
+    pub folds: bool,
+    /// Border edges neither trim nor shared: first meshes where sewing
+    /// left a loop's node off its segments (as1_motor, trj10_b2-oc-214,
+    /// trj3_s1-ct-203, bug32596_abc_0_13 of the wide corpus), mending
+    /// (trj7_b1-ec-214 at 1e-2), and the triangles closing slivers adds
+    /// between faces (by design).
+    pub loose_borders: bool,
+}
+
+impl Known {
+    /// Nothing: every invariant holds.
+    pub(crate) const NONE: Self = Self { non_manifold: false, folds: false, loose_borders: false };
+    /// From the first meshes to settling the nodes.
+    pub(crate) const SEWN: Self = Self { non_manifold: true, loose_borders: true, ..Self::NONE };
+    /// After mending and improving.
+    pub(crate) const MENDED: Self = Self { folds: true, ..Self::SEWN };
+    /// After closing slivers: no stale trim or shared edge either (a
+    /// removed flap's sides and a split border edge's leave the tables).
+    pub(crate) const CLOSED: Self = Self::MENDED;
+}
+
 /// The triangles on each edge, from the triangles themselves.
 type EdgeUses = HashMap<(u32, u32), Vec<u32>>;
 
@@ -91,19 +132,24 @@ impl WorkMesh {
     /// edge is an edge of the mesh. The first found broken.
     #[cfg(test)]
     pub(crate) fn check_invariants(&self) -> Result<(), Broken> {
+        self.check_invariants_but(Known::NONE)
+    }
+
+    /// [`WorkMesh::check_invariants`] but for the breaks `known` lets pass.
+    pub(crate) fn check_invariants_but(&self, known: Known) -> Result<(), Broken> {
         let uses = self.edge_uses();
-        if let Some((&edge, ts)) = uses.iter().find(|(_, ts)| ts.len() > 2) {
+        if let Some((&edge, ts)) = uses.iter().find(|(_, ts)| ts.len() > 2).filter(|_| !known.non_manifold) {
             return Err(Broken::NonManifold { edge, triangles: ts.clone() });
         }
-        self.check_tables()?;
-        for t in 0..self.tris.len() {
+        self.check_tables_with(&uses)?;
+        for t in (0..self.tris.len()).filter(|_| !known.folds) {
             let twice_area = super::uv_area(self.uv(t));
             // Not counter-clockwise: zero, negative or NaN.
             if twice_area.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
                 return Err(Broken::Clockwise { t, twice_area });
             }
         }
-        for (&edge, ts) in &uses {
+        for (&edge, ts) in uses.iter().filter(|_| !known.loose_borders) {
             if ts.len() == 1 && !self.trim.contains_key(&edge) && !self.shared.contains_key(&edge) {
                 return Err(Broken::LooseBorder { edge, t: ts[0] });
             }
@@ -121,7 +167,13 @@ impl WorkMesh {
     /// edge, and at rest it is empty and the rim lists exactly the border
     /// edges with their triangles. An edge of more than two triangles, which
     /// no table can hold, is left to [`WorkMesh::check_invariants`].
+    #[cfg(test)]
     pub(crate) fn check_tables(&self) -> Result<(), Broken> {
+        self.check_tables_with(&self.edge_uses())
+    }
+
+    /// [`WorkMesh::check_tables`] with the triangles on each edge given.
+    fn check_tables_with(&self, uses: &EdgeUses) -> Result<(), Broken> {
         let n = self.pos.len();
         if self.normal.len() != n || self.gid.len() != n || self.vuv.len() != n {
             let (normals, ids, uvs) = (self.normal.len(), self.gid.len(), self.vuv.len());
@@ -138,14 +190,13 @@ impl WorkMesh {
         if let Some(&t) = self.odd_uv.keys().find(|&&t| t as usize >= self.tris.len()) {
             return Err(Broken::OddUv { t });
         }
-        let uses = self.edge_uses();
         if uses.values().any(|ts| ts.len() > 2) {
             return Ok(());
         }
         if self.resting {
-            self.check_rim(&uses)
+            self.check_rim(uses)
         } else {
-            self.check_edge_table(&uses)
+            self.check_edge_table(uses)
         }
     }
 
@@ -283,6 +334,10 @@ mod tests {
             m.set_uv(5, [w[0], w[2], w[1]]);
         };
         assert!(matches!(broken(&clockwise), Some(Broken::Clockwise { t: 5, .. })));
+        let mut folded = trimmed_grid().0;
+        clockwise(&mut folded);
+        assert!(matches!(folded.check_invariants_but(Known::SEWN), Err(Broken::Clockwise { t: 5, .. })));
+        assert_eq!(folded.check_invariants_but(Known::MENDED), Ok(()));
         let (a, b) = m.boundary_edges()[0];
         let loose = |m: &mut WorkMesh| {
             m.trim.remove(&key(a, b));
@@ -302,6 +357,7 @@ mod tests {
         pinched.add_triangle([v[1], v[0], 25], uv);
         pinched.add_triangle([v[0], v[1], 25], [uv[1], uv[0], uv[2]]);
         assert!(matches!(pinched.check_invariants(), Err(Broken::NonManifold { .. })));
+        assert_eq!(pinched.check_invariants_but(Known::MENDED), Ok(()), "stages that may leave both");
         assert_eq!(pinched.check_tables(), Ok(()), "an edge of three triangles is left to the full check");
     }
 }

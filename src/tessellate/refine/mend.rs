@@ -3,6 +3,7 @@
 //! sewing left open (a triangle beside a hole, a border split at a corner
 //! poking over it, a flap removed).
 
+use crate::numeric::TINY;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
@@ -237,7 +238,7 @@ impl WorkMesh {
         let (qa, qb, qc) = (tuv[i], tuv[(i + 1) % 3], tuv[(i + 2) % 3]);
         let (qb2, qa2, qd) = (uuv[j], uuv[(j + 1) % 3], uuv[(j + 2) % 3]);
         // One chart on both sides (not across a seam).
-        let span = (qa - qb).length().max(1e-300);
+        let span = (qa - qb).length().max(TINY);
         if (qa - qa2).length() > 1e-9 * span || (qb - qb2).length() > 1e-9 * span {
             return None;
         }
@@ -540,7 +541,7 @@ impl WorkMesh {
         let hint = (uv_a + uv_b) * 0.5;
         let uv = project_to_surface(surface, p, Some(hint), &Default::default()).uv;
         // Far from the edge in (u,v): across a seam, not beside it.
-        if !uv.is_finite() || uv.distance(hint) > 2.0 * uv_a.distance(uv_b).max(1e-300) {
+        if !uv.is_finite() || uv.distance(hint) > 2.0 * uv_a.distance(uv_b).max(TINY) {
             return false;
         }
         let old_v = self.pos.len();
@@ -640,6 +641,13 @@ impl WorkMesh {
         self.measure_slots();
         self.measures[t] = STALE;
         if self.fits_placed(surface, c, t) && self.fits_placed(surface, c, self.tris.len() - 1) {
+            // Its halves run beside the other face's node: shared, as the
+            // border edge they replace was (trim or shared).
+            let side = key(a, b);
+            if self.trim.remove(&side).is_some() | self.shared.remove(&side).is_some() {
+                self.shared.insert(key(x0, m), ());
+                self.shared.insert(key(m, x1), ());
+            }
             return true;
         }
         self.pop_triangle();
@@ -655,12 +663,14 @@ impl WorkMesh {
     }
 
     /// Removes triangle `t`; the last triangle takes its index. Its corners
-    /// stay as vertices (one no other triangle uses is simply not drawn).
+    /// stay as vertices (one no other triangle uses is simply not drawn),
+    /// and a side of it no other triangle has is no trim or shared edge any more.
     pub fn remove_triangle(&mut self, t: usize) {
         if t >= self.tris.len() {
             return;
         }
         self.wake();
+        let gone = self.tris[t];
         let last = self.tris.len() - 1;
         for k in 0..3 {
             self.detach(self.tris[t][k], self.tris[t][(k + 1) % 3], t as u32);
@@ -686,6 +696,13 @@ impl WorkMesh {
             }
         }
         self.measures.truncate(self.tris.len());
+        for k in 0..3 {
+            let side = key(gone[k], gone[(k + 1) % 3]);
+            if !self.edges.contains_key(&side) {
+                self.trim.remove(&side);
+                self.shared.remove(&side);
+            }
+        }
     }
 
     /// Whether the facet normal opposes the surface normal at the centroid's (u,v).

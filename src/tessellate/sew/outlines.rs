@@ -1,6 +1,7 @@
 //! Sewing of face outlines before they are triangulated.
 
 use crate::collections::{CellGrid, HashMap};
+use crate::numeric::{guarded_div, TINY};
 use alloc::vec::Vec;
 use glam::DVec3;
 
@@ -110,7 +111,7 @@ fn radii_each(pos: &PerNode<DVec3>, sew_of: &dyn Fn(NodeRef) -> f64, tight: f64)
                 .enumerate()
                 .map(|(k, p)| {
                     let n = p.len();
-                    let scale = p.iter().fold(0.0f64, |m, q| m.max(q.abs().max_element())).max(1e-300);
+                    let scale = p.iter().fold(0.0f64, |m, q| m.max(q.abs().max_element())).max(TINY);
                     let length = |i: usize| {
                         let l = p[i].distance(p[(i + 1) % n]);
                         if l <= (1e-12 * scale).max(1e-3 * tight) {
@@ -129,6 +130,64 @@ fn radii_each(pos: &PerNode<DVec3>, sew_of: &dyn Fn(NodeRef) -> f64, tight: f64)
                 .collect()
         })
         .collect()
+}
+
+/// A node on another border's segment, to be added there: (segment,
+/// fraction, curve parameter, distance, node).
+type Candidate = (NodeRef, f64, f64, f64, NodeRef);
+
+/// How near the borders of other faces run to each node, as the search
+/// for candidates saw them: the gaps that set the sewing distances, and
+/// the nearest border an addition must not pass over.
+struct Nearness {
+    /// Per node, its distance to the nearest segment of another face it
+    /// lies beside (NaN: none seen).
+    nearest: PerNode<f64>,
+    /// Per node, the nearest other face seen, beyond a segment's end too,
+    /// and its distance (NaN: none seen).
+    nearest_face: PerNode<(u32, f64)>,
+    /// Per node and face, the node's distance to that face's nearest segment.
+    nearest_in: HashMap<(NodeRef, u32), f64>,
+}
+
+impl Nearness {
+    fn new(pos: &PerNode<DVec3>) -> Self {
+        Self {
+            nearest: per_node(pos, f64::NAN),
+            nearest_face: per_node(pos, (super::NONE, f64::NAN)),
+            nearest_in: HashMap::default(),
+        }
+    }
+
+    /// Notes node `q` at distance `d` from segment `seg`, at fraction `s`
+    /// of it (`BEYOND`: past an end, which counts for the nearest face only).
+    fn note(&mut self, seg: NodeRef, s: f64, d: f64, q: NodeRef) {
+        let (a, b, c) = (q.0 as usize, q.1 as usize, q.2 as usize);
+        if seg.0 != q.0 {
+            let e = &mut self.nearest_face[a][b][c];
+            if e.1.is_nan() {
+                *e = (super::NONE, f64::INFINITY);
+            }
+            if d < e.1 {
+                *e = (seg.0, d);
+            }
+        }
+        if s == BEYOND {
+            return;
+        }
+        if seg.0 != q.0 {
+            let e = &mut self.nearest[a][b][c];
+            *e = if e.is_nan() { f64::INFINITY } else { *e }.min(d);
+        }
+        let e = self.nearest_in.entry((q, seg.0)).or_insert(f64::INFINITY);
+        *e = e.min(d);
+    }
+}
+
+/// How far face `f`'s border was moved (a rebuilt face's fit error; zero
+/// for the others and for a missing or non-finite entry).
+fn moved_by(moved: &[f64], f: u32) -> f64 {
+    moved.get(f as usize).copied().filter(|m| m.is_finite()).unwrap_or(0.0).max(0.0)
 }
 
 /// Per segment, the nodes of other borders to add to it: (fraction,
@@ -165,7 +224,7 @@ fn insertions(
 ) -> (Additions, PerNode<f64>, f64) {
     let radius = radii(pos, sew, tight);
     // Nodes hashed on a grid about one loop segment long.
-    let mut grid = CellGrid::new(1.0 / mean_segment.max(reach).max(1e-300));
+    let mut grid = CellGrid::new(guarded_div(1.0, mean_segment.max(reach)));
     for (fi, f) in pos.iter().enumerate() {
         for (k, p) in f.iter().enumerate() {
             for (i, &q) in p.iter().enumerate() {
@@ -173,44 +232,41 @@ fn insertions(
             }
         }
     }
+    let (cands, mut near) = candidates(faces, bodies, pos, &grid, &radius, tight, reach);
+    // The nearest faces only set the distances: dropped before the
+    // additions are made, where the mesh phase of a large assembly peaked.
+    let nearest_face = core::mem::take(&mut near.nearest_face);
+    let (radius, sew) = sewing_distances(pos, &near.nearest, nearest_face, moved, sew, tight);
+    let adds = additions(pos, &grid, cands, &near, &radius, moved, tight);
+    (adds, radius, sew)
+}
+
+/// Every node within `reach` of another outline's segment, where that
+/// outline runs along the node's own (not merely past it), at the nearest
+/// point of the segment's curve; and the distances seen on the way
+/// ([`Nearness`]), ends of segments included.
+///
+/// A node goes only onto borders about as near as the nearest other
+/// face's: a face thinner than `sew` keeps its far border to itself. Of
+/// one face's borders it goes onto the nearest only (and onto another as
+/// near within `tight`, the other side of a seam): a face pinched narrower
+/// than `sew` is not sewn across its neck. Those tests need the distances
+/// noted here, so a pair that can only tell a distance is not kept (on a
+/// plate of 1000 holes those were most of 12 MB of pairs).
+fn candidates(
+    faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
+    bodies: &[u32],
+    pos: &PerNode<DVec3>,
+    grid: &CellGrid<NodeRef>,
+    radius: &PerNode<f64>,
+    tight: f64,
+    reach: f64,
+) -> (Vec<Candidate>, Nearness) {
     let at = |n: NodeRef| pos[n.0 as usize][n.1 as usize][n.2 as usize];
     let body = |f: usize| crate::model::body_of(bodies, f);
     let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
-    // A node goes only onto borders about as near as the nearest other
-    // face's: a face thinner than `sew` keeps its far border to itself.
-    // Of one face's borders it goes onto the nearest only (and onto
-    // another as near within `tight`, the other side of a seam): a face
-    // pinched narrower than `sew` is not sewn across its neck. Per node
-    // (NaN: none seen), noted as the pairs are found, so a pair that can
-    // only tell a distance is not kept (on a plate of 1000 holes those were
-    // most of 12 MB of pairs).
-    let mut nearest: PerNode<f64> = per_node(pos, f64::NAN);
-    let mut nearest_face: PerNode<(u32, f64)> = per_node(pos, (super::NONE, f64::NAN));
-    let mut nearest_in: HashMap<(NodeRef, u32), f64> = HashMap::default();
-    let mut note = |seg: NodeRef, s: f64, d: f64, q: NodeRef| {
-        let (a, b, c) = (q.0 as usize, q.1 as usize, q.2 as usize);
-        if seg.0 != q.0 {
-            let e = &mut nearest_face[a][b][c];
-            if e.1.is_nan() {
-                *e = (super::NONE, f64::INFINITY);
-            }
-            if d < e.1 {
-                *e = (seg.0, d);
-            }
-        }
-        if s == BEYOND {
-            return;
-        }
-        if seg.0 != q.0 {
-            let e = &mut nearest[a][b][c];
-            *e = if e.is_nan() { f64::INFINITY } else { *e }.min(d);
-        }
-        let e = nearest_in.entry((q, seg.0)).or_insert(f64::INFINITY);
-        *e = e.min(d);
-    };
-    // Every node on some other segment, to be added there: (segment,
-    // fraction, curve parameter, distance, node).
-    let mut cands: Vec<(NodeRef, f64, f64, f64, NodeRef)> = Vec::new();
+    let mut near = Nearness::new(pos);
+    let mut cands: Vec<Candidate> = Vec::new();
     for (fi, item) in faces.iter().enumerate() {
         let Some((surface, o)) = item else { continue };
         for (k, poly) in o.loops.polys.iter().enumerate() {
@@ -232,13 +288,13 @@ fn insertions(
                     }
                     let q = at(qn);
                     let limit = if g == fi { tight.min(r_of(qn)) } else { r_of(qn) };
-                    let s0 = ((q - pa).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
+                    let s0 = (guarded_div((q - pa).dot(ab), ab.length_squared())).clamp(0.0, 1.0);
                     if s0 <= 0.0 || s0 >= 1.0 {
                         // Beyond an end, at most as far as the end: a
                         // node the other border has too (a gap of nothing).
                         let e = q.distance(pa).min(q.distance(pb));
                         if e <= limit {
-                            note(na, BEYOND, e, qn);
+                            near.note(na, BEYOND, e, qn);
                         }
                         continue;
                     }
@@ -267,18 +323,31 @@ fn insertions(
                         nearest_fraction(&|s: f64| on_curve(s).distance(q), s0)
                     };
                     if d <= limit && s > 1e-9 && s < 1.0 - 1e-9 {
-                        note(na, s, d, qn);
+                        near.note(na, s, d, qn);
                         cands.push((na, s, ta + (tb - ta) * s, d, qn));
                     } else if q.distance(pa).min(q.distance(pb)) <= limit {
                         // At an end: noted for the gap estimate only.
-                        note(na, -1.0, q.distance(pa).min(q.distance(pb)), qn);
+                        near.note(na, -1.0, q.distance(pa).min(q.distance(pb)), qn);
                     }
                 }
             }
         }
     }
-    // The gaps the model has, and those of each pair of faces side by
-    // side (counted at the nodes whose nearest other face is the other).
+    (cands, near)
+}
+
+/// Each node's reach from the sewing distances the gaps ask for (see
+/// [`insertions`]): the model's, and each pair of faces' side by side
+/// (counted at the nodes whose nearest other face is the other); and the
+/// largest distance used.
+fn sewing_distances(
+    pos: &PerNode<DVec3>,
+    nearest: &PerNode<f64>,
+    nearest_face: PerNode<(u32, f64)>,
+    moved: &[f64],
+    sew: f64,
+    tight: f64,
+) -> (PerNode<f64>, f64) {
     let q90 = |gaps: &mut Vec<f64>| {
         crate::sort::f64s(gaps);
         gaps.get((gaps.len() * 9) / 10).copied().unwrap_or(0.0)
@@ -303,10 +372,10 @@ fn insertions(
     }
     let ceiling = sew.max(tight);
     let model_sew = (4.0 * q90(&mut gaps)).max(0.125 * sew).clamp(tight, ceiling);
-    let moved_by = |f: u32| moved.get(f as usize).copied().filter(|m| m.is_finite()).unwrap_or(0.0).max(0.0);
     // The least a pair is sewn at: the model's distance, widened by how far
     // either face's border was moved.
-    let floor = |a: u32, b: u32| (model_sew + moved_by(a) + if a == b { 0.0 } else { moved_by(b) }).min(ceiling);
+    let floor =
+        |a: u32, b: u32| (model_sew + moved_by(moved, a) + if a == b { 0.0 } else { moved_by(moved, b) }).min(ceiling);
     for (q, (g, _)) in seen_face() {
         pair_gaps.entry((q.0.min(g), q.0.max(g))).or_default();
     }
@@ -326,9 +395,25 @@ fn insertions(
     };
     let radius = radii_each(pos, &sew_of, tight);
     let sew = pair_sew.values().fold(model_sew, |m, &s| m.max(s));
-    // What only the gap estimates needed goes before the additions are
-    // made: this was the peak of the whole mesh phase on large assemblies.
-    drop((nearest_face, pair_sew));
+    (radius, sew)
+}
+
+/// The candidates kept, nearest first, per segment in order along it: one
+/// within reach of the segment's ends or of a nearer node of that face
+/// will be that node, one farther than the other face's nearest border
+/// (four times that distance, or `tight` plus how far the borders moved)
+/// would sew across a thin face, and of nodes within reach of each other
+/// only the first is added.
+fn additions(
+    pos: &PerNode<DVec3>,
+    grid: &CellGrid<NodeRef>,
+    mut cands: Vec<Candidate>,
+    near: &Nearness,
+    radius: &PerNode<f64>,
+    moved: &[f64],
+    tight: f64,
+) -> Additions {
+    let at = |n: NodeRef| pos[n.0 as usize][n.1 as usize][n.2 as usize];
     let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
     let mut adds: Additions = per_node(pos, Vec::new());
     crate::sort::by_f64(&mut cands, |c| c.3);
@@ -356,12 +441,13 @@ fn insertions(
             continue;
         }
         // A moved border (a rebuilt face's) is as near as it was, within how far it moved.
-        let near_enough = (tight + moved_by(seg.0) + moved_by(q.0))
-            .max(4.0 * Some(nearest[q.0 as usize][q.1 as usize][q.2 as usize]).filter(|d| !d.is_nan()).unwrap_or(0.0));
+        let nearest = near.nearest[q.0 as usize][q.1 as usize][q.2 as usize];
+        let near_enough = (tight + moved_by(moved, seg.0) + moved_by(moved, q.0))
+            .max(4.0 * Some(nearest).filter(|d| !d.is_nan()).unwrap_or(0.0));
         if seg.0 != q.0 && d > near_enough {
             continue;
         }
-        if d > nearest_in.get(&(q, seg.0)).copied().unwrap_or(0.0) + tight {
+        if d > near.nearest_in.get(&(q, seg.0)).copied().unwrap_or(0.0) + tight {
             continue;
         }
         let list = &mut adds[fi][k][i];
@@ -373,7 +459,7 @@ fn insertions(
     for list in adds.iter_mut().flatten().flatten() {
         crate::sort::by_f64(list, |x| x.0);
     }
-    (adds, radius, sew)
+    adds
 }
 
 /// Adds the nodes to the outlines; returns each new node with the node
@@ -502,6 +588,77 @@ impl<'n> Clusters<'n> {
         self.size[big as usize] += self.size[small as usize];
         self.next.swap(small as usize, big as usize);
     }
+
+    /// Joins nodes of one body within `sew` (`tight` inside one face) and
+    /// within both their reaches, nearest pairs first, so that a chain of
+    /// close nodes is cut where its nodes are farthest apart.
+    fn join_near(&mut self, bodies: &[u32], sew: f64) {
+        let (nodes, reach, tight) = (self.nodes, self.reach, self.tight);
+        let mut grid = CellGrid::new(1.0 / sew);
+        for (i, &(_, p)) in nodes.iter().enumerate() {
+            grid.insert(p, i as u32);
+        }
+        let body = |f: u32| crate::model::body_of(bodies, f as usize);
+        let mut pairs: Vec<(f64, u32, u32)> = Vec::new();
+        for (i, &(fi, p)) in nodes.iter().enumerate() {
+            for &j in grid.near(p) {
+                if j as usize <= i {
+                    continue;
+                }
+                let (fj, q) = nodes[j as usize];
+                if body(fi) != body(fj) {
+                    continue;
+                }
+                let d = p.distance(q);
+                let limit = if fi == fj { tight } else { sew };
+                if d <= limit.min(reach[i]).min(reach[j as usize]) {
+                    pairs.push((d, i as u32, j));
+                }
+            }
+        }
+        crate::sort::by_f64(&mut pairs, |x| x.0);
+        for (_, a, b) in pairs {
+            self.union(a, b);
+        }
+    }
+
+    /// A node no other face took, one segment shorter than `tight` from a
+    /// node shared with a face within `sew` of it, is that node: there the
+    /// other border has one node for this one's tiny jog. Only nodes shared
+    /// before this take others in, so it does not run along a border.
+    /// `index`: each outline node's place in the cluster's nodes.
+    fn absorb_jogs(&mut self, index: &PerNode<u32>, sew: f64) {
+        let (nodes, tight) = (self.nodes, self.tight);
+        let shared_before: Vec<bool> = (0..nodes.len() as u32)
+            .map(|a| {
+                let r = self.find(a);
+                self.size[r as usize] > 1
+            })
+            .collect();
+        for (fi, face) in index.iter().enumerate() {
+            for ring in face {
+                let n = ring.len();
+                for i in 0..n {
+                    let a = ring[i];
+                    if shared_before[a as usize] {
+                        continue;
+                    }
+                    let p = nodes[a as usize].1;
+                    for j in [(i + n - 1) % n, (i + 1) % n] {
+                        let b = ring[j];
+                        if b == a || !shared_before[b as usize] || nodes[b as usize].1.distance(p) > tight {
+                            continue;
+                        }
+                        let rb = self.find(b);
+                        let shared = self.members(rb).any(|(g, q, _)| g != fi as u32 && q.distance(p) <= sew);
+                        if shared && self.absorb(a, b) {
+                            break;
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Gives nodes within both their reaches of each other one id (within
@@ -515,8 +672,43 @@ fn name_nodes(
     sew: f64,
     tight: f64,
 ) -> u32 {
+    let (flat, index, r_flat) = flat_nodes(faces, radius_before, twins);
+    let mut cl = Clusters::new(&flat, &r_flat, tight);
+    // Twins first (they are one node by construction), then neighbours by distance.
+    let id_of = |n: NodeRef, index: &PerNode<u32>| index[n.0 as usize][n.1 as usize].get(n.2 as usize).copied();
+    for &(n, q) in twins {
+        if let (Some(a), Some(b)) = (id_of(n, &index), id_of(q, &index)) {
+            cl.union(a, b);
+        }
+    }
+    if sew > 0.0 {
+        cl.join_near(bodies, sew);
+        cl.absorb_jogs(&index, sew);
+    }
+    // Compact ids.
+    let mut ids: HashMap<u32, u32> = HashMap::default();
+    for (fi, item) in faces.iter_mut().enumerate() {
+        let Some((_, o)) = item else { continue };
+        for k in 0..o.gids.len() {
+            for i in 0..o.gids[k].len() {
+                let root = cl.find(index[fi][k][i]);
+                let next = ids.len() as u32;
+                o.gids[k][i] = *ids.entry(root).or_insert(next);
+            }
+        }
+    }
+    ids.len() as u32
+}
+
+/// Every outline node in one list: its face and place, where each node
+/// went in it, and its reach after insertion (a new node has its twin's,
+/// an old one keeps its own).
+fn flat_nodes(
+    faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
+    radius_before: &PerNode<f64>,
+    twins: &[(NodeRef, NodeRef)],
+) -> (Vec<(u32, DVec3)>, PerNode<u32>, Vec<f64>) {
     let pos = positions(faces);
-    // Reach after insertion: a new node has its twin's, an old one keeps its own.
     let mut radius: PerNode<f64> = per_node(&pos, 0.0);
     let mut index: PerNode<u32> = per_node(&pos, 0);
     let mut flat: Vec<(u32, DVec3)> = Vec::new();
@@ -544,87 +736,5 @@ fn name_nodes(
         radius[n.0 as usize][n.1 as usize][n.2 as usize] = r;
     }
     let r_flat: Vec<f64> = radius.iter().flatten().flatten().copied().collect();
-    let mut cl = Clusters::new(&flat, &r_flat, tight);
-    // Twins first (they are one node by construction), then neighbours by distance.
-    let id_of = |n: NodeRef, index: &PerNode<u32>| index[n.0 as usize][n.1 as usize].get(n.2 as usize).copied();
-    for &(n, q) in twins {
-        if let (Some(a), Some(b)) = (id_of(n, &index), id_of(q, &index)) {
-            cl.union(a, b);
-        }
-    }
-    if sew > 0.0 {
-        let mut grid = CellGrid::new(1.0 / sew);
-        for (i, &(_, p)) in flat.iter().enumerate() {
-            grid.insert(p, i as u32);
-        }
-        let body = |f: u32| crate::model::body_of(bodies, f as usize);
-        let mut pairs: Vec<(f64, u32, u32)> = Vec::new();
-        for (i, &(fi, p)) in flat.iter().enumerate() {
-            for &j in grid.near(p) {
-                if j as usize <= i {
-                    continue;
-                }
-                let (fj, q) = flat[j as usize];
-                if body(fi) != body(fj) {
-                    continue;
-                }
-                let d = p.distance(q);
-                let limit = if fi == fj { tight } else { sew };
-                if d <= limit.min(r_flat[i]).min(r_flat[j as usize]) {
-                    pairs.push((d, i as u32, j));
-                }
-            }
-        }
-        crate::sort::by_f64(&mut pairs, |x| x.0);
-        for (_, a, b) in pairs {
-            cl.union(a, b);
-        }
-        // A node no other face took, one segment shorter than `tight` from
-        // a node shared with a face within `sew` of it, is that node: there
-        // the other border has one node for this one's tiny jog. Only nodes
-        // shared before this take others in, so it does not run along a border.
-        let shared_before: Vec<bool> = (0..flat.len() as u32)
-            .map(|a| {
-                let r = cl.find(a);
-                cl.size[r as usize] > 1
-            })
-            .collect();
-        for (fi, item) in faces.iter().enumerate() {
-            let Some((_, o)) = item else { continue };
-            for (k, poly) in o.loops.polys.iter().enumerate() {
-                let n = poly.uv.len();
-                for i in 0..n {
-                    let a = index[fi][k][i];
-                    if shared_before[a as usize] {
-                        continue;
-                    }
-                    let p = flat[a as usize].1;
-                    for j in [(i + n - 1) % n, (i + 1) % n] {
-                        let b = index[fi][k][j];
-                        if b == a || !shared_before[b as usize] || flat[b as usize].1.distance(p) > tight {
-                            continue;
-                        }
-                        let rb = cl.find(b);
-                        let shared = cl.members(rb).any(|(g, q, _)| g != fi as u32 && q.distance(p) <= sew);
-                        if shared && cl.absorb(a, b) {
-                            break;
-                        }
-                    }
-                }
-            }
-        }
-    }
-    // Compact ids.
-    let mut ids: HashMap<u32, u32> = HashMap::default();
-    for (fi, item) in faces.iter_mut().enumerate() {
-        let Some((_, o)) = item else { continue };
-        for k in 0..o.gids.len() {
-            for i in 0..o.gids[k].len() {
-                let root = cl.find(index[fi][k][i]);
-                let next = ids.len() as u32;
-                o.gids[k][i] = *ids.entry(root).or_insert(next);
-            }
-        }
-    }
-    ids.len() as u32
+    (flat, index, r_flat)
 }

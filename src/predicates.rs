@@ -3,11 +3,12 @@
 //! decide. Every sign these functions return is the sign of the exact value
 //! for the `f64` inputs, so decisions taken in different triangles about the
 //! same points always agree (paper 002 §3 needs the intersection topology to
-//! be consistent, not just approximately right).
+//! be consistent, not just approximately right; a Delaunay triangulation
+//! needs its in-circle tests to agree with each other to stay one).
 //!
-//! Inputs must be finite and well inside the `f64` range (the reader and
-//! [`super::repair_mesh`] reject coordinates above 1e30 in magnitude), so no
-//! product overflows.
+//! Inputs must be finite and well inside the `f64` range (the mesh reader and
+//! `repair_mesh` reject coordinates above 1e30 in magnitude; fitting scales
+//! its neighbourhoods to the unit box), so no product overflows.
 
 use alloc::vec::Vec;
 use core::cmp::Ordering;
@@ -21,6 +22,8 @@ const SPLITTER: f64 = 134_217_729.0;
 const CCW_BOUND: f64 = (3.0 + 16.0 * EPS) * EPS;
 /// Shewchuk's bound for the rounding error of the plain orient3d evaluation.
 const O3D_BOUND: f64 = (7.0 + 56.0 * EPS) * EPS;
+/// Shewchuk's bound for the rounding error of the plain incircle evaluation.
+const ICC_BOUND: f64 = (10.0 + 96.0 * EPS) * EPS;
 
 // ------------------------------------------------------------ error-free transforms
 
@@ -186,6 +189,34 @@ pub(crate) fn orient2d(a: DVec2, b: DVec2, c: DVec2) -> Ordering {
     acx.mul(&bcy).sub(&acy.mul(&bcx)).sign()
 }
 
+/// Whether `d` lies inside the circle through `a, b, c` (counter-clockwise):
+/// `Greater` inside, `Equal` on it, `Less` outside (reversed for clockwise
+/// `a, b, c`).
+pub(crate) fn incircle(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> Ordering {
+    let (ad, bd, cd) = (a - d, b - d, c - d);
+    let (bdxcdy, cdxbdy) = (bd.x * cd.y, cd.x * bd.y);
+    let (cdxady, adxcdy) = (cd.x * ad.y, ad.x * cd.y);
+    let (adxbdy, bdxady) = (ad.x * bd.y, bd.x * ad.y);
+    let (alift, blift, clift) = (ad.length_squared(), bd.length_squared(), cd.length_squared());
+    let det = alift * (bdxcdy - cdxbdy) + blift * (cdxady - adxcdy) + clift * (adxbdy - bdxady);
+    let permanent = (bdxcdy.abs() + cdxbdy.abs()) * alift
+        + (cdxady.abs() + adxcdy.abs()) * blift
+        + (adxbdy.abs() + bdxady.abs()) * clift;
+    let bound = ICC_BOUND * permanent;
+    if det > bound || -det > bound {
+        return sign_of(det);
+    }
+    let e = |p: f64, q: f64| Expansion::diff(p, q);
+    let (adx, ady) = (e(a.x, d.x), e(a.y, d.y));
+    let (bdx, bdy) = (e(b.x, d.x), e(b.y, d.y));
+    let (cdx, cdy) = (e(c.x, d.x), e(c.y, d.y));
+    let lift = |x: &Expansion, y: &Expansion| x.mul(x).add(&y.mul(y));
+    let m1 = bdx.mul(&cdy).sub(&cdx.mul(&bdy));
+    let m2 = cdx.mul(&ady).sub(&adx.mul(&cdy));
+    let m3 = adx.mul(&bdy).sub(&bdx.mul(&ady));
+    lift(&adx, &ady).mul(&m1).add(&lift(&bdx, &bdy).mul(&m2)).add(&lift(&cdx, &cdy).mul(&m3)).sign()
+}
+
 /// Float orient3d and its error bound; `(det, bound)`.
 #[inline]
 fn orient3d_fast(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> (f64, f64) {
@@ -305,6 +336,25 @@ mod tests {
         assert_eq!(orient2d(a, b, up), Ordering::Greater);
         let down = DVec2::new(0.7, f64::from_bits(0.7f64.to_bits() - 1));
         assert_eq!(orient2d(a, b, down), Ordering::Less);
+    }
+
+    #[test]
+    fn incircle_decides_exactly_cocircular_and_near_cocircular_points() {
+        // The unit square's corners lie on one circle.
+        let (a, b, c) = (DVec2::new(0.0, 0.0), DVec2::new(1.0, 0.0), DVec2::new(1.0, 1.0));
+        assert_eq!(incircle(a, b, c, DVec2::new(0.0, 1.0)), Ordering::Equal);
+        assert_eq!(incircle(a, b, c, DVec2::new(0.5, 0.5)), Ordering::Greater);
+        assert_eq!(incircle(a, b, c, DVec2::new(2.0, 2.0)), Ordering::Less);
+        // A step far below the float evaluation's error, inside or outside, is told apart.
+        let step = 2f64.powi(-60);
+        assert_eq!(incircle(a, b, c, DVec2::new(step, 1.0)), Ordering::Greater);
+        assert_eq!(incircle(a, b, c, DVec2::new(-step, 1.0)), Ordering::Less);
+        // Scaled off the unit box: 0.1 is not representable, the circle still holds all four.
+        let s = |p: DVec2| p * 0.1 + DVec2::new(0.3, 0.7);
+        let on = incircle(s(a), s(b), s(c), s(DVec2::new(0.0, 1.0)));
+        // A cyclic shift of the four points is an odd permutation of the determinant's rows.
+        let shifted = incircle(s(b), s(c), s(DVec2::new(0.0, 1.0)), s(a));
+        assert_eq!(on, shifted.reverse(), "one circle, whichever three");
     }
 
     #[test]
