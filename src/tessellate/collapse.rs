@@ -90,18 +90,10 @@ impl Reach<'_> {
     }
 }
 
-/// [`collapse_edges`], also returning where each collapsed vertex went
-/// (a chain ends at a kept vertex); a collapse is made only where `keeps`
-/// holds for each triangle it rewrites (before, after), and, with a
-/// `reach`, only where it keeps every gathered vertex within it.
-fn collapse_edges_moving(
-    tris: &mut Vec<[u32; 3]>,
-    same: impl Fn(u32, u32) -> bool,
-    reach: Option<Reach<'_>>,
-    keeps: impl Fn([u32; 3], [u32; 3]) -> bool,
-) -> (usize, HashMap<u32, u32>) {
+/// The edges `same` holds for, each once, lower end first, sorted.
+fn candidate_edges(tris: &[[u32; 3]], same: impl Fn(u32, u32) -> bool) -> Vec<(u32, u32)> {
     let mut edges: Vec<(u32, u32)> = Vec::new();
-    for t in tris.iter() {
+    for t in tris {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
             if a != b && same(a, b) {
@@ -109,14 +101,15 @@ fn collapse_edges_moving(
             }
         }
     }
-    if edges.is_empty() {
-        return (0, HashMap::default());
-    }
     crate::sort::pairs(&mut edges);
     edges.dedup();
-    // The triangles at each end of a candidate edge: all a collapse looks at.
+    edges
+}
+
+/// The triangles at each end of the `edges`: all a collapse looks at.
+fn fans_at_ends(tris: &[[u32; 3]], edges: &[(u32, u32)]) -> HashMap<u32, Vec<u32>> {
     let mut around: HashMap<u32, Vec<u32>> = HashMap::default();
-    for &(a, b) in &edges {
+    for &(a, b) in edges {
         around.entry(a).or_default();
         around.entry(b).or_default();
     }
@@ -127,6 +120,64 @@ fn collapse_edges_moving(
             }
         }
     }
+    around
+}
+
+/// Whether collapsing edge a-b (its live triangles `on_edge`, each end
+/// with its fan) keeps the face a manifold: the two ends share no
+/// neighbour but the edge's apexes (the link condition), and an inner
+/// edge does not join two border vertices.
+fn stays_manifold(tris: &[[u32; 3]], (a, ta): (u32, &[u32]), (b, tb): (u32, &[u32]), on_edge: &[u32]) -> bool {
+    let apexes = on_edge.iter().filter(|&&i| tris[i as usize].iter().any(|&v| v != a && v != b)).count();
+    let ring = |list: &[u32], me: u32| -> Vec<u32> {
+        let mut r: Vec<u32> = list.iter().flat_map(|&i| tris[i as usize]).filter(|&v| v != me).collect();
+        r.sort_unstable();
+        r.dedup();
+        r
+    };
+    let (ra, rb) = (ring(ta, a), ring(tb, b));
+    let common = ra.iter().filter(|&&v| v != b && rb.binary_search(&v).is_ok()).count();
+    if common != apexes {
+        return false;
+    }
+    let border = |list: &[u32], me: u32| {
+        let mut seen: Vec<(u32, u32)> = Vec::new();
+        for &i in list {
+            for &v in &tris[i as usize] {
+                if v != me {
+                    seen.push((v, i));
+                }
+            }
+        }
+        crate::sort::pairs(&mut seen);
+        // An edge from `me` with one triangle: `me` is on the border.
+        let mut k = 0;
+        let mut any = false;
+        while k < seen.len() {
+            let n = seen[k..].iter().take_while(|s| s.0 == seen[k].0).count();
+            any |= n == 1;
+            k += n;
+        }
+        any
+    };
+    !(on_edge.len() == 2 && border(ta, a) && border(tb, b))
+}
+
+/// [`collapse_edges`], also returning where each collapsed vertex went
+/// (a chain ends at a kept vertex); a collapse is made only where `keeps`
+/// holds for each triangle it rewrites (before, after), and, with a
+/// `reach`, only where it keeps every gathered vertex within it.
+fn collapse_edges_moving(
+    tris: &mut Vec<[u32; 3]>,
+    same: impl Fn(u32, u32) -> bool,
+    reach: Option<Reach<'_>>,
+    keeps: impl Fn([u32; 3], [u32; 3]) -> bool,
+) -> (usize, HashMap<u32, u32>) {
+    let edges = candidate_edges(tris, same);
+    if edges.is_empty() {
+        return (0, HashMap::default());
+    }
+    let mut around = fans_at_ends(tris, &edges);
     let mut dropped = alloc::vec![false; tris.len()];
     // Where each collapsed vertex went (chains end at a kept vertex).
     let mut moved: HashMap<u32, u32> = HashMap::default();
@@ -165,43 +216,7 @@ fn collapse_edges_moving(
         };
         let (ta, tb) = (live(a), live(b));
         let on_edge: Vec<u32> = ta.iter().copied().filter(|&i| tris[i as usize].contains(&b)).collect();
-        if on_edge.is_empty() || on_edge.len() > 2 {
-            continue;
-        }
-        let apexes: Vec<u32> =
-            on_edge.iter().filter_map(|&i| tris[i as usize].iter().copied().find(|&v| v != a && v != b)).collect();
-        let ring = |list: &[u32], me: u32| -> Vec<u32> {
-            let mut r: Vec<u32> = list.iter().flat_map(|&i| tris[i as usize]).filter(|&v| v != me).collect();
-            r.sort_unstable();
-            r.dedup();
-            r
-        };
-        let (ra, rb) = (ring(&ta, a), ring(&tb, b));
-        let common = ra.iter().filter(|&&v| v != b && rb.binary_search(&v).is_ok()).count();
-        if common != apexes.len() {
-            continue;
-        }
-        let border = |list: &[u32], me: u32| {
-            let mut seen: Vec<(u32, u32)> = Vec::new();
-            for &i in list {
-                for &v in &tris[i as usize] {
-                    if v != me {
-                        seen.push((v, i));
-                    }
-                }
-            }
-            crate::sort::pairs(&mut seen);
-            // An edge from `me` with one triangle: `me` is on the border.
-            let mut k = 0;
-            let mut any = false;
-            while k < seen.len() {
-                let n = seen[k..].iter().take_while(|s| s.0 == seen[k].0).count();
-                any |= n == 1;
-                k += n;
-            }
-            any
-        };
-        if on_edge.len() == 2 && border(&ta, a) && border(&tb, b) {
+        if on_edge.is_empty() || on_edge.len() > 2 || !stays_manifold(tris, (a, &ta), (b, &tb), &on_edge) {
             continue;
         }
         let turned = tb.iter().filter(|&&i| !on_edge.contains(&i)).any(|&i| {
