@@ -18,7 +18,7 @@ pub use assembly::{Assembly, AssemblyNode, PartInstance};
 pub(crate) use bodies::body_count;
 pub use bodies::share_of_faces;
 pub(crate) use extent::trimmed_bbox;
-#[cfg(feature = "std")]
+#[cfg(all(feature = "std", feature = "quality"))]
 pub(crate) use extent::LoopSample;
 
 /// Everything read from one input file.
