@@ -41,6 +41,16 @@ impl Polyline {
         self.at.push(CurveRef { curve, t });
         *from = t;
     }
+
+    /// Splits segment `i` at parameter `t` of its curve, the new node (at
+    /// `q` in (u,v)) becoming node `i + 1`.
+    pub fn split_segment(&mut self, i: usize, t: f64, q: DVec2) {
+        let (curve, ta, tb) = self.seg[i];
+        self.seg[i] = (curve, ta, t);
+        self.seg.insert(i + 1, (curve, t, tb));
+        self.uv.insert(i + 1, q);
+        self.at.insert(i + 1, CurveRef { curve, t });
+    }
 }
 
 /// All loops of one face, discretized and oriented: outer counter-clockwise
@@ -464,12 +474,7 @@ fn split_chord(loops: &mut Loops<'_>, k: usize, i: usize) -> bool {
     if !(tm != ta && tm != tb && tm.is_finite()) {
         return false;
     }
-    let q = curve.point(tm).truncate();
-    let poly = &mut loops.polys[k];
-    poly.seg[i] = (c, ta, tm);
-    poly.seg.insert(i + 1, (c, tm, tb));
-    poly.uv.insert(i + 1, q);
-    poly.at.insert(i + 1, CurveRef { curve: c, t: tm });
+    loops.polys[k].split_segment(i, tm, curve.point(tm).truncate());
     true
 }
 

@@ -16,7 +16,7 @@ use glam::DVec3;
 use super::nearest_fraction;
 use crate::nurbs::Surface;
 use crate::tessellate::face::Outline;
-use crate::tessellate::trim::{crossings, CurveRef};
+use crate::tessellate::trim::crossings;
 
 /// Most rounds of halving; curves that really cross stay crossing after it.
 const MAX_ROUNDS: usize = 16;
@@ -90,10 +90,7 @@ fn cut_face(surface: &dyn Surface, o: &mut Outline<'_>, cuts: &[((u32, u32), DVe
             let (s, _) = nearest_fraction(&|s: f64| on_curve(s).distance(target), 0.5);
             let s = if s > 1e-9 && s < 1.0 - 1e-9 { s } else { 0.5 };
             let t = ta + (tb - ta) * s;
-            poly.seg[i] = (c, ta, t);
-            poly.seg.insert(i + 1, (c, t, tb));
-            poly.uv.insert(i + 1, curve.point(t).truncate());
-            poly.at.insert(i + 1, CurveRef { curve: c, t });
+            poly.split_segment(i, t, curve.point(t).truncate());
             gids.insert(i + 1, first + at as u32);
         }
     }
@@ -103,7 +100,7 @@ fn cut_face(surface: &dyn Surface, o: &mut Outline<'_>, cuts: &[((u32, u32), DVe
 mod tests {
     use super::*;
     use crate::nurbs::NurbsCurve;
-    use crate::tessellate::trim::{Loops, Polyline};
+    use crate::tessellate::trim::{CurveRef, Loops, Polyline};
     use alloc::vec::Vec;
     use glam::DVec2;
 
