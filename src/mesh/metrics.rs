@@ -61,8 +61,9 @@ pub fn edge_counts_around_skipped(
 pub(crate) struct Gap {
     /// The two faces, the lower index first.
     pub faces: (u32, u32),
-    /// The widest distance, over their cracks, from a crack edge to the
-    /// nearest border point of the other face beside it.
+    /// The widest distance, over their cracks, from a point of a crack edge
+    /// (its quarter, half or three-quarter point) to the nearest border point
+    /// of the other face beside it.
     pub width: f64,
 }
 
@@ -218,17 +219,21 @@ fn face_lookup(mesh: &Mesh) -> impl Fn(usize) -> u32 + '_ {
     }
 }
 
-/// A free edge is a crack when a vertex or midpoint of a free edge of another
-/// face of its body lies within `sew` (and within a fifth of the edge's
-/// length) of its quarter, half or three-quarter point. A vertex on the
-/// edge's own face's border too is not: the two faces are joined there, and
-/// the edge passes it where its own face is narrower than `sew` (a strip
-/// whose far side comes near a corner it shares with a neighbour). A free
-/// edge that runs along the border of a skipped face of its body
-/// ([`Holes::along`]) is a crack too, the missing face's hole.
-/// Returns, per crack between two faces, the faces (lower first) and the
-/// distance from the edge to the nearest border point of the other face
-/// beside it; and how many cracks run along skipped faces.
+/// A free edge is a crack when a vertex of a free edge of another face of
+/// its body, or a point along one running beside it, lies within `sew` (and within a fifth of
+/// the edge's length) of its quarter, half or three-quarter point. A vertex
+/// on the edge's own face's border too is not: the two faces are joined
+/// there, and the edge passes it where its own face is narrower than `sew`
+/// (a strip whose far side comes near a corner it shares with a
+/// neighbour). The points along an edge lie at most half of `sew` apart, so
+/// a long border beside a short crack is seen wherever it passes, not only
+/// near its ends and middle (a sliver hole whose sides are long beside its
+/// width). A free edge that runs along the border of a skipped face of its
+/// body ([`Holes::along`]) is a crack too, the missing face's hole.
+/// Returns, per crack between two faces, the faces (lower first) and how
+/// far apart they lie there: the largest, over the three points, of the
+/// distance to the nearest border point of the other face; and how many
+/// cracks run along skipped faces.
 fn find_cracks(
     free: &[(u32, u32, u32)],
     pos: &dyn Fn(u32) -> DVec3,
@@ -240,12 +245,17 @@ fn find_cracks(
     if free.is_empty() || !(sew > 0.0 && sew.is_finite()) {
         return (cracks, 0);
     }
-    // Points of interest: free-edge vertices (tag = vertex id) and midpoints (tag = edge index).
+    // Points of interest: free-edge vertices (tag = vertex id) and points along the edges.
     #[derive(Clone, Copy)]
     enum Tag {
         Vertex(u32),
-        Mid,
+        /// A point along an edge, with the edge's direction.
+        Along(DVec3),
     }
+    let length: f64 = free.iter().map(|&(a, b, _)| pos(a).distance(pos(b))).sum();
+    // Half the sewing distance apart, but no more than ALONG_POINTS in all
+    // (a tolerance far below the model's size along long open borders).
+    let spacing = (0.5 * sew).max(length / ALONG_POINTS as f64);
     let mut grid = crate::collections::CellGrid::new(1.0 / sew);
     let mut seen = crate::collections::HashSet::default();
     for &(a, b, f) in free {
@@ -255,8 +265,14 @@ fn find_cracks(
                 grid.insert(p, (p, Tag::Vertex(v), f));
             }
         }
-        let m = (pos(a) + pos(b)) * 0.5;
-        grid.insert(m, (m, Tag::Mid, f));
+        let (pa, pb) = (pos(a), pos(b));
+        let dir = (pb - pa).normalize_or_zero();
+        // At least the midpoint; the fraction of ALONG_POINTS this edge's length earns.
+        let n = ((pa.distance(pb) / spacing).ceil() as usize).clamp(2, ALONG_POINTS);
+        for k in 1..n {
+            let m = pa.lerp(pb, k as f64 / n as f64);
+            grid.insert(m, (m, Tag::Along(dir), f));
+        }
     }
     let holes = Holes::new(skipped, 2.0 * sew);
     let mut along = 0;
@@ -264,25 +280,33 @@ fn find_cracks(
         let (pa, pb) = (pos(a), pos(b));
         // Relative to the edge too: an open border's own neighbours sit half an edge away.
         let reach = sew.min(0.2 * pa.distance(pb));
-        // The nearest other face's border point beside the edge, and that face.
+        let dir = (pb - pa).normalize_or_zero();
+        // Per point of the edge, the nearest other face's border point beside it, and that face.
         let mut hit: Option<(f64, u32)> = None;
+        let mut width: f64 = 0.0;
         for q in [0.25, 0.5, 0.75].map(|f| pa.lerp(pb, f)) {
+            let mut nearest: Option<(f64, u32)> = None;
             for &(p, tag, f) in grid.near(q) {
                 let other = f != face
                     && body(f) == body(face)
                     && match tag {
                         Tag::Vertex(v) => v != a && v != b && !seen.contains(&(v, face)),
-                        Tag::Mid => true,
+                        // Side by side, not two borders leaving a corner apart.
+                        Tag::Along(d) => d.dot(dir).abs() >= SIDE_BY_SIDE,
                     };
-                if other && p.distance(q) < reach {
-                    let width = to_segment(p, pa, pb);
-                    if hit.is_none_or(|h| width < h.0) {
-                        hit = Some((width, f));
-                    }
+                let d = p.distance(q);
+                if other && d < reach && nearest.is_none_or(|h| d < h.0) {
+                    nearest = Some((d, f));
+                }
+            }
+            if let Some((d, f)) = nearest {
+                width = width.max(d);
+                if hit.is_none_or(|h| d < h.0) {
+                    hit = Some((d, f));
                 }
             }
         }
-        if let Some((width, f)) = hit {
+        if let Some((_, f)) = hit {
             cracks.push(((face.min(f), face.max(f)), width));
         } else if holes.along(pa, pb, body(face)) {
             along += 1;
@@ -290,6 +314,17 @@ fn find_cracks(
     }
     (cracks, along)
 }
+
+/// The least cosine of the angle between two free edges that
+/// [`find_cracks`] takes to run side by side (10 degrees): borders of two
+/// faces that leave a corner they share at a wider angle are an open
+/// boundary's, however near each other they start (a notch of 25 degrees
+/// between two walls was taken for a crack at 0.9). A sliver between faces
+/// narrows to a few degrees.
+const SIDE_BY_SIDE: f64 = 0.985;
+
+/// The most points [`find_cracks`] places along the free edges in all.
+const ALONG_POINTS: usize = 200_000;
 
 /// The border curves of skipped faces, each with its body and its box, for [`Holes::along`].
 struct Holes<'a> {
@@ -327,14 +362,6 @@ impl<'a> Holes<'a> {
 
 /// A crack between two faces: the faces (lower first) and its width.
 type Crack = ((u32, u32), f64);
-
-/// Distance from `p` to the segment `ab`.
-fn to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
-    let ab = b - a;
-    let l2 = ab.length_squared();
-    let t = if l2 > 0.0 { ((p - a).dot(ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
-    p.distance(a + ab * t)
-}
 
 /// Triangle angle distribution.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -398,15 +425,31 @@ mod tests {
     fn a_node_of_another_face_along_a_free_edge_is_a_crack() {
         let pts = [(0.0, 0.0), (4.0, 0.0), (2.0, -2.0), (2.0, 0.0), (1.0, 2.0), (3.0, 2.0)];
         let m = two_faces(&pts, &[[0, 2, 1]], &[[0, 3, 4], [3, 1, 5], [3, 5, 4]]);
-        assert_eq!(edge_counts(&m, 1e-9, 1.0).free_edges, 1);
+        // Face a's edge, and face b's two halves of it, which run along it.
+        assert_eq!(edge_counts(&m, 1e-9, 1.0).free_edges, 3);
         // The node lies on the edge: a gap of nothing between faces 0 and 1.
         assert_eq!(edge_census(&m, &[], &[], 1e-9, 1.0).1, [Gap { faces: (0, 1), width: 0.0 }]);
-        // Lifted 0.3 off it, the nearest of face 1's border points (the
-        // midpoints of its edges to that node) lie 0.15 off.
+        // Lifted 0.3 off it, the node is the nearest of face 1's border
+        // points to the edge's middle: the faces lie 0.3 apart there.
         let mut lifted = m.clone();
         lifted.positions[3].z = 0.3;
         let gaps = edge_census(&lifted, &[], &[], 1e-9, 1.0).1;
-        assert!(gaps.len() == 1 && (gaps[0].width - 0.15).abs() < 1e-12, "{gaps:?}");
+        assert!(gaps.len() == 1 && (gaps[0].width - 0.3).abs() < 1e-12, "{gaps:?}");
+    }
+
+    /// A sliver hole whose sides are long beside the sewing distance: face
+    /// b's border bends 0.05 off face a's straight edge at a node 4 units
+    /// along it, and neither face's vertices nor its edges' midpoints come
+    /// within the sewing distance (0.2) of the other's edges. All three
+    /// sides are cracks, and the faces lie about 0.04 apart at the edge's
+    /// middle.
+    #[test]
+    fn a_long_sided_sliver_between_two_faces_is_a_crack() {
+        let pts = [(0.0, 0.0), (10.0, 0.0), (5.0, -3.0), (4.0, 0.05), (5.0, 3.0)];
+        let m = two_faces(&pts, &[[0, 2, 1]], &[[0, 3, 4], [3, 1, 4]]);
+        assert_eq!(edge_counts(&m, 1e-9, 0.2).free_edges, 3);
+        let gaps = edge_census(&m, &[], &[], 1e-9, 0.2).1;
+        assert!(gaps.len() == 1 && gaps[0].width > 0.03 && gaps[0].width < 0.05, "{gaps:?}");
     }
 
     /// A strip 0.5 wide (face a, its top border through node 4) that face b
