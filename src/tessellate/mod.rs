@@ -20,6 +20,7 @@ mod collapse;
 mod face;
 #[cfg(feature = "std")]
 mod fill;
+mod holes;
 pub(crate) mod measure;
 #[cfg(feature = "std")]
 mod mend_loops;
