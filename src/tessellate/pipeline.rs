@@ -469,14 +469,7 @@ impl<'m> Plan<'m> {
             let mut normals: Vec<glam::DVec3> = (0..wm.tris.len()).map(|t| wm.centroid_normal(w.surface, t)).collect();
             collapse::collapse_point_edges(&wm.pos, &mut wm.tris, &mut normals);
             shift = shift.max(collapse::collapse_short_inner_edges(&wm.pos, &wm.gid, &mut wm.tris, weld, &mut normals));
-            // Corners a millionth of the tolerance apart are one point of the
-            // welded mesh (far inside the edge counts' weld distance).
-            run.report.inverted_triangles += wm
-                .tris
-                .iter()
-                .zip(&normals)
-                .filter(|(t, n)| refine::folded_facet(t.map(|v| wm.pos[v as usize]), **n, 1e-6 * self.tol))
-                .count();
+            run.report.inverted_triangles += refine::count_folded(&wm.pos, &wm.tris, &normals, weld, 1e-6 * self.tol);
             append_face(&mut mesh, &wm);
         }
         // The faces were measured before: a collapse moves a triangle's

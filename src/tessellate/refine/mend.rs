@@ -730,3 +730,20 @@ pub(crate) fn folded_facet(p: [DVec3; 3], n: DVec3, negligible: f64) -> bool {
     let height = facet.length() / longest.max(f64::MIN_POSITIVE);
     height > negligible && facet.length_squared() > 0.0 && facet.dot(n) < 0.0
 }
+
+/// How many of triangles `tris` (corners in `pos`) fold against their
+/// surface normals `normals` ([`folded_facet`] beyond `negligible`), the
+/// triangles with two corners within `weld` left out: the edge census takes
+/// those corners for one point and drops the triangle as collapsed, and
+/// its facet turns on an offset the welded mesh does not resolve (two
+/// outline nodes of one corner that sewing left a hair apart).
+pub(crate) fn count_folded(pos: &[DVec3], tris: &[[u32; 3]], normals: &[DVec3], weld: f64, negligible: f64) -> usize {
+    tris.iter()
+        .zip(normals)
+        .filter(|(t, n)| {
+            let p = t.map(|v| pos[v as usize]);
+            let shortest = (0..3).map(|k| p[k].distance(p[(k + 1) % 3])).fold(f64::INFINITY, f64::min);
+            shortest > weld && folded_facet(p, **n, negligible)
+        })
+        .count()
+}
