@@ -22,10 +22,12 @@ pub(crate) fn one_point(a: DVec3, b: DVec3) -> bool {
 /// place, and drops the triangles on it. An edge is left alone when its
 /// collapse would join the face to itself elsewhere (its ends share a
 /// neighbour that is not a corner of a triangle on the edge, or both ends
-/// lie on the border while the edge does not). Returns the triangles dropped.
-pub(crate) fn collapse_point_edges(pos: &[DVec3], tris: &mut Vec<[u32; 3]>) -> usize {
+/// lie on the border while the edge does not). `with` (empty, or one item
+/// per triangle) drops the same items. Returns the triangles dropped.
+pub(crate) fn collapse_point_edges<T>(pos: &[DVec3], tris: &mut Vec<[u32; 3]>, with: &mut Vec<T>) -> usize {
     let at = |v: u32| pos.get(v as usize).copied();
-    collapse_edges(tris, |a, b| matches!((at(a), at(b)), (Some(p), Some(q)) if one_point(p, q)))
+    let same = |a: u32, b: u32| matches!((at(a), at(b)), (Some(p), Some(q)) if one_point(p, q));
+    collapse_edges_moving(tris, with, same, None, |_, _, _| true).0
 }
 
 /// How far, in census welds, collapses may gather vertices into one: far
@@ -45,18 +47,32 @@ const REACH_IN_WELDS: f64 = 10.0;
 /// its points (near-poles, pleats). No vertex is carried farther than
 /// [`REACH_IN_WELDS`] welds. Returns how far the farthest collapsed vertex
 /// moved, which bounds what the collapse adds to the measured deviation.
-pub(crate) fn collapse_short_inner_edges(pos: &[DVec3], gid: &[u32], tris: &mut Vec<[u32; 3]>, weld: f64) -> f64 {
+/// `normals` (empty, or one per triangle: the surface's normal it faces)
+/// loses the dropped triangles' too.
+pub(crate) fn collapse_short_inner_edges(
+    pos: &[DVec3],
+    gid: &[u32],
+    tris: &mut Vec<[u32; 3]>,
+    weld: f64,
+    normals: &mut Vec<DVec3>,
+) -> f64 {
     let inner = |v: u32| gid.get(v as usize) == Some(&u32::MAX);
     let near = |a: u32, b: u32| matches!((pos.get(a as usize), pos.get(b as usize)), (Some(p), Some(q)) if p.distance(*q) <= weld);
     // A triangle a move turns over (or flattens) would overlap its
-    // neighbours: such a collapse is not made.
+    // neighbours, and one it turns against the surface (a sliver, whose
+    // facet a short move swings far) folds: such a collapse is not made.
     let facet = |t: [u32; 3]| {
         let p = t.map(|v| pos[v as usize]);
         (p[1] - p[0]).cross(p[2] - p[0])
     };
-    let keeps = |old: [u32; 3], new: [u32; 3]| facet(new).dot(facet(old)) > 0.0;
+    let surface_normals = normals.clone();
+    let keeps = |i: usize, old: [u32; 3], new: [u32; 3]| {
+        let (before, after) = (facet(old), facet(new));
+        let faces = surface_normals.get(i).is_none_or(|n| after.dot(*n) > 0.0 || before.dot(*n) <= 0.0);
+        after.dot(before) > 0.0 && faces
+    };
     let reach = Some(Reach { pos, gid, within: weld * REACH_IN_WELDS });
-    let (_, moved) = collapse_edges_moving(tris, |a, b| (inner(a) || inner(b)) && near(a, b), reach, keeps);
+    let (_, moved) = collapse_edges_moving(tris, normals, |a, b| (inner(a) || inner(b)) && near(a, b), reach, keeps);
     let mut shift: f64 = 0.0;
     for &v in moved.keys() {
         let mut w = v;
@@ -71,7 +87,7 @@ pub(crate) fn collapse_short_inner_edges(pos: &[DVec3], gid: &[u32], tris: &mut 
 /// [`collapse_point_edges`] for the edges `same` holds for: a trial mesh,
 /// not yet sewn, judges its shape by the edges sewing will make one point.
 pub(crate) fn collapse_edges(tris: &mut Vec<[u32; 3]>, same: impl Fn(u32, u32) -> bool) -> usize {
-    collapse_edges_moving(tris, same, None, |_, _| true).0
+    collapse_edges_moving(tris, &mut Vec::<()>::new(), same, None, |_, _, _| true).0
 }
 
 /// How far collapses may carry a vertex: every vertex gathered into a kept
@@ -165,13 +181,15 @@ fn stays_manifold(tris: &[[u32; 3]], (a, ta): (u32, &[u32]), (b, tb): (u32, &[u3
 
 /// [`collapse_edges`], also returning where each collapsed vertex went
 /// (a chain ends at a kept vertex); a collapse is made only where `keeps`
-/// holds for each triangle it rewrites (before, after), and, with a
-/// `reach`, only where it keeps every gathered vertex within it.
-fn collapse_edges_moving(
+/// holds for each triangle it rewrites (index, before, after), and, with a
+/// `reach`, only where it keeps every gathered vertex within it. `with`
+/// (empty, or one item per triangle) loses the items of the triangles dropped.
+fn collapse_edges_moving<T>(
     tris: &mut Vec<[u32; 3]>,
+    with: &mut Vec<T>,
     same: impl Fn(u32, u32) -> bool,
     reach: Option<Reach<'_>>,
-    keeps: impl Fn([u32; 3], [u32; 3]) -> bool,
+    keeps: impl Fn(usize, [u32; 3], [u32; 3]) -> bool,
 ) -> (usize, HashMap<u32, u32>) {
     let edges = candidate_edges(tris, same);
     if edges.is_empty() {
@@ -221,7 +239,7 @@ fn collapse_edges_moving(
         }
         let turned = tb.iter().filter(|&&i| !on_edge.contains(&i)).any(|&i| {
             let old = tris[i as usize];
-            !keeps(old, old.map(|v| if v == b { a } else { v }))
+            !keeps(i as usize, old, old.map(|v| if v == b { a } else { v }))
         });
         if turned {
             continue;
@@ -254,6 +272,13 @@ fn collapse_edges_moving(
             i += 1;
             !dropped[i - 1]
         });
+        if with.len() == dropped.len() {
+            let mut i = 0;
+            with.retain(|_| {
+                i += 1;
+                !dropped[i - 1]
+            });
+        }
     }
     (count, moved)
 }
@@ -277,7 +302,7 @@ mod tests {
             DVec3::new(0.0, -1.0, -1.0),
         ];
         let mut tris = alloc::vec![[0, 2, 3], [0, 3, 4], [0, 4, 1], [1, 4, 5]];
-        assert_eq!(collapse_point_edges(&pos, &mut tris), 1);
+        assert_eq!(collapse_point_edges(&pos, &mut tris, &mut Vec::<()>::new()), 1);
         assert_eq!(tris.len(), 3);
         assert!(tris.iter().all(|t| !t.contains(&1)), "vertex 1 folded into 0: {tris:?}");
         for t in &tris {
@@ -301,7 +326,7 @@ mod tests {
             DVec3::new(1.0, -1.0, 0.0),
         ];
         let mut tris = alloc::vec![[0, 3, 4], [0, 4, 1], [1, 4, 5], [1, 5, 2]];
-        assert_eq!(collapse_point_edges(&pos, &mut tris), 0);
+        assert_eq!(collapse_point_edges(&pos, &mut tris, &mut Vec::<()>::new()), 0);
         assert_eq!(tris.len(), 4);
     }
 
@@ -322,21 +347,47 @@ mod tests {
         let none = u32::MAX;
         let gid = [0, 1, 2, 3, none, none];
         let mut tris = alloc::vec![[0, 1, 5], [0, 5, 4], [1, 2, 5], [2, 3, 4], [2, 4, 5], [3, 0, 4]];
-        let shift = collapse_short_inner_edges(&pos, &gid, &mut tris, 1e-3);
+        let shift = collapse_short_inner_edges(&pos, &gid, &mut tris, 1e-3, &mut Vec::new());
         assert_eq!(tris.len(), 4, "{tris:?}");
         assert!((shift - 1e-6).abs() < 1e-12, "moved {shift}");
         assert!(tris.iter().all(|t| !t.contains(&5)));
         // The same two points on the border: nothing moves.
         let gid = [0, 1, 2, 3, 4, 5];
         let mut tris = alloc::vec![[0, 1, 5], [0, 5, 4], [1, 2, 5], [2, 3, 4], [2, 4, 5], [3, 0, 4]];
-        assert_eq!(collapse_short_inner_edges(&pos, &gid, &mut tris, 1e-3), 0.0);
+        assert_eq!(collapse_short_inner_edges(&pos, &gid, &mut tris, 1e-3, &mut Vec::new()), 0.0);
         assert_eq!(tris.len(), 6);
         // Vertex 4 on the outline, 5 inner: 5 goes to 4, never 4 to 5.
         let gid = [0, 1, 2, 3, 4, none];
         let mut tris = alloc::vec![[0, 1, 5], [0, 5, 4], [1, 2, 5], [2, 3, 4], [2, 4, 5], [3, 0, 4]];
-        collapse_short_inner_edges(&pos, &gid, &mut tris, 1e-3);
+        collapse_short_inner_edges(&pos, &gid, &mut tris, 1e-3, &mut Vec::new());
         assert_eq!(tris.len(), 4, "{tris:?}");
         assert!(tris.iter().all(|t| !t.contains(&5)) && tris.iter().any(|t| t.contains(&4)), "{tris:?}");
+    }
+
+    /// A sliver whose inner corner lies a weld from an outline vertex but on
+    /// the other side of its long edge's vertical plane: the move swings
+    /// its facet by 60°, past the surface's side, so the collapse is refused
+    /// (without the surface's normals it is made).
+    #[test]
+    fn a_collapse_that_turns_a_sliver_against_the_surface_is_refused() {
+        let e = 1e-4;
+        let (s, c) = (0.5 * e, 0.866 * e);
+        // a, b the long edge; y on the outline, x inner, e apart.
+        let pos = [DVec3::ZERO, DVec3::new(0.0, 1.0, 0.0), DVec3::new(s, 0.5, c), DVec3::new(-s, 0.5, c)];
+        let gid = [0, 1, 2, u32::MAX];
+        let fan = alloc::vec![[0, 1, 3], [1, 2, 3], [2, 0, 3]];
+        let up = |n: usize| alloc::vec![DVec3::Z; n];
+        let mut tris = fan.clone();
+        let mut normals = up(3);
+        assert_eq!(collapse_short_inner_edges(&pos, &gid, &mut tris, 1e-3, &mut normals), 0.0);
+        assert_eq!(tris, fan);
+        // Only the facets judged: the move keeps the sliver within 90° of
+        // its old facet, so it is made and the sliver faces down.
+        let mut tris = fan.clone();
+        assert!(collapse_short_inner_edges(&pos, &gid, &mut tris, 1e-3, &mut Vec::new()) > 0.0);
+        assert_eq!(tris, alloc::vec![[0, 1, 2]]);
+        let p = tris[0].map(|v| pos[v as usize]);
+        assert!((p[1] - p[0]).cross(p[2] - p[0]).z < 0.0);
     }
 
     /// A row of inner points each 0.6 welds from the next, 18 welds long,
@@ -362,7 +413,7 @@ mod tests {
             tris.push([0, row(i + 1), row(i)]);
             tris.push([3, row(i), row(i + 1)]);
         }
-        let shift = collapse_short_inner_edges(&pos, &gid, &mut tris, weld);
+        let shift = collapse_short_inner_edges(&pos, &gid, &mut tris, weld, &mut Vec::new());
         assert!(shift > 0.0 && shift <= REACH_IN_WELDS * weld + 1e-15, "moved {shift}");
         let mut left: Vec<u32> = tris.iter().flatten().copied().filter(|&v| v >= 4).collect();
         left.sort_unstable();
@@ -380,7 +431,7 @@ mod tests {
     fn a_short_edge_is_not_a_point() {
         let pos = [DVec3::ZERO, DVec3::new(1e-9, 0.0, 0.0), DVec3::new(0.0, 1.0, 0.0)];
         let mut tris = alloc::vec![[0, 1, 2]];
-        assert_eq!(collapse_point_edges(&pos, &mut tris), 0);
+        assert_eq!(collapse_point_edges(&pos, &mut tris, &mut Vec::<()>::new()), 0);
         assert_eq!(tris.len(), 1);
     }
 }

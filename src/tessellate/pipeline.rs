@@ -414,7 +414,7 @@ impl<'m> Plan<'m> {
 
     /// Stage 8, the verification paper 000 leaves to its chord test: each
     /// face's triangles measured against its exact surface (deviation,
-    /// normal turn, folds), with a warning for a face left empty and for
+    /// normal turn; folds are counted once assembly's collapses are made), with a warning for a face left empty and for
     /// triangles still over the limits.
     pub fn measure_faces(&self, run: &mut Run<'m>, works: &mut Works<'_>) {
         let report = &mut run.report;
@@ -427,10 +427,6 @@ impl<'m> Plan<'m> {
             run.deviation.0 += out.sum;
             run.deviation.1 += out.count;
             report.max_normal_turn = report.max_normal_turn.max(out.max_turn);
-            // Corners a millionth of the tolerance apart are one point of the
-            // welded mesh (far inside the edge counts' weld distance).
-            report.inverted_triangles +=
-                (0..w.mesh.tris.len()).filter(|&t| w.mesh.folded_beyond(w.surface, t, 1e-6 * self.tol)).count();
             if w.mesh.tris.is_empty() {
                 if self.mine[index] && !report.warnings.iter().any(|x| x.face == Some(index)) {
                     report.faces_skipped += 1;
@@ -457,15 +453,23 @@ impl<'m> Plan<'m> {
     /// copied, the mesh growing by what each face adds: presized in
     /// full, it sat next to every face's full working state (wasm memory
     /// never shrinks, so the peak is what a page keeps). An edge whose two
-    /// ends sewing put on one point is collapsed; the tessellated faces follow.
+    /// ends sewing put on one point is collapsed, and the triangles left that
+    /// fold against the surface are counted; the tessellated faces follow.
     pub fn assemble(&self, run: &mut Run<'m>, works: Works<'_>) -> Mesh {
         let mut mesh = Mesh { face_ranges: Vec::with_capacity(works.faces.len()), ..Mesh::default() };
         let weld = self.weld();
         let mut shift: f64 = 0.0;
         for mut w in works.faces {
             let mut wm = core::mem::take(&mut w.mesh);
-            collapse::collapse_point_edges(&wm.pos, &mut wm.tris);
-            shift = shift.max(collapse::collapse_short_inner_edges(&wm.pos, &wm.gid, &mut wm.tris, weld));
+            // Folds are counted on the triangles the mesh keeps (a collapse
+            // takes away folded slivers), each judged against the normal at
+            // its (u,v) centroid as refined: a collapse moves a corner by a
+            // hundredth of the tolerance at most, and never turns a facet
+            // over or against that normal.
+            let mut normals: Vec<glam::DVec3> = (0..wm.tris.len()).map(|t| wm.centroid_normal(w.surface, t)).collect();
+            collapse::collapse_point_edges(&wm.pos, &mut wm.tris, &mut normals);
+            shift = shift.max(collapse::collapse_short_inner_edges(&wm.pos, &wm.gid, &mut wm.tris, weld, &mut normals));
+            run.report.inverted_triangles += refine::count_folded(&wm.pos, &wm.tris, &normals, weld, 1e-6 * self.tol);
             append_face(&mut mesh, &wm);
         }
         // The faces were measured before: a collapse moves a triangle's

@@ -22,6 +22,7 @@ pub(crate) use check::Known;
 pub(crate) use edges::EdgeList;
 pub(crate) use limits::{Criteria, Lift, Outcome};
 use limits::{Packed, STALE};
+pub(crate) use mend::count_folded;
 
 const NONE: u32 = u32::MAX;
 

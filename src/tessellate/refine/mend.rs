@@ -510,16 +510,18 @@ impl WorkMesh {
     }
 
     /// Whether triangle `t` folds against the surface with a facet worth
-    /// judging: a triangle whose smallest height is within `negligible` is
-    /// flat (two corners one point, as a pole's nodes a rounding error apart,
-    /// or three in a line where a side of the surface is collapsed to a
-    /// hair), its facet's normal then noise.
+    /// judging ([`folded_facet`] against its [`Self::centroid_normal`]).
+    #[cfg(test)]
     pub fn folded_beyond(&self, surface: &dyn Surface, t: usize, negligible: f64) -> bool {
         let v = self.tris[t];
-        let p = [self.pos[v[0] as usize], self.pos[v[1] as usize], self.pos[v[2] as usize]];
-        let longest = (0..3).map(|k| p[k].distance(p[(k + 1) % 3])).fold(0.0, f64::max);
-        let height = (p[1] - p[0]).cross(p[2] - p[0]).length() / longest.max(f64::MIN_POSITIVE);
-        height > negligible && self.inverted(surface, t)
+        folded_facet(v.map(|x| self.pos[x as usize]), self.centroid_normal(surface, t), negligible)
+    }
+
+    /// The surface normal triangle `t`'s facet is judged against: at the
+    /// centroid of its corners' (u,v).
+    pub fn centroid_normal(&self, surface: &dyn Surface, t: usize) -> DVec3 {
+        let uv = self.uv(t);
+        surface.normal((uv[0] + uv[1] + uv[2]) / 3.0)
     }
 
     /// Closes a small hole beside border edge `a-b` (run a→b by its one
@@ -713,8 +715,35 @@ impl WorkMesh {
         if facet.length_squared() == 0.0 {
             return false;
         }
-        let uv = self.uv(t);
-        let n = surface.normal((uv[0] + uv[1] + uv[2]) / 3.0);
-        facet.dot(n) < 0.0
+        facet.dot(self.centroid_normal(surface, t)) < 0.0
     }
+}
+
+/// Whether the triangle on corners `p` folds against the surface normal `n`
+/// with a facet worth judging: a triangle whose smallest height is within
+/// `negligible` is flat (two corners one point, as a pole's nodes a rounding
+/// error apart, or three in a line where a side of the surface is collapsed
+/// to a hair), its facet's normal then noise.
+pub(crate) fn folded_facet(p: [DVec3; 3], n: DVec3, negligible: f64) -> bool {
+    let facet = (p[1] - p[0]).cross(p[2] - p[0]);
+    let longest = (0..3).map(|k| p[k].distance(p[(k + 1) % 3])).fold(0.0, f64::max);
+    let height = facet.length() / longest.max(f64::MIN_POSITIVE);
+    height > negligible && facet.length_squared() > 0.0 && facet.dot(n) < 0.0
+}
+
+/// How many of triangles `tris` (corners in `pos`) fold against their
+/// surface normals `normals` ([`folded_facet`] beyond `negligible`), the
+/// triangles with two corners within `weld` left out: the edge census takes
+/// those corners for one point and drops the triangle as collapsed, and
+/// its facet turns on an offset the welded mesh does not resolve (two
+/// outline nodes of one corner that sewing left a hair apart).
+pub(crate) fn count_folded(pos: &[DVec3], tris: &[[u32; 3]], normals: &[DVec3], weld: f64, negligible: f64) -> usize {
+    tris.iter()
+        .zip(normals)
+        .filter(|(t, n)| {
+            let p = t.map(|v| pos[v as usize]);
+            let shortest = (0..3).map(|k| p[k].distance(p[(k + 1) % 3])).fold(f64::INFINITY, f64::min);
+            shortest > weld && folded_facet(p, **n, negligible)
+        })
+        .count()
 }

@@ -258,3 +258,21 @@ fn a_folded_fan_collapses_into_a_neighbour() {
         assert!(uv_area(m.uv(t)) > 0.0, "triangle {t} turned clockwise in (u,v)");
     }
 }
+
+/// A needle folded against the surface whose two near corners lie within
+/// the census's weld is no triangle of the welded mesh and is not counted;
+/// the same needle with them farther apart is, and one facing the
+/// surface's way never is.
+#[test]
+fn folds_count_only_triangles_the_weld_keeps() {
+    let weld = 1e-3;
+    // Corners 1 and 2 `gap` apart, 10 from corner 0; the facet faces -z.
+    let needle = |gap: f64| [DVec3::ZERO, DVec3::new(10.0, 0.0, 0.0), DVec3::new(10.0, -gap, 0.0)];
+    let up = [DVec3::Z];
+    let tri = [[0, 1, 2]];
+    assert_eq!(mend::count_folded(&needle(0.5 * weld), &tri, &up, weld, 1e-9), 0);
+    assert_eq!(mend::count_folded(&needle(2.0 * weld), &tri, &up, weld, 1e-9), 1);
+    assert_eq!(mend::count_folded(&needle(2.0 * weld), &tri, &[-DVec3::Z], weld, 1e-9), 0);
+    // Flat within `negligible`: not counted however far apart.
+    assert_eq!(mend::count_folded(&needle(2.0 * weld), &tri, &up, weld, 1e-2), 0);
+}
