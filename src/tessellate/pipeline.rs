@@ -414,8 +414,9 @@ impl<'m> Plan<'m> {
 
     /// Stage 8, the verification paper 000 leaves to its chord test: each
     /// face's triangles measured against its exact surface (deviation,
-    /// normal turn; folds are counted once assembly's collapses are made), with a warning for a face left empty and for
-    /// triangles still over the limits.
+    /// normal turn; folds are counted once assembly's collapses are made),
+    /// with a warning for a face left empty and for triangles still over
+    /// the limits.
     pub fn measure_faces(&self, run: &mut Run<'m>, works: &mut Works<'_>) {
         let report = &mut run.report;
         for (index, (w, fit_error)) in works.faces.iter_mut().zip(&works.fit_errors).enumerate() {
