@@ -268,7 +268,7 @@ fn find_cracks(
         let (pa, pb) = (pos(a), pos(b));
         let dir = (pb - pa).normalize_or_zero();
         // At least the midpoint; the fraction of ALONG_POINTS this edge's length earns.
-        let n = ((pa.distance(pb) / spacing).ceil() as usize).clamp(2, ALONG_POINTS);
+        let n = (crate::math::ceil(pa.distance(pb) / spacing) as usize).clamp(2, ALONG_POINTS);
         for k in 1..n {
             let m = pa.lerp(pb, k as f64 / n as f64);
             grid.insert(m, (m, Tag::Along(dir), f));
