@@ -213,6 +213,13 @@ impl Surface for FaceSurface {
             }
         }
     }
+    fn derivative_bounds(&self) -> Option<[f64; 2]> {
+        match self {
+            Self::Nurbs(s) | Self::Rebuilt(s) => s.derivative_bounds(),
+            // The offset's speed also turns with the base's curvature.
+            Self::Offset { .. } => None,
+        }
+    }
     fn point_normal(&self, uv: DVec2) -> (DVec3, DVec3) {
         match self {
             Self::Nurbs(s) | Self::Rebuilt(s) => s.point_normal(uv),

@@ -7,6 +7,7 @@ use core::cmp::Ordering;
 use glam::{DVec3, DVec4};
 
 use super::knots::{KnotVector, MAX_DERIV};
+use super::speed::speed_bound;
 use super::{Aabb, CurveProjection, NurbsError, MAX_DEGREE};
 
 /// A (possibly rational) B-spline curve. 2-D curves (trim loops in (u,v)) keep z = 0.
@@ -217,6 +218,13 @@ impl NurbsCurve {
         let left = Self { knots: KnotVector::try_new(p, k1).ok()?, points: p1, rational: self.rational };
         let right = Self { knots: KnotVector::try_new(p, k2).ok()?, points: p2, rational: self.rational };
         Some((left, right))
+    }
+
+    /// Per coordinate, a bound of `|C'(t)|` over the whole domain (`None`
+    /// for a non-positive or non-finite weight): lets a caller rule a curve
+    /// piece out from its length without sampling it ([`speed_bound`]).
+    pub fn derivative_bound(&self) -> Option<DVec3> {
+        speed_bound(&self.knots, &self.points, 1, 1)
     }
 
     /// Box around the control polygon (contains the curve: convex hull property).

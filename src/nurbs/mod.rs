@@ -15,6 +15,7 @@ mod knots;
 mod project;
 pub(crate) mod reparam;
 pub(crate) mod seam;
+mod speed;
 mod surface;
 
 use alloc::vec::Vec;
@@ -62,6 +63,11 @@ pub trait Surface {
     fn breaks(&self, along_u: bool) -> Vec<f64>;
     /// A box that contains the surface.
     fn bounding_box(&self) -> Aabb;
+    /// Bounds of `|S_u|` and `|S_v|` over the whole domain, where known:
+    /// how far a curve on the surface can stray from its chord.
+    fn derivative_bounds(&self) -> Option<[f64; 2]> {
+        None
+    }
     /// Whether parameters follow model-space length and the surface is C²
     /// across its knots (paper 001's rebuild): its knots then mark no feature
     /// the mesher's grid must start from.

@@ -4,6 +4,7 @@ use alloc::vec::Vec;
 use glam::{DVec2, DVec3, DVec4};
 
 use super::knots::KnotVector;
+use super::speed::speed_bound;
 use super::{Aabb, NurbsError, Surface, SurfaceDerivs};
 
 /// A (possibly rational) tensor-product B-spline surface.
@@ -134,6 +135,23 @@ impl NurbsSurface {
     /// Euclidean control points, row-major.
     pub fn control_points(&self) -> impl Iterator<Item = DVec3> + '_ {
         self.points.iter().map(|h| h.truncate() / h.w)
+    }
+
+    /// Bounds of `|S_u|` and `|S_v|` over the whole domain ([`speed_bound`]
+    /// along each direction); `None` for a non-positive or non-finite weight.
+    pub fn derivative_bounds(&self) -> Option<[f64; 2]> {
+        let nv = self.kv.control_count();
+        let along_u = speed_bound(&self.ku, &self.points, nv, self.kv.degree() + 1)?;
+        let along_v = self.derivative_bound_v()?;
+        Some([along_u.length(), along_v.length()])
+    }
+
+    /// [`speed_bound`] along v: each row of the net is a curve in v, the
+    /// rows a span of u spans together making the block.
+    fn derivative_bound_v(&self) -> Option<DVec3> {
+        let (nu, nv) = (self.ku.control_count(), self.kv.control_count());
+        let transposed: Vec<DVec4> = (0..nv).flat_map(|j| (0..nu).map(move |i| self.points[i * nv + j])).collect();
+        speed_bound(&self.kv, &transposed, nu, self.ku.degree() + 1)
     }
 
     /// Box around the control net (contains the surface).
@@ -467,5 +485,9 @@ impl Surface for NurbsSurface {
 
     fn bounding_box(&self) -> Aabb {
         self.bbox()
+    }
+
+    fn derivative_bounds(&self) -> Option<[f64; 2]> {
+        NurbsSurface::derivative_bounds(self)
     }
 }

@@ -134,11 +134,18 @@ fn border_uses(faces: &[FaceWork<'_>]) -> Uses {
 /// carry different nodes (their gap there was wider than the nodes' reach
 /// when the outlines were sewn: T-junctions), each face takes the other's
 /// nodes in between, within the sewing distance `sew`. Paper 000 §3.3:
-/// both sides of a shared edge carry the same nodes.
-fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) {
+/// both sides of a shared edge carry the same nodes. Returns the border
+/// uses after it ([`border_uses`]).
+fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) -> Uses {
     /// Border nodes walked from one shared node towards the next, at most.
     const STEPS: usize = 24;
     let uses = border_uses(faces);
+    // Every walk below starts on an edge no other face uses: where there is
+    // none (a closed shell), there is nothing to close, and the tables of
+    // neighbours were most of the stage's time on a drilled plate.
+    if uses.values().all(|l| l.len() != 1) {
+        return uses;
+    }
     let lonely = |ga: u32, gb: u32| uses.get(&node_key(ga, gb)).is_some_and(|l| l.len() == 1);
     // Per (face, node id): the border neighbours' ids; per node id: (face,
     // vertex). From the border uses, in face and edge order.
@@ -213,6 +220,10 @@ fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) {
             }
         }
     }
+    // The tables go before the splits, and the uses before they are taken
+    // again: the peak of a large model's mesh phase is here.
+    drop((around, holders, seen));
+    let mut split = false;
     for (fa, mut run, gap, nodes) in plans {
         let f = &mut faces[fa];
         // Per edge of the run from `from` on: its index, the fraction of its
@@ -251,7 +262,15 @@ fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) {
             f.mesh.forget(&changed);
             run.insert(i + 1, n);
             from = i + 1;
+            split = true;
         }
+    }
+    // Unchanged borders keep their uses.
+    if split {
+        drop(uses);
+        border_uses(faces)
+    } else {
+        uses
     }
 }
 
@@ -283,8 +302,7 @@ pub(crate) fn refine_all(
     budget: usize,
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<bool, Error> {
-    close_t_junctions(faces, sew);
-    let mut uses = border_uses(faces);
+    let mut uses = close_t_junctions(faces, sew);
     let mut shared: Vec<Vec<((u32, u32), ())>> = alloc::vec![Vec::new(); faces.len()];
     for list in uses.values().filter(|l| l.len() > 1) {
         for &(fi, a, b) in list {

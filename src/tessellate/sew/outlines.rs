@@ -269,6 +269,9 @@ fn candidates(
     let mut cands: Vec<Candidate> = Vec::new();
     for (fi, item) in faces.iter().enumerate() {
         let Some((surface, o)) = item else { continue };
+        // Speed bounds, taken when a search is first about to run.
+        let mut surface_speed: Option<Option<[f64; 2]>> = None;
+        let mut curve_speed: Vec<Option<Option<DVec3>>> = alloc::vec![None; o.loops.curves.len()];
         for (k, poly) in o.loops.polys.iter().enumerate() {
             let n = poly.uv.len();
             for i in 0..n {
@@ -280,6 +283,7 @@ fn candidates(
                 let (curve, ta, tb) = poly.seg[i];
                 let Some(c) = o.loops.curves.get(curve as usize) else { continue };
                 let on_curve = |s: f64| surface.point(c.point(ta + (tb - ta) * s).truncate());
+                let mut piece: Option<Option<Piece>> = None;
                 // Only nodes within `reach` of the segment pass the tests below.
                 for &qn in grid.near_segment(pa, pb, reach) {
                     let (g, kk, jj) = (qn.0 as usize, qn.1 as usize, qn.2 as usize);
@@ -317,7 +321,14 @@ fn candidates(
                     // Most nodes are such ends: the other face's copy of
                     // this border's node.
                     let at_end = q.distance(pa).min(q.distance(pb)) <= 1e-9 * ab.length();
-                    let (s, d) = if at_end {
+                    let piece = piece.get_or_insert_with(|| {
+                        let speed = *surface_speed.get_or_insert_with(|| surface.derivative_bounds());
+                        let along = *curve_speed[curve as usize].get_or_insert_with(|| c.derivative_bound());
+                        Piece::new(&on_curve, (tb - ta).abs(), speed, along)
+                    });
+                    // The search's distance is one of the piece's: where all
+                    // of them exceed the limit, its result would be rejected.
+                    let (s, d) = if at_end || piece.as_ref().is_some_and(|p| p.beyond(q, limit)) {
                         (0.0, f64::INFINITY)
                     } else {
                         nearest_fraction(&|s: f64| on_curve(s).distance(q), s0)
@@ -334,6 +345,45 @@ fn candidates(
         }
     }
     (cands, near)
+}
+
+/// A segment's curve piece (`on_curve` over `[0, 1]`): the chord between
+/// its ends and how far the piece may stray from that chord, from a bound
+/// of its length (the curve's and the surface's speed bounds over the
+/// parameter span): a curve of length `l` between points `c` apart lies
+/// within `sqrt(l² - c²) / 2` of the chord joining them.
+struct Piece {
+    a: DVec3,
+    b: DVec3,
+    stray: f64,
+    /// Room for rounding in the evaluations and in the bound.
+    margin: f64,
+}
+
+impl Piece {
+    /// `None` where a speed bound is unknown (an offset surface, a bad weight).
+    fn new(
+        on_curve: &dyn Fn(f64) -> DVec3,
+        span: f64,
+        surface: Option<[f64; 2]>,
+        curve: Option<DVec3>,
+    ) -> Option<Self> {
+        let ([su, sv], c) = (surface?, curve?);
+        let length = span * (su * c.x.abs() + sv * c.y.abs());
+        let (a, b) = (on_curve(0.0), on_curve(1.0));
+        let chord = a.distance(b);
+        let stray = 0.5 * (length * length - chord * chord).max(0.0).sqrt();
+        let margin = 1e-9 * (a.abs().max_element() + b.abs().max_element() + length + chord);
+        (stray.is_finite() && margin.is_finite()).then_some(Self { a, b, stray, margin })
+    }
+
+    /// Whether every point of the piece lies farther than `limit` from `q`.
+    fn beyond(&self, q: DVec3, limit: f64) -> bool {
+        let ab = self.b - self.a;
+        let t = guarded_div((q - self.a).dot(ab), ab.length_squared()).clamp(0.0, 1.0);
+        let to_chord = q.distance(self.a + ab * t);
+        to_chord - self.stray > limit + self.margin + 1e-9 * q.abs().max_element()
+    }
 }
 
 /// Each node's reach from the sewing distances the gaps ask for (see
@@ -737,4 +787,53 @@ fn flat_nodes(
     }
     let r_flat: Vec<f64> = radius.iter().flatten().flatten().copied().collect();
     (flat, index, r_flat)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nurbs::{NurbsCurve, NurbsSurface};
+    use alloc::vec;
+    use glam::DVec2;
+
+    /// A piece of a circle in (u, v) on a cylinder: wherever it is ruled
+    /// out, every sampled point of it is farther than the limit, and nodes
+    /// well away from the piece are ruled out.
+    #[test]
+    fn a_piece_ruled_out_has_no_point_within_the_limit() {
+        let w = core::f64::consts::FRAC_1_SQRT_2;
+        let ring = [(1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (-1.0, 1.0), (-1.0, 0.0)];
+        let net: Vec<Vec<DVec3>> = ring
+            .iter()
+            .map(|&(x, y)| vec![DVec3::new(5.0 * x, 5.0 * y, 0.0), DVec3::new(5.0 * x, 5.0 * y, 3.0)])
+            .collect();
+        let wn: Vec<Vec<f64>> = [1.0, w, 1.0, w, 1.0].iter().map(|&w| vec![w, w]).collect();
+        let knots = vec![0.0, 0.0, 0.0, 0.5, 0.5, 1.0, 1.0, 1.0];
+        let surface =
+            NurbsSurface::try_new([2, 1], knots, vec![0.0, 0.0, 1.0, 1.0], &net, Some(&wn)).expect("cylinder");
+        // A circle of radius 0.3 about (0.5, 0.5) in the parameters.
+        let uv: Vec<DVec3> = ring.iter().map(|&(x, y)| DVec3::new(0.5 + 0.3 * x, 0.5 + 0.3 * y, 0.0)).collect();
+        let curve =
+            NurbsCurve::try_new(2, vec![0.0, 0.0, 0.0, 0.5, 0.5, 1.0, 1.0, 1.0], uv, Some(vec![1.0, w, 1.0, w, 1.0]))
+                .expect("circle");
+        // A piece as short as a loop's segments are, against nodes all over the face.
+        let (ta, tb) = (0.1, 0.12);
+        let on_curve = |s: f64| surface.point(curve.point(ta + (tb - ta) * s).truncate());
+        let piece = Piece::new(&on_curve, tb - ta, surface.derivative_bounds(), curve.derivative_bound())
+            .expect("bounds known");
+        let samples: Vec<DVec3> = (0..=400).map(|i| on_curve(f64::from(i) / 400.0)).collect();
+        let (mut ruled_out, limit) = (0, 0.2);
+        for i in 0..=20 {
+            for j in 0..=20 {
+                let uv = DVec2::new(f64::from(i) / 20.0, f64::from(j) / 20.0);
+                let q = surface.point(uv) + DVec3::new(0.0, 0.0, 0.1 * f64::from(i % 3));
+                if piece.beyond(q, limit) {
+                    ruled_out += 1;
+                    let nearest = samples.iter().map(|p| p.distance(q)).fold(f64::INFINITY, f64::min);
+                    assert!(nearest > limit, "{q} is {nearest} from the piece");
+                }
+            }
+        }
+        assert!(ruled_out > 200, "only {ruled_out} of 441 nodes ruled out");
+    }
 }
