@@ -550,6 +550,29 @@ fn fuzz_timeout_stacked_triangles_mesh_within_budget() {
     assert!(rep.max_deviation <= rep.tolerance, "deviation {} > {}", rep.max_deviation, rep.tolerance);
 }
 
+/// Found by fuzzing (a debug build's invariant check): a face whose loop
+/// uses one edge twice touches itself at a point. Halving the chords that
+/// touch there crowded nodes 2^-30 of the face apart on one straight side,
+/// where the triangulation's scaled plane made a triangle of three of them
+/// that is flat in (u,v). Chords that short are no longer halved: the
+/// loop is mended instead, and every triangle runs counter-clockwise (the
+/// debug build checks it after each stage).
+#[test]
+fn fuzz_pinched_loop_meshes_without_flat_triangles() {
+    let model = read_step(&data("step_fuzz_pinched_loop.stp")).unwrap();
+    let options = MeshOptions::default().with_relative_tolerance(0.05).with_max_triangles(5_000);
+    let r = mesh_model(&model, &options).expect("meshes");
+    let rep = &r.report;
+    assert!(rep.triangles > 0, "{} triangles", rep.triangles);
+    assert!(rep.max_deviation <= rep.tolerance, "deviation {} > {}", rep.max_deviation, rep.tolerance);
+    // No triangle without area: the flat ones were three points on one line.
+    let m = &r.mesh;
+    for t in m.indices.chunks_exact(3) {
+        let p = [0, 1, 2].map(|k| m.positions[t[k] as usize]);
+        assert!((p[1] - p[0]).cross(p[2] - p[0]).length() > 0.0, "a triangle without area: {p:?}");
+    }
+}
+
 /// Two shares of a two-body assembly mesh one body each, and together they
 /// are the whole model's mesh face by face (bodies share no border); with
 /// more shares than bodies the extra share is empty, not an error.
