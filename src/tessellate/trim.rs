@@ -490,7 +490,8 @@ fn split_chord(loops: &mut Loops<'_>, k: usize, i: usize) -> bool {
         (Some(&a), Some(&b)) => a.distance(b),
         _ => return false,
     };
-    if !(chord > SHORTEST_SPLIT * lo.distance(hi)) {
+    // Not longer (or NaN): not halved.
+    if chord.partial_cmp(&(SHORTEST_SPLIT * lo.distance(hi))) != Some(core::cmp::Ordering::Greater) {
         return false;
     }
     loops.polys[k].split_segment(i, tm, curve.point(tm).truncate());
