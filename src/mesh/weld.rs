@@ -11,7 +11,7 @@ const CELL: i64 = 8;
 /// Maps each position to a representative index so that positions closer than
 /// `tol` share one: the first earlier representative found in the 27 cubes of
 /// size `tol` about it (x outer, z inner). Returns `(map, count)`. The
-/// positions grouped by a hash of their cell ([`CELL`] cubes a side; each
+/// positions grouped by a hash of their cell (`CELL` cubes a side; each
 /// group in index order) and a table from hash to where its group starts
 /// stand in for a hash grid of cells, which took about 60 bytes a vertex
 /// and set the peak of a model's edge census.

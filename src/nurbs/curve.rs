@@ -222,7 +222,7 @@ impl NurbsCurve {
 
     /// Per coordinate, a bound of `|C'(t)|` over the whole domain (`None`
     /// for a non-positive or non-finite weight): lets a caller rule a curve
-    /// piece out from its length without sampling it ([`speed_bound`]).
+    /// piece out from its length without sampling it (`speed_bound`).
     pub fn derivative_bound(&self) -> Option<DVec3> {
         speed_bound(&self.knots, &self.points, 1, 1)
     }

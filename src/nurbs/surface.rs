@@ -137,7 +137,7 @@ impl NurbsSurface {
         self.points.iter().map(|h| h.truncate() / h.w)
     }
 
-    /// Bounds of `|S_u|` and `|S_v|` over the whole domain ([`speed_bound`]
+    /// Bounds of `|S_u|` and `|S_v|` over the whole domain (`speed_bound`
     /// along each direction); `None` for a non-positive or non-finite weight.
     pub fn derivative_bounds(&self) -> Option<[f64; 2]> {
         let nv = self.kv.control_count();
