@@ -137,15 +137,44 @@ fn border_uses(faces: &[FaceWork<'_>]) -> Uses {
 /// both sides of a shared edge carry the same nodes. Returns the border
 /// uses after it ([`border_uses`]).
 fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) -> Uses {
-    /// Border nodes walked from one shared node towards the next, at most.
-    const STEPS: usize = 24;
     let uses = border_uses(faces);
-    // Every walk below starts on an edge no other face uses: where there is
-    // none (a closed shell), there is nothing to close, and the tables of
+    // Every walk starts on an edge no other face uses: where there is none
+    // (a closed shell), there is nothing to close, and the tables of
     // neighbours were most of the stage's time on a drilled plate.
     if uses.values().all(|l| l.len() != 1) {
         return uses;
     }
+    // The planning's tables are gone before the splits, and the uses before
+    // they are taken again: the peak of a large model's mesh phase is here.
+    let junctions = t_junctions(faces, &uses);
+    // Unchanged borders keep their uses.
+    if take_their_nodes(faces, junctions, sew) {
+        drop(uses);
+        border_uses(faces)
+    } else {
+        uses
+    }
+}
+
+/// A stretch of one face's border between two nodes it shares with another
+/// face whose border there carries other nodes.
+struct Junction {
+    /// The face whose border takes the other's nodes.
+    face: usize,
+    /// Its border's vertices from one shared node to the next.
+    run: Vec<u32>,
+    /// The larger of the two faces' gaps at the shared nodes.
+    gap: f64,
+    /// The other face's nodes in between: id and position.
+    nodes: Vec<(u32, DVec3)>,
+}
+
+/// The T-junctions of [`close_t_junctions`]: per pair of faces, each
+/// stretch of border, over edges no other face shares, between two nodes
+/// both faces have.
+fn t_junctions(faces: &[FaceWork<'_>], uses: &Uses) -> Vec<Junction> {
+    /// Border nodes walked from one shared node towards the next, at most.
+    const STEPS: usize = 24;
     let lonely = |ga: u32, gb: u32| uses.get(&node_key(ga, gb)).is_some_and(|l| l.len() == 1);
     // Per (face, node id): the border neighbours' ids; per node id: (face,
     // vertex). From the border uses, in face and edge order.
@@ -184,10 +213,7 @@ fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) -> Uses {
         }
         None
     };
-    // (face, its border's vertices from one shared node to the next, the
-    // gap at those two, the other face's nodes between: id and position).
-    type Plan = (usize, Vec<u32>, f64, Vec<(u32, DVec3)>);
-    let mut plans: Vec<Plan> = Vec::new();
+    let mut junctions: Vec<Junction> = Vec::new();
     let mut seen = crate::collections::HashSet::default();
     let mut starts: Vec<(u32, u32)> = around.keys().copied().collect();
     crate::sort::pairs(&mut starts);
@@ -215,17 +241,21 @@ fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) -> Uses {
                 let gap =
                     |id: u32| Some(f.mesh.pos[place(id, fa)? as usize].distance(g.mesh.pos[place(id, fb)? as usize]));
                 if let (Some(run), Some(nodes), Some(g0), Some(g1)) = (run, nodes, gap(ga), gap(gb)) {
-                    plans.push((fa as usize, run, g0.max(g1), nodes));
+                    junctions.push(Junction { face: fa as usize, run, gap: g0.max(g1), nodes });
                 }
             }
         }
     }
-    // The tables go before the splits, and the uses before they are taken
-    // again: the peak of a large model's mesh phase is here.
-    drop((around, holders, seen));
+    junctions
+}
+
+/// Each junction's face takes the other face's nodes on its border, where
+/// all of them run along it within the sewing distance `sew`; returns
+/// whether any border edge was split.
+fn take_their_nodes(faces: &mut [FaceWork<'_>], junctions: Vec<Junction>, sew: f64) -> bool {
     let mut split = false;
-    for (fa, mut run, gap, nodes) in plans {
-        let f = &mut faces[fa];
+    for Junction { face, mut run, gap, nodes } in junctions {
+        let f = &mut faces[face];
         // Per edge of the run from `from` on: its index, the fraction of its
         // border point nearest `p`, that point's distance and the distance
         // allowed (about as far off as the shared end nodes are).
@@ -265,13 +295,7 @@ fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) -> Uses {
             split = true;
         }
     }
-    // Unchanged borders keep their uses.
-    if split {
-        drop(uses);
-        border_uses(faces)
-    } else {
-        uses
-    }
+    split
 }
 
 /// The fraction from `a` of the point of the exact border under edge `a-b`
