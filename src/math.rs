@@ -58,3 +58,10 @@ pub(crate) fn angle_between(a: glam::DVec3, b: glam::DVec3) -> f64 {
     }
     atan2(a.cross(b).length(), a.dot(b))
 }
+
+/// Twice the area over the longest side: how wide a triangle is (a sliver
+/// between faces is narrow however long).
+pub(crate) fn triangle_width(p: [glam::DVec3; 3]) -> f64 {
+    let longest = (0..3).map(|k| p[k].distance(p[(k + 1) % 3])).fold(0.0, f64::max);
+    (p[1] - p[0]).cross(p[2] - p[0]).length() / longest.max(f64::MIN_POSITIVE)
+}

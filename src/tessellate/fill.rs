@@ -89,7 +89,7 @@ fn remove_flaps(faces: &mut [FaceWork<'_>], width: f64) -> usize {
                     continue;
                 }
                 let p = v.map(|x| m.pos[x as usize]);
-                if width_of(p) > width || m.tris.iter().filter(|w| w.contains(&apex)).count() != 1 {
+                if crate::math::triangle_width(p) > width || m.tris.iter().filter(|w| w.contains(&apex)).count() != 1 {
                     continue;
                 }
                 flaps.push(t);
@@ -166,12 +166,6 @@ fn pos_of(faces: &[FaceWork<'_>], s: &Side, g: u32) -> DVec3 {
     faces[s.face as usize].mesh.pos[(if s.ga == g { s.a } else { s.b }) as usize]
 }
 
-/// Twice the area over the longest side: how wide a triangle is.
-fn width_of(p: [DVec3; 3]) -> f64 {
-    let longest = (0..3).map(|k| p[k].distance(p[(k + 1) % 3])).fold(0.0, f64::max);
-    (p[1] - p[0]).cross(p[2] - p[0]).length() / longest.max(f64::MIN_POSITIVE)
-}
-
 /// Three-sided holes.
 fn close_triangles(faces: &mut [FaceWork<'_>], open: &[Side], at_node: &HashMap<u32, Vec<usize>>, width: f64) -> usize {
     let mut used = alloc::vec![false; open.len()];
@@ -198,7 +192,7 @@ fn close_triangles(faces: &mut [FaceWork<'_>], open: &[Side], at_node: &HashMap<
             }
             let p = [pos_of(faces, &s1, n1), pos_of(faces, &s2, n2), pos_of(faces, &s3, n3)];
             let len = [p[0].distance(p[1]), p[1].distance(p[2]), p[2].distance(p[0])];
-            if width_of(p) > width {
+            if crate::math::triangle_width(p) > width {
                 continue;
             }
             // Into the face along whose border it lies longest, else the next.
@@ -290,7 +284,7 @@ fn ear(p: &[DVec3], first: usize, width: f64) -> Option<usize> {
         let m = if chosen.is_none() { first } else { (0..n).max_by(|&x, &y| side(x).total_cmp(&side(y)))? };
         let (x, y, z, w) = (ring[m], ring[(m + 1) % n], ring[(m + 2) % n], ring[(m + n - 1) % n]);
         let (far, drop) = if n == 3 || p[x].distance(p[z]) <= p[y].distance(p[w]) { (z, (m + 1) % n) } else { (w, m) };
-        if width_of([p[x], p[y], p[far]]) > width {
+        if crate::math::triangle_width([p[x], p[y], p[far]]) > width {
             return None;
         }
         chosen.get_or_insert(far);

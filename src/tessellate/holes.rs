@@ -51,7 +51,7 @@ pub(crate) fn close_short_holes(
                 continue;
             }
             let p = hole.map(|g| joins.pos[g as usize]);
-            if width_of(p) > width {
+            if crate::math::triangle_width(p) > width {
                 continue;
             }
             // The shortest side first; its ends each way round.
@@ -73,12 +73,6 @@ pub(crate) fn close_short_holes(
     }
     joins.write_back(mesh);
     moved_most
-}
-
-/// Twice the area over the longest side: how wide a triangle is.
-fn width_of(p: [DVec3; 3]) -> f64 {
-    let longest = (0..3).map(|k| p[k].distance(p[(k + 1) % 3])).fold(0.0, f64::max);
-    (p[1] - p[0]).cross(p[2] - p[0]).length() / longest.max(f64::MIN_POSITIVE)
 }
 
 /// The mesh's triangles over welded points, as joins change them.
@@ -136,7 +130,7 @@ impl Joins {
         let point = |v: u32| map.get(v as usize).copied().unwrap_or(0);
         let tris: Vec<[u32; 3]> =
             mesh.indices.chunks_exact(3).map(|t| [point(t[0]), point(t[1]), point(t[2])]).collect();
-        let alive = tris.iter().map(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0]).collect();
+        let alive = tris.iter().map(|&t| three_points(t)).collect();
         Self {
             map,
             parent: (0..n as u32).collect(),
@@ -314,11 +308,8 @@ impl Joins {
         for r in &mesh.face_ranges {
             let first = (indices.len() / 3) as u32;
             for t in r.first as usize..(r.first + r.count) as usize {
-                // A triangle already without area in the mesh stays as it was.
-                let had_area = self.tris[t][0] != self.tris[t][1]
-                    && self.tris[t][1] != self.tris[t][2]
-                    && self.tris[t][2] != self.tris[t][0];
-                if self.alive[t] || !had_area {
+                // A triangle the weld already collapsed stays as it was.
+                if self.alive[t] || !three_points(self.tris[t]) {
                     indices.extend_from_slice(&mesh.indices[3 * t..3 * t + 3]);
                 }
             }
@@ -327,6 +318,11 @@ impl Joins {
         mesh.indices = indices;
         mesh.face_ranges = ranges;
     }
+}
+
+/// Whether a triangle's corners are three welded points (not collapsed by the weld).
+fn three_points(t: [u32; 3]) -> bool {
+    t[0] != t[1] && t[1] != t[2] && t[2] != t[0]
 }
 
 /// The facet normal of a triangle, not normalized.

@@ -542,12 +542,23 @@ fn fuzz_timeout_folded_sheet_meshes_without_exploding() {
 /// vertex. It reads and meshes within its tolerance and the fuzz budget.
 #[test]
 fn fuzz_timeout_stacked_triangles_mesh_within_budget() {
-    let model = read_step(&data("step_fuzz_timeout_census.stp")).unwrap();
+    let rep = mesh_as_the_fuzz_target("step_fuzz_timeout_census.stp").report;
+    assert!(rep.triangles > 0 && rep.triangles < 20_000, "{} triangles", rep.triangles);
+}
+
+/// Reads a file of tests/data and meshes it as the STEP fuzz target does
+/// (relative tolerance 0.05, 5000 triangles), within its tolerance.
+fn mesh_as_the_fuzz_target(name: &str) -> MeshResult {
+    let model = read_step(&data(name)).unwrap();
     let options = MeshOptions::default().with_relative_tolerance(0.05).with_max_triangles(5_000);
     let r = mesh_model(&model, &options).expect("meshes");
-    let rep = &r.report;
-    assert!(rep.triangles > 0 && rep.triangles < 20_000, "{} triangles", rep.triangles);
-    assert!(rep.max_deviation <= rep.tolerance, "deviation {} > {}", rep.max_deviation, rep.tolerance);
+    assert!(
+        r.report.max_deviation <= r.report.tolerance,
+        "deviation {} > {}",
+        r.report.max_deviation,
+        r.report.tolerance
+    );
+    r
 }
 
 /// Found by fuzzing (a debug build's invariant check): a face whose loop
@@ -559,12 +570,8 @@ fn fuzz_timeout_stacked_triangles_mesh_within_budget() {
 /// debug build checks it after each stage).
 #[test]
 fn fuzz_pinched_loop_meshes_without_flat_triangles() {
-    let model = read_step(&data("step_fuzz_pinched_loop.stp")).unwrap();
-    let options = MeshOptions::default().with_relative_tolerance(0.05).with_max_triangles(5_000);
-    let r = mesh_model(&model, &options).expect("meshes");
-    let rep = &r.report;
-    assert!(rep.triangles > 0, "{} triangles", rep.triangles);
-    assert!(rep.max_deviation <= rep.tolerance, "deviation {} > {}", rep.max_deviation, rep.tolerance);
+    let r = mesh_as_the_fuzz_target("step_fuzz_pinched_loop.stp");
+    assert!(r.report.triangles > 0, "{} triangles", r.report.triangles);
     // No triangle without area: the flat ones were three points on one line.
     let m = &r.mesh;
     for t in m.indices.chunks_exact(3) {
