@@ -10,6 +10,11 @@ use super::region::{sample_face, FacePlan};
 use crate::model::Face;
 use crate::nurbs::{project_to_surface, Aabb, ProjectionOptions, Surface};
 
+/// Faces this near each other, as a fraction of the model's size, are
+/// equally near a triangle: coincident faces, as where two parts of an
+/// assembly touch (projection itself is far more accurate than this).
+const COINCIDENT: f64 = 1e-6;
+
 /// One surface sample.
 #[derive(Debug, Clone, Copy)]
 struct Sample {
@@ -90,10 +95,20 @@ impl<'a> SurfaceIndex<'a> {
     /// Distances from `points` (all on the triangle `corners`) to the closest
     /// point over all faces, written into `out`. Each distance is that of an
     /// actual surface point, so it can over-state but never hide a deviation.
-    /// Infinite when the model has no samples.
-    pub(crate) fn distances(&mut self, corners: &[DVec3; 3], points: &[DVec3], out: &mut Vec<f64>) {
+    /// Infinite when the model has no samples. `near` gets the faces nearest
+    /// the triangle's centroid: the nearest and those no more than a
+    /// millionth of the model's size farther (coincident faces), only those
+    /// whose normal the triangle's agrees with when there are such.
+    pub(crate) fn distances(
+        &mut self,
+        corners: &[DVec3; 3],
+        points: &[DVec3],
+        out: &mut Vec<f64>,
+        near: &mut Vec<u32>,
+    ) {
         out.clear();
         out.resize(points.len(), f64::INFINITY);
+        near.clear();
         let c = (corners[0] + corners[1] + corners[2]) / 3.0;
         let reach = corners.iter().map(|p| p.distance(c)).fold(0.0, f64::max);
         if !(c.is_finite() && reach.is_finite()) {
@@ -140,6 +155,16 @@ impl<'a> SurfaceIndex<'a> {
         }
         for &f in &self.touched {
             self.nearest[f as usize] = (f64::INFINITY, 0);
+        }
+        // Of coincident faces, those facing the triangle's way: where two
+        // parts touch, their faces there face each other.
+        let slack = COINCIDENT * self.bbox.diagonal();
+        let facet = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+        let nearest =
+            || self.candidates.iter().zip(&dist_c).filter(|(_, &dc)| dc <= best + slack).map(|(cand, _)| cand);
+        near.extend(nearest().filter(|cand| cand.su.cross(cand.sv).dot(facet) > 0.0).map(|cand| cand.face));
+        if near.is_empty() {
+            near.extend(nearest().map(|cand| cand.face));
         }
         for (cand, &dc) in self.candidates.iter().zip(&dist_c) {
             if dc - reach > best + reach {

@@ -21,6 +21,7 @@
 //! projections (their own stopping tolerance); vertices weld within a
 //! thousandth of the tolerance unless given; no exact predicates.
 
+mod bodies;
 mod bvh;
 mod index;
 mod region;
@@ -35,6 +36,7 @@ use serde::Serialize;
 use crate::mesh::{angle_stats, edge_counts_around_skipped, weld_positions, FaceRange, Mesh};
 use crate::model::Model;
 use crate::nurbs::{Aabb, ProjectionOptions};
+use bodies::BodyVotes;
 use bvh::{closest_on_triangle, Bvh};
 use index::SurfaceIndex;
 use region::{sample_face, spacing, FacePlan};
@@ -177,6 +179,9 @@ pub fn measure_mesh(model: &Model, mesh: &Mesh, options: &MeasureOptions) -> Mes
     let mut points: Vec<DVec3> = Vec::new();
     let mut dist: Vec<f64> = Vec::new();
     let mut sum = 0.0;
+    // Per triangle, the model faces nearest its centroid: which body it is on.
+    let mut near: Vec<u32> = Vec::new();
+    let mut votes = BodyVotes::new(model, &mesh);
     for t in 0..mesh.triangle_count() {
         let corners = mesh.triangle(t);
         points.clear();
@@ -186,7 +191,8 @@ pub fn measure_mesh(model: &Model, mesh: &Mesh, options: &MeasureOptions) -> Mes
                 points.push(corners[0] * (1.0 - b - c) + corners[1] * b + corners[2] * c);
             }
         }
-        index.distances(&corners, &points, &mut dist);
+        index.distances(&corners, &points, &mut dist, &mut near);
+        votes.add(t, &near);
         for &d in &dist {
             out.max_deviation = out.max_deviation.max(d);
             sum += d;
@@ -202,7 +208,8 @@ pub fn measure_mesh(model: &Model, mesh: &Mesh, options: &MeasureOptions) -> Mes
 
     let weld = options.weld.filter(|w| *w > 0.0 && w.is_finite()).unwrap_or(1e-3 * tolerance);
     // Edges along faces the reader skipped are cracks, as the mesher counts them.
-    let edges = edge_counts_around_skipped(&mesh, &[], &model.skipped, weld, tolerance);
+    let bodies = votes.bodies(&mesh, weld);
+    let edges = edge_counts_around_skipped(&mesh, &bodies, &model.skipped, weld, tolerance);
     out.boundary_edges = edges.boundary_edges;
     out.free_edges = edges.free_edges;
     out.nonmanifold_edges = edges.nonmanifold_edges;

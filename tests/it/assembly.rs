@@ -7,7 +7,7 @@ use std::collections::{HashMap, HashSet};
 use glam::{DAffine3, DMat3, DVec3};
 use surfmesh::{
     edge_lines, flatten, measure_mesh, mesh_instanced, mesh_model, read_model, read_step_parts, Assembly, EdgeLines,
-    Format, MeasureOptions, Mesh, MeshOptions, Units,
+    FaceRange, Format, MeasureOptions, Mesh, MeshOptions, Units,
 };
 
 use crate::corpus_files::{corpus_bytes, corpus_names};
@@ -247,4 +247,41 @@ fn edge_lines_of_the_as1_parts_placed_are_the_flattened_meshs_borders() {
     for (p, part) in r.parts.iter().enumerate() {
         check_lines(&format!("part {p}"), &part.mesh, &edge_lines(&part.mesh));
     }
+}
+
+/// The mesh with its faces in reverse order, as another mesher might number
+/// them: each face's triangles kept together, the ranges renumbered.
+fn faces_reversed(mesh: &Mesh) -> Mesh {
+    let mut out = Mesh { positions: mesh.positions.clone(), ..Mesh::default() };
+    for r in mesh.face_ranges.iter().rev() {
+        let first = out.indices.len() as u32 / 3;
+        let (a, b) = (3 * r.first as usize, 3 * (r.first + r.count) as usize);
+        out.indices.extend_from_slice(&mesh.indices[a..b]);
+        out.face_ranges.push(FaceRange { first, count: r.count });
+    }
+    out
+}
+
+#[test]
+fn the_yardstick_counts_edges_per_body_where_two_parts_touch() {
+    // Two blocks of one part, the second stacked on the first: the top of
+    // one lies on the bottom of the other, border on border.
+    let bytes = include_bytes!("../data/step_touching_blocks.stp");
+    let mut model = read_model(bytes, Format::Step).unwrap();
+    let bodies: HashSet<u32> = model.bodies.iter().copied().collect();
+    assert_eq!((model.faces.len(), bodies.len()), (12, 2));
+    let r = mesh_model(&model, &MeshOptions::default()).unwrap();
+    assert_eq!((r.report.free_edges, r.report.nonmanifold_edges), (0, 0));
+    let options = MeasureOptions::default().with_tolerance(r.report.tolerance);
+    // In the mesher's own face order and in another, the same count as
+    // the mesher's report: no edge shared across the contact.
+    for mesh in [r.mesh.clone(), faces_reversed(&r.mesh)] {
+        let m = measure_mesh(&model, &mesh, &options);
+        assert_eq!((m.free_edges, m.nonmanifold_edges, m.boundary_edges), (0, 0, 0));
+        assert!(m.max_deviation <= r.report.tolerance);
+    }
+    // Welded as one body, the contact's borders are edges of four triangles.
+    model.bodies.clear();
+    let m = measure_mesh(&model, &r.mesh, &options);
+    assert!(m.nonmanifold_edges >= 4, "{} non-manifold edges", m.nonmanifold_edges);
 }
