@@ -97,8 +97,9 @@ impl<'a> SurfaceIndex<'a> {
     /// actual surface point, so it can over-state but never hide a deviation.
     /// Infinite when the model has no samples. `near` gets the faces nearest
     /// the triangle's centroid: the nearest and those no more than a
-    /// millionth of the model's size farther (coincident faces), only those
-    /// whose normal the triangle's agrees with when there are such.
+    /// millionth of the model's size farther (coincident faces), on their
+    /// trimmed regions as the samples tell, only those whose normal the
+    /// triangle's agrees with when there are such.
     pub(crate) fn distances(
         &mut self,
         corners: &[DVec3; 3],
@@ -140,6 +141,7 @@ impl<'a> SurfaceIndex<'a> {
         self.candidates.clear();
         let mut best = f64::INFINITY;
         let mut dist_c: Vec<f64> = Vec::with_capacity(order.len());
+        let mut bounds: Vec<f64> = Vec::with_capacity(order.len());
         for &(bound, f) in &order {
             // dist(q, f) >= bound - reach and dist(q, best face) <= best + reach.
             if bound - reach > best + reach {
@@ -152,16 +154,20 @@ impl<'a> SurfaceIndex<'a> {
             let d = s.derivs(pr.uv);
             self.candidates.push(Candidate { face: f, uv: pr.uv, point: pr.point, su: d.su, sv: d.sv });
             dist_c.push(pr.distance);
+            bounds.push(bound);
         }
         for &f in &self.touched {
             self.nearest[f as usize] = (f64::INFINITY, 0);
         }
         // Of coincident faces, those facing the triangle's way: where two
-        // parts touch, their faces there face each other.
+        // parts touch, their faces there face each other. Two flush faces of
+        // one plane are coincident only where their samples say both are.
         let slack = COINCIDENT * self.bbox.diagonal();
         let facet = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
-        let nearest =
-            || self.candidates.iter().zip(&dist_c).filter(|(_, &dc)| dc <= best + slack).map(|(cand, _)| cand);
+        let nearest = || {
+            let within = |(_, (&dc, &bound)): &(&Candidate, (&f64, &f64))| dc.max(bound) <= best + slack;
+            self.candidates.iter().zip(dist_c.iter().zip(&bounds)).filter(within).map(|(cand, _)| cand)
+        };
         near.extend(nearest().filter(|cand| cand.su.cross(cand.sv).dot(facet) > 0.0).map(|cand| cand.face));
         if near.is_empty() {
             near.extend(nearest().map(|cand| cand.face));
