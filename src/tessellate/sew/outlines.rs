@@ -16,7 +16,7 @@ const BEYOND: f64 = -2.0;
 const PAIR_MIN: usize = 3;
 
 /// A node of some face's outline: face, loop, index.
-type NodeRef = (u32, u32, u32);
+pub(super) type NodeRef = (u32, u32, u32);
 
 /// Per face, per loop, per node.
 pub(super) type PerNode<T> = Vec<Vec<Vec<T>>>;
@@ -35,7 +35,8 @@ type Additions = PerNode<Vec<(f64, f64, NodeRef)>>;
 /// where the two run side by side and no more than four times as far as
 /// the nearest other face's border, is added to that border at its own
 /// curve's nearest point (unless it is within reach of a node there
-/// already). Then nodes within both reaches of each other get one id in
+/// already, or a narrow face lies between: [`super::across::across_faces`]).
+/// Then nodes within both reaches of each other get one id in
 /// [`Outline::gids`], and a node left alone one short segment from a
 /// shared node takes its id (a trim curve shorter than the gaps). Within
 /// one face (a seam) `tight` takes the place of `sew`: a face's loops meet
@@ -134,7 +135,7 @@ fn radii_each(pos: &PerNode<DVec3>, sew_of: &dyn Fn(NodeRef) -> f64, tight: f64)
 
 /// A node on another border's segment, to be added there: (segment,
 /// fraction, curve parameter, distance, node).
-type Candidate = (NodeRef, f64, f64, f64, NodeRef);
+pub(super) type Candidate = (NodeRef, f64, f64, f64, NodeRef);
 
 /// How near the borders of other faces run to each node, as the search
 /// for candidates saw them: the gaps that set the sewing distances, and
@@ -237,6 +238,13 @@ fn insertions(
     // additions are made, where the mesh phase of a large assembly peaked.
     let nearest_face = core::mem::take(&mut near.nearest_face);
     let (radius, sew) = sewing_distances(pos, &near.nearest, nearest_face, moved, sew, tight);
+    // A node beyond a face narrower than the sewing distance stays off the
+    // border on that face's other side (a strip keeps both its sides).
+    let r_of = |n: NodeRef| radius[n.0 as usize][n.1 as usize][n.2 as usize];
+    let limit = |c: &Candidate| if c.0 .0 == c.4 .0 { tight.min(r_of(c.4)) } else { r_of(c.4) };
+    let across =
+        super::across::across_faces(faces, bodies, pos, &grid, &cands, &limit, &r_of, mean_segment.max(reach), tight);
+    let cands = cands.into_iter().zip(across).filter_map(|(c, x)| (!x).then_some(c)).collect();
     let adds = additions(pos, &grid, cands, &near, &radius, moved, tight);
     (adds, radius, sew)
 }

@@ -1,0 +1,207 @@
+//! Insertions that would sew a border across a face (see [`across_faces`]).
+
+use alloc::vec::Vec;
+use glam::DVec3;
+
+use super::nearest_fraction;
+use super::outlines::{Candidate, NodeRef, PerNode};
+use crate::collections::CellGrid;
+use crate::numeric::guarded_div;
+use crate::nurbs::Surface;
+use crate::tessellate::face::Outline;
+
+/// Share of a candidate's distance within which a third face's border
+/// beside its point counts as lying between the node and that point.
+const BETWEEN: f64 = 0.5;
+
+/// Per candidate (a node `q` of one face to be added to another face's
+/// border at point `P`, `d` apart), whether the border of some third face of
+/// their body, or another piece of `q`'s own face's border, runs within
+/// `BETWEEN · d` of `P` but not as near `q`: that face lies between them,
+/// a strip narrower than the sewing distance, and `q` on the border would
+/// lay the border's face over it (the two overlap on the strip, and the
+/// strip's sides become a crack no join can close the right way up). Where
+/// both faces at `P` fold shut there by themselves (each has a node of its
+/// own at `q` within `tight` and its `reach` of `P`: a loop that doubles
+/// back on itself), all of them take `q` and the insertion stands.
+/// Candidates farther than `limit` (they are refused anyway) and those at
+/// nothing are not looked at. `cell`: the side of the grid's cubes.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn across_faces(
+    faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
+    bodies: &[u32],
+    pos: &PerNode<DVec3>,
+    nodes: &CellGrid<NodeRef>,
+    cands: &[Candidate],
+    limit: &dyn Fn(&Candidate) -> f64,
+    reach: &dyn Fn(NodeRef) -> f64,
+    cell: f64,
+    tight: f64,
+) -> Vec<bool> {
+    let mut across = alloc::vec![false; cands.len()];
+    let at = |n: NodeRef| pos[n.0 as usize][n.1 as usize][n.2 as usize];
+    let body = |f: u32| crate::model::body_of(bodies, f as usize);
+    // Whether face `f` folds shut at `p` by itself: a node of its own
+    // within `r` of `q` goes onto its border at `p` (no farther than
+    // `tight` and its reach), so every face there takes `q`.
+    let pinches = |f: u32, q: DVec3, p: DVec3, r: f64| {
+        let r3 = DVec3::splat(r);
+        nodes
+            .in_box(q - r3, q + r3)
+            .any(|&m| m.0 == f && at(m).distance(q) <= r && at(m).distance(p) <= tight.min(reach(m)))
+    };
+    // Each candidate looked at: its index and point on the border.
+    let mut probes: Vec<(usize, DVec3)> = Vec::new();
+    for (ci, c) in cands.iter().enumerate() {
+        let &(seg, _, t, d, q) = c;
+        if d > limit(c) || d <= 1e-9 * at(q).abs().max_element() {
+            continue;
+        }
+        let Some((surface, o)) = &faces[seg.0 as usize] else { continue };
+        let Some(poly) = o.loops.polys.get(seg.1 as usize) else { continue };
+        let Some(curve) = poly.seg.get(seg.2 as usize).and_then(|s| o.loops.curves.get(s.0 as usize)) else {
+            continue;
+        };
+        probes.push((ci, surface.point(curve.point(t).truncate())));
+    }
+    let Some(widest) = probes.iter().map(|&(ci, _)| BETWEEN * cands[ci].3).reduce(f64::max) else {
+        return across;
+    };
+    let mut grid = CellGrid::new(guarded_div(1.0, cell));
+    for (pi, &(_, p)) in probes.iter().enumerate() {
+        grid.insert(p, pi as u32);
+    }
+    for (hi, item) in faces.iter().enumerate() {
+        let Some((surface, o)) = item else { continue };
+        let h = hi as u32;
+        for (k, poly) in o.loops.polys.iter().enumerate() {
+            let ring = &pos[hi][k];
+            let n = ring.len();
+            for i in 0..n {
+                let (j, a, b) = ((i + 1) % n, ring[i], ring[(i + 1) % n]);
+                // The piece strays from its chord by at most about half its
+                // length (a semicircle's) as a loop is discretized: every
+                // point it passes near is found near its chord with that room.
+                let half = 0.5 * a.distance(b);
+                let mut probes_near = grid.near_segment(a, b, widest + half).peekable();
+                if probes_near.peek().is_none() {
+                    continue;
+                }
+                let Some(&(curve, ta, tb)) = poly.seg.get(i) else { continue };
+                let Some(c) = o.loops.curves.get(curve as usize) else { continue };
+                let on_curve = |s: f64| surface.point(c.point(ta + (tb - ta) * s).truncate());
+                // How far the piece strays from its chord: twice as far as
+                // its quarter points do (the test that discretized it).
+                let ab = b - a;
+                let off_chord = |x: DVec3| {
+                    let s0 = guarded_div((x - a).dot(ab), ab.length_squared()).clamp(0.0, 1.0);
+                    x.distance(a + ab * s0)
+                };
+                let sag = [0.25, 0.5, 0.75].map(|s| off_chord(on_curve(s))).into_iter().fold(0.0, f64::max);
+                let room = (2.0 * sag + 1e-9 * (a.abs().max_element() + b.abs().max_element())).min(half);
+                // Whether the piece passes within `r` of `x`: by its chord
+                // where the room decides, else by the nearest point.
+                let within = |x: DVec3, r: f64| {
+                    let s0 = guarded_div((x - a).dot(ab), ab.length_squared()).clamp(0.0, 1.0);
+                    let to_chord = x.distance(a + ab * s0);
+                    if to_chord - room > r {
+                        return false;
+                    }
+                    if to_chord + room < r {
+                        return true;
+                    }
+                    nearest_fraction(&|s: f64| on_curve(s).distance(x), s0).1 < r
+                };
+                for &pi in probes_near {
+                    let (ci, p) = probes[pi as usize];
+                    let (seg, _, _, d, q) = cands[ci];
+                    let mine = q.0 == h && q.1 == k as u32 && (q.2 == i as u32 || q.2 == j as u32);
+                    if across[ci] || mine || seg.0 == h || body(seg.0) != body(h) {
+                        continue;
+                    }
+                    let r = BETWEEN * d;
+                    if within(p, r) && !within(at(q), r) && !(pinches(seg.0, at(q), p, r) && pinches(h, at(q), p, r)) {
+                        across[ci] = true;
+                    }
+                }
+            }
+        }
+    }
+    across
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::nurbs::{NurbsCurve, NurbsSurface, Surface};
+    use crate::tessellate::face::Outline;
+    use crate::tessellate::sew::outlines::unify;
+    use crate::tessellate::trim::{CurveRef, Loops, Polyline};
+    use alloc::vec::Vec;
+    use glam::{DVec2, DVec3};
+
+    /// The outline of the polygon `corners` in (u,v), one straight curve and
+    /// one segment per side.
+    fn polygon(corners: &[(f64, f64)]) -> (Vec<NurbsCurve>, Vec<DVec2>) {
+        let n = corners.len();
+        let curves = (0..n)
+            .map(|i| {
+                let (p, q) = (corners[i], corners[(i + 1) % n]);
+                let pts = alloc::vec![DVec3::new(p.0, p.1, 0.0), DVec3::new(q.0, q.1, 0.0)];
+                NurbsCurve::try_new(1, alloc::vec![0.0, 0.0, 1.0, 1.0], pts, None).unwrap()
+            })
+            .collect();
+        (curves, corners.iter().map(|&(u, v)| DVec2::new(u, v)).collect())
+    }
+
+    fn outline<'a>(curves: &'a [NurbsCurve], uv: &[DVec2]) -> Outline<'a> {
+        let mut poly = Polyline::default();
+        for (i, &q) in uv.iter().enumerate() {
+            poly.uv.push(q);
+            poly.at.push(CurveRef { curve: i as u32, t: 0.0 });
+            poly.seg.push((i as u32, 0.0, 1.0));
+        }
+        let gids = alloc::vec![alloc::vec![u32::MAX; poly.uv.len()]];
+        let loops = Loops { polys: alloc::vec![poly], curves: curves.iter().collect(), mended: None };
+        Outline { loops, pu: alloc::vec![0.0, 3.0], pv: alloc::vec![0.0, 12.0], gids }
+    }
+
+    /// Three faces of one plane side by side: `f` up to u = 1, a strip 0.3
+    /// wide beyond it whose lower end is slanted, and `g` beyond the strip.
+    /// `g`'s corner at the strip's far end lies 0.3 from `f`'s border, within
+    /// the sewing distance and the model's precision (`tight`), but the strip
+    /// lies between: `f` must not take that corner (it would run over the
+    /// strip's end, the two faces overlapping there), while it does take the
+    /// strip's corner that lies on its border.
+    #[test]
+    fn a_node_is_not_sewn_across_a_narrow_face() {
+        let pts: Vec<Vec<DVec3>> = alloc::vec![
+            alloc::vec![DVec3::ZERO, DVec3::new(0.0, 12.0, 0.0)],
+            alloc::vec![DVec3::new(3.0, 0.0, 0.0), DVec3::new(3.0, 12.0, 0.0)],
+        ];
+        let plane = NurbsSurface::try_new(
+            [1, 1],
+            alloc::vec![0.0, 0.0, 3.0, 3.0],
+            alloc::vec![0.0, 0.0, 12.0, 12.0],
+            &pts,
+            None,
+        )
+        .unwrap();
+        let (fc, fuv) = polygon(&[(0.0, 0.0), (1.0, 0.0), (1.0, 12.0), (0.0, 12.0)]);
+        let (hc, huv) = polygon(&[(1.0, 0.8), (1.3, 1.0), (1.3, 11.0), (1.0, 11.0)]);
+        let (gc, guv) = polygon(&[(1.3, 1.0), (3.0, 1.0), (3.0, 11.0), (1.3, 11.0)]);
+        let (mut f, mut h, mut g) = (outline(&fc, &fuv), outline(&hc, &huv), outline(&gc, &guv));
+        {
+            let s = &plane as &dyn Surface;
+            let mut faces = alloc::vec![Some((s, &mut f)), Some((s, &mut h)), Some((s, &mut g))];
+            unify(&mut faces, &[], &[0.0; 3], 0.5, 0.4, 1.0);
+        }
+        let ids = |o: &Outline<'_>, far: bool| -> Vec<u32> {
+            o.loops.polys[0].uv.iter().zip(&o.gids[0]).filter(|(q, _)| (q.x > 1.2) == far).map(|(_, &g)| g).collect()
+        };
+        let beyond: Vec<u32> = ids(&h, true).into_iter().chain(ids(&g, true)).collect();
+        let mine = ids(&f, false);
+        assert!(mine.iter().all(|id| !beyond.contains(id)), "f {mine:?} takes a node of {beyond:?}");
+        // The strip's near corners are f's nodes too: the two are sewn.
+        assert!(ids(&h, false).iter().all(|id| mine.contains(id)), "{:?} {mine:?}", ids(&h, false));
+    }
+}
