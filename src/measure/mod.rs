@@ -14,8 +14,11 @@
 //!   (a grid inside each face's trim loops, by the even-odd rule over their
 //!   polylines, and points on the loops) to the mesh, through a BVH over the
 //!   triangles. Holes and dropped faces show up here and nowhere else.
-//! - **Edges** after welding coincident vertices ([`crate::edge_counts`]) and
-//!   **angles** ([`crate::angle_stats`]).
+//! - **Edges** after welding coincident vertices ([`crate::edge_counts`]),
+//!   per body of the model as the mesher's own report counts them: each face
+//!   range's body is found from the model faces nearest its triangles
+//!   (`bodies.rs`), since another program numbers its faces its own way.
+//! - **Angles** ([`crate::angle_stats`]).
 //!
 //! Numbers ([`crate::numeric`]): distances are floats from Newton
 //! projections (their own stopping tolerance); vertices weld within a
