@@ -164,7 +164,7 @@ impl WorkMesh {
         b: u32,
         taken: &crate::collections::HashSet<(u32, u32)>,
     ) -> Option<(u32, Option<(u32, u32)>)> {
-        let &adj = self.edges.get(&key(a, b))?;
+        let &adj = self.pair(a, b)?;
         let u = if adj[0] == t { adj[1] } else { adj[0] };
         if u == NONE || (adj[0] != t && adj[1] != t) || self.trim.contains_key(&key(a, b)) {
             return None;
@@ -221,7 +221,7 @@ impl WorkMesh {
         if self.trim.contains_key(&key(a, b)) {
             return None;
         }
-        let &adj = self.edges.get(&key(a, b))?;
+        let &adj = self.pair(a, b)?;
         let u = if adj[0] == t { adj[1] } else { adj[0] };
         if u == NONE || adj[0] != t && adj[1] != t {
             return None;
@@ -285,7 +285,7 @@ impl WorkMesh {
             let tv = self.tris[cur as usize];
             let k = tv.iter().position(|&v| v == x)?;
             let z = tv[(k + 1) % 3];
-            let &adj = self.edges.get(&key(x, z))?;
+            let &adj = self.pair(x, z)?;
             let next = if adj[0] == cur { adj[1] } else { adj[0] };
             if next == NONE || next == cur {
                 return None;
@@ -380,7 +380,7 @@ impl WorkMesh {
         crate::sort::by_f64(&mut around, |&a| self.pos[a as usize].distance(here));
         let sense: f64 = ring.iter().map(|&t| uv_area(self.uv(t as usize))).sum();
         'candidates: for &y in &around {
-            let &gone = self.edges.get(&key(x, y))?;
+            let &gone = self.pair(x, y)?;
             // y's (u,v), the same in both triangles of the edge (one chart).
             let at = |m: &Self, t: u32| {
                 let tv = m.tris[t as usize];
