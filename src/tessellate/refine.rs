@@ -20,7 +20,7 @@ mod mend;
 
 pub(crate) use check::Known;
 pub(crate) use edges::EdgeList;
-pub(crate) use limits::{Criteria, Lift, Outcome};
+pub(crate) use limits::{Criteria, Lift, Outcome, FOLD_TURN};
 use limits::{Packed, STALE};
 pub(crate) use mend::count_folded;
 
