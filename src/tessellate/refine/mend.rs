@@ -8,9 +8,9 @@ use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
 use super::{key, uv_area, Criteria, TriMeasure, WorkMesh, NONE, STALE};
-#[cfg(feature = "std")]
-use crate::nurbs::project_to_surface;
 use crate::nurbs::Surface;
+#[cfg(feature = "std")]
+use crate::nurbs::{project_to_surface, regular_normal};
 
 /// The smallest angle below which [`WorkMesh::improve_angles`] looks for a
 /// better diagonal (radians, 15°): wider pairs gain little for the measuring.
@@ -522,6 +522,33 @@ impl WorkMesh {
     pub fn centroid_normal(&self, surface: &dyn Surface, t: usize) -> DVec3 {
         let uv = self.uv(t);
         surface.normal((uv[0] + uv[1] + uv[2]) / 3.0)
+    }
+
+    /// [`Self::centroid_normal`], but where the facet opposes it and the
+    /// surface turns over inside the triangle (two corners' normals, seen
+    /// from inside, face apart: a fold or pleat, where the control net
+    /// doubles back), the normal of a corner the facet agrees with. Such a
+    /// triangle has no one surface normal: it lies along one of the sheets
+    /// it spans, and is turned over only if it faces away from all of them.
+    pub fn judged_normal(&self, surface: &dyn Surface, t: usize) -> DVec3 {
+        let n = self.centroid_normal(surface, t);
+        let v = self.tris[t];
+        let p = v.map(|x| self.pos[x as usize]);
+        let facet = (p[1] - p[0]).cross(p[2] - p[0]);
+        if facet.dot(n) >= 0.0 {
+            return n;
+        }
+        let uv = self.uv(t);
+        let centre = (uv[0] + uv[1] + uv[2]) / 3.0;
+        let corners: [Option<DVec3>; 3] = core::array::from_fn(|k| {
+            [1e-6, 1e-4, 1e-2].iter().find_map(|f| regular_normal(&surface.derivs(uv[k] + (centre - uv[k]) * *f)))
+        });
+        let [Some(a), Some(b), Some(c)] = corners else { return n };
+        let turns_over = a.dot(b) < 0.0 || b.dot(c) < 0.0 || c.dot(a) < 0.0;
+        match [a, b, c].into_iter().find(|m| facet.dot(*m) > 0.0) {
+            Some(m) if turns_over => m,
+            _ => n,
+        }
     }
 
     /// Closes a small hole beside border edge `a-b` (run a→b by its one
