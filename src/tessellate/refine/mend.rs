@@ -8,9 +8,9 @@ use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
 use super::{key, uv_area, Criteria, TriMeasure, WorkMesh, NONE, STALE};
-use crate::nurbs::Surface;
 #[cfg(feature = "std")]
-use crate::nurbs::{project_to_surface, regular_normal};
+use crate::nurbs::project_to_surface;
+use crate::nurbs::{regular_normal, Surface};
 
 /// The smallest angle below which [`WorkMesh::improve_angles`] looks for a
 /// better diagonal (radians, 15°): wider pairs gain little for the measuring.
