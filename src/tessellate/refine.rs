@@ -87,9 +87,9 @@ pub(crate) struct WorkMesh {
     pub events: Vec<(u32, u32, u32)>,
     /// Edges of more than two triangles (sewing that passes a loop through
     /// one node twice), found as they are attached: the edge table holds
-    /// two of their triangles, so they are never split, flipped or
-    /// collapsed (a split halved the two listed triangles and left the
-    /// third on an edge no table had).
+    /// two of their triangles, so a split of one halves those two and the
+    /// table then lists the others on it (before, they were left on an
+    /// edge no table had), and none is flipped or collapsed.
     crowded: crate::collections::HashSet<(u32, u32)>,
     /// Cached measure and normal turn of each triangle; [`STALE`] (a NaN
     /// distance) marks one changed since measured, which saves an `Option`'s
@@ -370,7 +370,8 @@ impl WorkMesh {
 
     /// The two triangles the edge table lists on edge `a-b` (one and
     /// `NONE` on a border edge), or None where it has none or is crowded
-    /// (more than two: see `crowded`), for what changes the triangles on it.
+    /// (more than two: see `crowded`), for the flips, moves and walks that
+    /// take an edge for two triangles.
     fn pair(&self, a: u32, b: u32) -> Option<&[u32; 2]> {
         if !self.crowded.is_empty() && self.crowded.contains(&key(a, b)) {
             return None;
@@ -568,7 +569,16 @@ impl WorkMesh {
         }
         let adj = match on_rim {
             Some(t) => [t, NONE],
-            None => *self.pair(a, b)?,
+            None => *self.edges.get(&key(a, b))?,
+        };
+        // A crowded edge's triangles the table does not list (found by a
+        // walk: rare) keep the edge, and the table lists them on it after.
+        let unlisted: Vec<u32> = if !self.crowded.is_empty() && self.crowded.contains(&key(a, b)) {
+            let on = |t: &[u32; 3]| t.contains(&a) && t.contains(&b);
+            let listed = |i: u32| adj.contains(&i);
+            (0..self.tris.len() as u32).filter(|&i| !listed(i) && on(&self.tris[i as usize])).collect()
+        } else {
+            Vec::new()
         };
         let trim = self.trim.get(&key(a, b)).copied();
         // The split's (u,v) and the curve parameters at a, the split and b.
@@ -591,6 +601,12 @@ impl WorkMesh {
             return None;
         }
         let m = self.apply_split(a, b, p, normal, plan, out);
+        if !unlisted.is_empty() {
+            self.crowded.remove(&key(a, b));
+            for t in unlisted {
+                self.attach(a, b, t);
+            }
+        }
         if let (Some(te), Some((_, ta, tm, tb))) = (trim, trim_at) {
             self.trim.remove(&key(a, b));
             self.mark_trim(a, m, te.curve, ta, tm);

@@ -91,8 +91,10 @@ impl fmt::Display for Broken {
 pub(crate) struct Known {
     /// Edges of more than two triangles: sewing that passes one loop
     /// through a node twice (trj3_s1-al-214 and trj7_b1-ec-214 at 1e-2;
-    /// OCC131-3 of the wide corpus). Such an edge is never split, flipped
-    /// or collapsed (a split of one left the rim a border edge short).
+    /// OCC131-3 of the wide corpus). A split of such an edge halves the
+    /// two triangles the edge table lists and the table then lists the
+    /// third on it (it was left on an edge no table had, and the rim came
+    /// out a border edge short); none is flipped or collapsed.
     pub non_manifold: bool,
     /// Triangles flat or clockwise in (u,v): mending's flips and moves
     /// (trj3_s1-al-214, trj7_b1-ec-214, ship_kcs, trj6_pm4-ec-203), and
@@ -313,9 +315,9 @@ mod tests {
     }
 
     /// An edge of three triangles (sewing passed a loop through one node
-    /// twice), which the edge table holds two of, is not split or flipped:
-    /// a split made the two listed triangles' halves and left the third on
-    /// an edge no table had, and the rim came out a border edge short.
+    /// twice), which the edge table holds two of, keeps the tables through
+    /// a split and refinement: a split of the two listed triangles left the
+    /// third on an edge no table had, and the rim came out a border edge short.
     #[test]
     fn an_edge_of_three_triangles_keeps_the_tables() {
         let s = analytic::xy_plane(10.0);
@@ -330,8 +332,9 @@ mod tests {
         assert!(matches!(m.check_invariants(), Err(Broken::NonManifold { .. })));
         assert_eq!(m.check_tables(), Ok(()));
         let mut out = Vec::new();
-        m.split_edge_at(&s, &curves, v[0], v[1], 0.5, None, &mut out);
+        let mid = m.split_edge_at(&s, &curves, v[0], v[1], 0.5, None, &mut out);
         assert_eq!(m.check_tables(), Ok(()), "after the split");
+        assert!(mid.is_some(), "the edge was split");
         m.rest();
         assert_eq!(m.check_tables(), Ok(()), "at rest");
         let c = Criteria { max_edge: 0.3, ..Criteria::PLANE_TEST };
