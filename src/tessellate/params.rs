@@ -14,6 +14,7 @@
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
+use super::refine::FOLD_TURN;
 use crate::math::{ceil, sqrt};
 use crate::nurbs::Surface;
 
@@ -56,6 +57,26 @@ fn interval_need(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Lim
 /// short intervals the demand adds up along the curve. 0 at or below the
 /// shortest edge. With `one_sided`, see [`Probe::one_sided`].
 fn interval_demand(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits, one_sided: bool) -> (f64, f64) {
+    let d = demand_parts(eval, a, b, lim, one_sided);
+    (d.smooth.max(d.fold), d.sag)
+}
+
+/// An interval's demand in two parts: what falls with the step (sag, a
+/// turn that spreads over the interval, length), and a turn past a right
+/// angle within a quarter of it: a fold of the surface (a pleat, where the
+/// control net doubles back and the normal reverses within a band far
+/// narrower than any interval; on a curve across it, a cusp), which no
+/// equal split of a longer interval lowers where it is. Over a chord
+/// within the tolerance a fold asks for nothing, as refinement stops there
+/// too (`Criteria::short_for_angle`).
+struct Demand {
+    smooth: f64,
+    fold: f64,
+    sag: f64,
+}
+
+/// [`interval_demand`] with the fold's part apart ([`Demand`]).
+fn demand_parts(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits, one_sided: bool) -> Demand {
     let (pa, na) = eval(a);
     let (pb, nb) = eval(b);
     let chord = pb - pa;
@@ -73,6 +94,7 @@ fn interval_demand(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &L
         })
     };
     let mut turn = turn_of(na, nb);
+    let mut ends = (na, nb);
     if one_sided && turn > lim.angle {
         // On a crease (a C0 knot: a folded strip, a polyline's corner) an
         // end's own normal or tangent is the next piece's: the interval
@@ -82,22 +104,42 @@ fn interval_demand(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &L
         // end itself gets (a step inside would see the pole's fan turn);
         // and only ever less, so no interval is split more than before.
         let e = (b - a) * 1e-12;
-        turn = turn.min(turn_of(eval(a + e).1, eval(b - e).1));
+        let inside = (eval(a + e).1, eval(b - e).1);
+        let seen = turn_of(inside.0, inside.1);
+        if seen < turn {
+            (turn, ends) = (seen, inside);
+        }
     }
+    // A fold turns past a right angle between two neighbouring samples (a
+    // quarter of the interval); a bend that turns as far over the whole
+    // interval turns less between them, and an equal split serves it. On
+    // a curve (a trim curve, an untrimmed face's border) only the inner
+    // samples count, as an end's tangent may be the next piece's (a
+    // corner at a knot).
+    let sharp = || {
+        let n = [ends.0, mids[0], mids[1], mids[2], ends.1];
+        let pairs = if one_sided { &n[..] } else { &n[1..4] };
+        pairs.windows(2).any(|w| crate::math::angle_between(w[0], w[1]) > FOLD_TURN)
+    };
     if len <= lim.min_edge {
-        return (0.0, sag);
+        return Demand { smooth: 0.0, fold: 0.0, sag };
     }
     let mut demand: f64 = 0.0;
+    let mut fold: f64 = 0.0;
     if sag > 0.0 {
         demand = demand.max(sqrt(sag / lim.tol));
     }
-    if turn > 0.0 {
+    if turn > FOLD_TURN && sharp() {
+        if len > lim.tol {
+            fold = turn / lim.angle;
+        }
+    } else if turn > 0.0 {
         demand = demand.max(turn / lim.angle);
     }
     if len > 0.0 {
         demand = demand.max(len / lim.max_edge);
     }
-    (demand, sag)
+    Demand { smooth: demand, fold, sag }
 }
 
 /// Distance from `p` to the segment `ab`.
@@ -247,15 +289,30 @@ fn split_rec(
     // Equal parts; when a part still fails, raise the count for the whole
     // interval by that part's need rather than bisecting just it, so the
     // interval keeps equal steps and close to the fewest that pass.
+    // A part that fails only for a fold ([`Demand`]) fails at every count:
+    // raising the whole interval's count for it covered a pleated patch's
+    // every knot span with 64 lines. Such parts are split on their own,
+    // the others kept as they are.
     let mut n = (ceil(need) as usize).clamp(2, MAX_SPLIT);
     for _ in 0..6 {
         let mut part_need: f64 = 1.0;
         let mut part_sag: f64 = 0.0;
+        let mut folded = false;
         for k in 0..n {
             let (t0, t1) = (a + (b - a) * k as f64 / n as f64, a + (b - a) * (k + 1) as f64 / n as f64);
-            let (nk, sk) = need_all(probes, t0, t1, lim);
-            part_need = part_need.max(nk);
-            part_sag = part_sag.max(sk);
+            let d = demand_all(probes, t0, t1, lim);
+            part_need = part_need.max(d.smooth);
+            part_sag = part_sag.max(d.sag);
+            folded |= d.fold > 1.0;
+        }
+        if part_need <= 1.0 && folded {
+            let mut prev = a;
+            for k in 1..=n {
+                let t = if k == n { b } else { a + (b - a) * k as f64 / n as f64 };
+                split_rec(probes, prev, t, lim, depth + 1, cap, out, worst);
+                prev = t;
+            }
+            return;
         }
         if part_need <= 1.0 {
             for k in 1..=n {
@@ -279,6 +336,32 @@ fn split_rec(
 
 fn need_all(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits) -> (f64, f64) {
     over_probes(probes, a, b, lim, interval_need, 1.0)
+}
+
+/// [`need_all`] with the folds' part apart: the largest of each part over
+/// the probes (0 where nothing is asked, not 1).
+fn demand_all(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits) -> Demand {
+    let mut all = Demand { smooth: 0.0, fold: 0.0, sag: 0.0 };
+    let mut take = |d: Demand| {
+        all.smooth = all.smooth.max(d.smooth);
+        all.fold = all.fold.max(d.fold);
+        all.sag = all.sag.max(d.sag);
+    };
+    for p in probes {
+        match &p.inside {
+            None => take(demand_parts(p.eval, a, b, lim, p.one_sided)),
+            Some(pieces) => {
+                let eps = (b - a) * 1e-9;
+                for &(lo, hi) in pieces {
+                    let (x, y) = (a.max(lo), b.min(hi));
+                    if y - x > eps {
+                        take(demand_parts(p.eval, x, y, lim, p.one_sided));
+                    }
+                }
+            }
+        }
+    }
+    all
 }
 
 /// A test of one interval of one curve: a need and the largest sag.
@@ -594,6 +677,49 @@ mod tests {
         // A chord the caller rejects (a straight (u,v) segment off the surface) is not taken.
         let none = |_: f64, _: f64| false;
         assert_eq!(coarsen(&[&line], &none, &ts_line(), &lim(0.01)).len(), 17);
+    }
+
+    /// An iso-line across a pleat (the surface runs out along x, folds
+    /// back within a hair at t = 0.37 and its normal reverses there) gets
+    /// lines where its sag needs them and a few more about the fold, not
+    /// the 64 equal parts per interval that raising the whole interval's
+    /// count for the fold gave; every interval but the fold's passes.
+    #[test]
+    fn a_fold_is_split_where_it_is() {
+        let fold = 0.37;
+        let pleat = |t: f64| {
+            let x = 10.0 * (t - fold);
+            // Out to the fold and back over itself; the normal turns over
+            // within 1e-6 of the parameter about the fold.
+            let p = DVec3::new(-x * x, 0.0, t);
+            let s = ((t - fold) / 1e-6).clamp(-1.0, 1.0);
+            (p, DVec3::new((1.0 - s * s).sqrt(), 0.0, -s).normalize())
+        };
+        let probes = [Probe { eval: &pleat, inside: None, one_sided: true }];
+        let l = lim(0.05);
+        let (ts, _) = subdivide_probes(&probes, &[0.0, 0.5, 1.0], &l, MAX_PARAMS);
+        assert!(ts.len() < 40, "{} lines: {ts:?}", ts.len());
+        let across = |w: &[f64]| w[0] <= fold && fold <= w[1];
+        for w in ts.windows(2) {
+            let (need, _) = need_all(&probes, w[0], w[1], &l);
+            if across(w) {
+                assert!(
+                    pleat(w[0]).0.distance(pleat(w[1]).0) <= l.tol,
+                    "fold interval {w:?} longer than the tolerance"
+                );
+            } else {
+                assert!(need <= 1.0, "interval {w:?} fails: {need}");
+            }
+        }
+        // A bend as far over the whole interval (half a circle) is split evenly as before.
+        let bend = |t: f64| {
+            let a = core::f64::consts::PI * t;
+            (DVec3::new(a.cos(), a.sin(), 0.0), DVec3::new(a.cos(), a.sin(), 0.0))
+        };
+        let probes = [Probe { eval: &bend, inside: None, one_sided: true }];
+        let (ts, _) = subdivide_probes(&probes, &[0.0, 1.0], &l, MAX_PARAMS);
+        let steps: Vec<f64> = ts.windows(2).map(|w| w[1] - w[0]).collect();
+        assert!(steps.iter().all(|d| (d - steps[0]).abs() < 1e-12), "{ts:?}");
     }
 
     /// On a curve whose bend is concentrated (a parabola sharp at one end),

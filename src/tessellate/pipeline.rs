@@ -464,10 +464,11 @@ impl<'m> Plan<'m> {
             let mut wm = core::mem::take(&mut w.mesh);
             // Folds are counted on the triangles the mesh keeps (a collapse
             // takes away folded slivers), each judged against the normal at
-            // its (u,v) centroid as refined: a collapse moves a corner by a
-            // hundredth of the tolerance at most, and never turns a facet
-            // over or against that normal.
-            let mut normals: Vec<glam::DVec3> = (0..wm.tris.len()).map(|t| wm.centroid_normal(w.surface, t)).collect();
+            // its (u,v) centroid as refined (or, across a fold of the
+            // surface, the corner normal it lies along: `judged_normal`): a
+            // collapse moves a corner by a hundredth of the tolerance at
+            // most, and never turns a facet over or against that normal.
+            let mut normals: Vec<glam::DVec3> = (0..wm.tris.len()).map(|t| wm.judged_normal(w.surface, t)).collect();
             collapse::collapse_point_edges(&wm.pos, &mut wm.tris, &mut normals);
             shift = shift.max(collapse::collapse_short_inner_edges(&wm.pos, &wm.gid, &mut wm.tris, weld, &mut normals));
             run.report.inverted_triangles += refine::count_folded(&wm.pos, &wm.tris, &normals, weld, 1e-6 * self.tol);

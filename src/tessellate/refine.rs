@@ -20,7 +20,7 @@ mod mend;
 
 pub(crate) use check::Known;
 pub(crate) use edges::EdgeList;
-pub(crate) use limits::{Criteria, Lift, Outcome};
+pub(crate) use limits::{Criteria, Lift, Outcome, FOLD_TURN};
 use limits::{Packed, STALE};
 pub(crate) use mend::count_folded;
 
@@ -85,6 +85,12 @@ pub(crate) struct WorkMesh {
     /// Shared edges refinement split, as `(a, b, new vertex)`, for the caller
     /// to make the same split where the edge is shared.
     pub events: Vec<(u32, u32, u32)>,
+    /// Edges of more than two triangles (sewing that passes a loop through
+    /// one node twice), found as they are attached: the edge table holds
+    /// two of their triangles, so a split of one halves those two and the
+    /// table then lists the others on it (before, they were left on an
+    /// edge no table had), and none is flipped or collapsed.
+    crowded: crate::collections::HashSet<(u32, u32)>,
     /// Cached measure and normal turn of each triangle; [`STALE`] (a NaN
     /// distance) marks one changed since measured, which saves an `Option`'s
     /// tag, and the sample count follows from the grid: 12 bytes a triangle.
@@ -276,6 +282,7 @@ impl WorkMesh {
         let n = (3 * self.tris.len() + self.rim.0.len()) / 2;
         self.rim = EdgeList::default();
         self.edges = PairMap::with_capacity(n, [NONE, NONE]);
+        self.crowded.clear();
         for t in 0..self.tris.len() {
             let v = self.tris[t];
             for k in 0..3 {
@@ -356,7 +363,20 @@ impl WorkMesh {
             e[0] = t;
         } else if e[1] == NONE {
             e[1] = t;
+        } else {
+            self.crowded.insert(key(a, b));
         }
+    }
+
+    /// The two triangles the edge table lists on edge `a-b` (one and
+    /// `NONE` on a border edge), or None where it has none or is crowded
+    /// (more than two: see `crowded`), for the flips, moves and walks that
+    /// take an edge for two triangles.
+    fn pair(&self, a: u32, b: u32) -> Option<&[u32; 2]> {
+        if !self.crowded.is_empty() && self.crowded.contains(&key(a, b)) {
+            return None;
+        }
+        self.edges.get(&key(a, b))
     }
 
     fn detach(&mut self, a: u32, b: u32, t: u32) {
@@ -460,7 +480,7 @@ impl WorkMesh {
             let (mut a, mut b) = first;
             let mut cur = t;
             for _ in 0..64 {
-                let Some(adj) = self.edges.get(&key(a, b)) else { break };
+                let Some(adj) = self.pair(a, b) else { break };
                 let other = if adj[0] == cur { adj[1] } else { adj[0] };
                 if other == NONE {
                     break;
@@ -551,6 +571,15 @@ impl WorkMesh {
             Some(t) => [t, NONE],
             None => *self.edges.get(&key(a, b))?,
         };
+        // A crowded edge's triangles the table does not list (found by a
+        // walk: rare) keep the edge, and the table lists them on it after.
+        let unlisted: Vec<u32> = if !self.crowded.is_empty() && self.crowded.contains(&key(a, b)) {
+            let on = |t: &[u32; 3]| t.contains(&a) && t.contains(&b);
+            let listed = |i: u32| adj.contains(&i);
+            (0..self.tris.len() as u32).filter(|&i| !listed(i) && on(&self.tris[i as usize])).collect()
+        } else {
+            Vec::new()
+        };
         let trim = self.trim.get(&key(a, b)).copied();
         // The split's (u,v) and the curve parameters at a, the split and b.
         let trim_at = trim.and_then(|te| {
@@ -572,6 +601,12 @@ impl WorkMesh {
             return None;
         }
         let m = self.apply_split(a, b, p, normal, plan, out);
+        if !unlisted.is_empty() {
+            self.crowded.remove(&key(a, b));
+            for t in unlisted {
+                self.attach(a, b, t);
+            }
+        }
         if let (Some(te), Some((_, ta, tm, tb))) = (trim, trim_at) {
             self.trim.remove(&key(a, b));
             self.mark_trim(a, m, te.curve, ta, tm);

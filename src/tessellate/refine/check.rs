@@ -86,14 +86,15 @@ impl fmt::Display for Broken {
 /// as the sweeps of both corpora (1e-2 and 1e-3) found them; each later
 /// stage's set holds the earlier ones', since no stage mends what an
 /// earlier one broke. No set lets the tables ([`WorkMesh::check_tables`])
-/// disagree; one file of the wide corpus still makes them (OCC131-3 at
-/// 1e-2, see `non_manifold`), and fails a debug build there.
+/// disagree.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Known {
     /// Edges of more than two triangles: sewing that passes one loop
     /// through a node twice (trj3_s1-al-214 and trj7_b1-ec-214 at 1e-2;
-    /// OCC131-3 of the wide corpus, where a later split of such an edge
-    /// leaves the rim a border edge short).
+    /// OCC131-3 of the wide corpus). A split of such an edge halves the
+    /// two triangles the edge table lists and the table then lists the
+    /// third on it (it was left on an edge no table had, and the rim came
+    /// out a border edge short); none is flipped or collapsed.
     pub non_manifold: bool,
     /// Triangles flat or clockwise in (u,v): mending's flips and moves
     /// (trj3_s1-al-214, trj7_b1-ec-214, ship_kcs, trj6_pm4-ec-203), and
@@ -311,6 +312,36 @@ mod tests {
         assert_eq!(m.check_invariants(), Ok(()));
         m.wake();
         assert_eq!(m.check_invariants(), Ok(()));
+    }
+
+    /// An edge of three triangles (sewing passed a loop through one node
+    /// twice), which the edge table holds two of, keeps the tables through
+    /// a split and refinement: a split of the two listed triangles left the
+    /// third on an edge no table had, and the rim came out a border edge short.
+    #[test]
+    fn an_edge_of_three_triangles_keeps_the_tables() {
+        let s = analytic::xy_plane(10.0);
+        let (mut m, sides) = trimmed_grid();
+        let curves: Vec<&NurbsCurve> = sides.iter().collect();
+        let v = m.tris[0];
+        m.add_vertex(DVec3::new(0.5, -1.0, 0.0), DVec3::Z);
+        m.add_vertex(DVec3::new(0.5, -2.0, 0.0), DVec3::Z);
+        let uv = [DVec2::new(1.0, 0.0), DVec2::new(0.0, 0.0), DVec2::new(0.5, -1.0)];
+        m.add_triangle([v[1], v[0], 25], uv);
+        m.add_triangle([v[1], v[0], 26], [uv[0], uv[1], DVec2::new(0.5, -2.0)]);
+        assert!(matches!(m.check_invariants(), Err(Broken::NonManifold { .. })));
+        assert_eq!(m.check_tables(), Ok(()));
+        let mut out = Vec::new();
+        let mid = m.split_edge_at(&s, &curves, v[0], v[1], 0.5, None, &mut out);
+        assert_eq!(m.check_tables(), Ok(()), "after the split");
+        assert!(mid.is_some(), "the edge was split");
+        m.rest();
+        assert_eq!(m.check_tables(), Ok(()), "at rest");
+        let c = Criteria { max_edge: 0.3, ..Criteria::PLANE_TEST };
+        m.refine(&s, &curves, &c, 100_000);
+        assert_eq!(m.check_tables(), Ok(()), "after refinement");
+        m.rest();
+        assert_eq!(m.check_invariants_but(Known::MENDED), Ok(()), "refined, at rest");
     }
 
     /// Each invariant, broken on purpose, is the one reported.

@@ -133,7 +133,7 @@ impl WorkMesh {
             if self.trim.contains_key(&key(x, y)) {
                 return None;
             }
-            let adj = *self.edges.get(&key(x, y))?;
+            let adj = *self.pair(x, y)?;
             let u = if adj[0] == t { adj[1] } else { adj[0] };
             if u == NONE {
                 return None;
@@ -215,7 +215,7 @@ impl WorkMesh {
             if flips == 0 {
                 break;
             }
-            let Some(&adj) = self.edges.get(&key(a, b)) else { continue };
+            let Some(&adj) = self.pair(a, b) else { continue };
             let u = if adj[0] == t { adj[1] } else { adj[0] };
             if u == NONE || (adj[0] != t && adj[1] != t) || self.trim.contains_key(&key(a, b)) {
                 continue;

@@ -6,7 +6,7 @@ use super::TriMeasure;
 /// A normal turn past a right angle inside one triangle: the surface folds
 /// back there or is within the tolerance of a sharp edge (see
 /// [`Criteria::short_for_angle`]).
-const FOLD_TURN: f64 = core::f64::consts::FRAC_PI_2;
+pub(crate) const FOLD_TURN: f64 = core::f64::consts::FRAC_PI_2;
 
 /// Limits a triangle must meet.
 #[derive(Debug, Clone, Copy)]

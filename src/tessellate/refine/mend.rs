@@ -10,7 +10,7 @@ use glam::{DVec2, DVec3};
 use super::{key, uv_area, Criteria, TriMeasure, WorkMesh, NONE, STALE};
 #[cfg(feature = "std")]
 use crate::nurbs::project_to_surface;
-use crate::nurbs::Surface;
+use crate::nurbs::{regular_normal, Surface};
 
 /// The smallest angle below which [`WorkMesh::improve_angles`] looks for a
 /// better diagonal (radians, 15°): wider pairs gain little for the measuring.
@@ -164,7 +164,7 @@ impl WorkMesh {
         b: u32,
         taken: &crate::collections::HashSet<(u32, u32)>,
     ) -> Option<(u32, Option<(u32, u32)>)> {
-        let &adj = self.edges.get(&key(a, b))?;
+        let &adj = self.pair(a, b)?;
         let u = if adj[0] == t { adj[1] } else { adj[0] };
         if u == NONE || (adj[0] != t && adj[1] != t) || self.trim.contains_key(&key(a, b)) {
             return None;
@@ -221,7 +221,7 @@ impl WorkMesh {
         if self.trim.contains_key(&key(a, b)) {
             return None;
         }
-        let &adj = self.edges.get(&key(a, b))?;
+        let &adj = self.pair(a, b)?;
         let u = if adj[0] == t { adj[1] } else { adj[0] };
         if u == NONE || adj[0] != t && adj[1] != t {
             return None;
@@ -285,7 +285,7 @@ impl WorkMesh {
             let tv = self.tris[cur as usize];
             let k = tv.iter().position(|&v| v == x)?;
             let z = tv[(k + 1) % 3];
-            let &adj = self.edges.get(&key(x, z))?;
+            let &adj = self.pair(x, z)?;
             let next = if adj[0] == cur { adj[1] } else { adj[0] };
             if next == NONE || next == cur {
                 return None;
@@ -380,7 +380,7 @@ impl WorkMesh {
         crate::sort::by_f64(&mut around, |&a| self.pos[a as usize].distance(here));
         let sense: f64 = ring.iter().map(|&t| uv_area(self.uv(t as usize))).sum();
         'candidates: for &y in &around {
-            let &gone = self.edges.get(&key(x, y))?;
+            let &gone = self.pair(x, y)?;
             // y's (u,v), the same in both triangles of the edge (one chart).
             let at = |m: &Self, t: u32| {
                 let tv = m.tris[t as usize];
@@ -522,6 +522,33 @@ impl WorkMesh {
     pub fn centroid_normal(&self, surface: &dyn Surface, t: usize) -> DVec3 {
         let uv = self.uv(t);
         surface.normal((uv[0] + uv[1] + uv[2]) / 3.0)
+    }
+
+    /// [`Self::centroid_normal`], but where the facet opposes it and the
+    /// surface turns over inside the triangle (two corners' normals, seen
+    /// from inside, face apart: a fold or pleat, where the control net
+    /// doubles back), the normal of a corner the facet agrees with. Such a
+    /// triangle has no one surface normal: it lies along one of the sheets
+    /// it spans, and is turned over only if it faces away from all of them.
+    pub fn judged_normal(&self, surface: &dyn Surface, t: usize) -> DVec3 {
+        let n = self.centroid_normal(surface, t);
+        let v = self.tris[t];
+        let p = v.map(|x| self.pos[x as usize]);
+        let facet = (p[1] - p[0]).cross(p[2] - p[0]);
+        if facet.dot(n) >= 0.0 {
+            return n;
+        }
+        let uv = self.uv(t);
+        let centre = (uv[0] + uv[1] + uv[2]) / 3.0;
+        let corners: [Option<DVec3>; 3] = core::array::from_fn(|k| {
+            [1e-6, 1e-4, 1e-2].iter().find_map(|f| regular_normal(&surface.derivs(uv[k] + (centre - uv[k]) * *f)))
+        });
+        let [Some(a), Some(b), Some(c)] = corners else { return n };
+        let turns_over = a.dot(b) < 0.0 || b.dot(c) < 0.0 || c.dot(a) < 0.0;
+        match [a, b, c].into_iter().find(|m| facet.dot(*m) > 0.0) {
+            Some(m) if turns_over => m,
+            _ => n,
+        }
     }
 
     /// Closes a small hole beside border edge `a-b` (run a→b by its one

@@ -276,3 +276,38 @@ fn folds_count_only_triangles_the_weld_keeps() {
     // Flat within `negligible`: not counted however far apart.
     assert_eq!(mend::count_folded(&needle(2.0 * weld), &tri, &up, weld, 1e-2), 0);
 }
+
+/// A flat sheet folded over itself, `S(u,v) = (4v(1 − v), u, 0)`: out along
+/// x to v = 1/2 and back, its normal −z before the fold and +z after.
+fn pleat() -> crate::nurbs::NurbsSurface {
+    let row = |y: f64| alloc::vec![DVec3::new(0.0, y, 0.0), DVec3::new(2.0, y, 0.0), DVec3::new(0.0, y, 0.0)];
+    let points = [row(0.0), row(1.0)];
+    crate::nurbs::NurbsSurface::try_new(
+        [1, 2],
+        alloc::vec![0.0, 0.0, 1.0, 1.0],
+        alloc::vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        &points,
+        None,
+    )
+    .unwrap()
+}
+
+/// A triangle across a fold of the surface lies along one of the sheets it
+/// spans and is not counted as turned over, though its facet opposes the
+/// normal at its (u,v) centroid; one turned over on one sheet still is.
+#[test]
+fn a_triangle_across_a_fold_is_judged_by_the_sheet_it_lies_along() {
+    let s = pleat();
+    let mut m = WorkMesh::default();
+    let uvs = [at(0.0, 0.3), at(1.0, 0.3), at(0.5, 0.8), at(0.0, 0.1), at(1.0, 0.1), at(0.5, 0.4)];
+    for w in uvs {
+        m.add_vertex(s.point(w), s.normal(w));
+    }
+    m.add_triangle([0, 1, 2], [uvs[0], uvs[1], uvs[2]]);
+    m.add_triangle([3, 5, 4], [uvs[3], uvs[5], uvs[4]]);
+    let centroid: Vec<DVec3> = (0..2).map(|t| m.centroid_normal(&s, t)).collect();
+    let judged: Vec<DVec3> = (0..2).map(|t| m.judged_normal(&s, t)).collect();
+    assert_eq!(mend::count_folded(&m.pos, &m.tris, &centroid, 1e-9, 1e-9), 2);
+    assert_eq!(mend::count_folded(&m.pos, &m.tris[1..], &judged[1..], 1e-9, 1e-9), 1, "turned over on one sheet");
+    assert_eq!(mend::count_folded(&m.pos, &m.tris, &judged, 1e-9, 1e-9), 1);
+}
