@@ -38,7 +38,53 @@ pub(super) fn across_faces(
     cell: f64,
     tight: f64,
 ) -> Vec<bool> {
+    let mut probes: Vec<Probe> = Vec::new();
+    let mut looked: Vec<usize> = Vec::new();
+    for (ci, c) in cands.iter().enumerate() {
+        let &(seg, _, t, d, q) = c;
+        let at_q = pos[q.0 as usize][q.1 as usize][q.2 as usize];
+        if d > limit(c) || d <= 1e-9 * at_q.abs().max_element() {
+            continue;
+        }
+        let Some((surface, o)) = &faces[seg.0 as usize] else { continue };
+        let Some(poly) = o.loops.polys.get(seg.1 as usize) else { continue };
+        let Some(curve) = poly.seg.get(seg.2 as usize).and_then(|s| o.loops.curves.get(s.0 as usize)) else {
+            continue;
+        };
+        probes.push(Probe { face: seg.0, p: surface.point(curve.point(t).truncate()), q, d });
+        looked.push(ci);
+    }
     let mut across = alloc::vec![false; cands.len()];
+    for (ci, x) in looked.into_iter().zip(between(faces, bodies, pos, nodes, &probes, reach, cell, tight)) {
+        across[ci] = x;
+    }
+    across
+}
+
+/// A node `q` to become one with point `p` of face `face`'s border, `d` apart.
+#[derive(Clone, Copy)]
+pub(super) struct Probe {
+    pub face: u32,
+    pub p: DVec3,
+    pub q: NodeRef,
+    pub d: f64,
+}
+
+/// Per probe, whether a third face's border (or another piece of `q`'s
+/// own face's) lies between `q` and `p`, as [`across_faces`] tells it.
+/// Probes at nothing (`d` a rounding) are not looked at.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn between(
+    faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
+    bodies: &[u32],
+    pos: &PerNode<DVec3>,
+    nodes: &CellGrid<NodeRef>,
+    all: &[Probe],
+    reach: &dyn Fn(NodeRef) -> f64,
+    cell: f64,
+    tight: f64,
+) -> Vec<bool> {
+    let mut across = alloc::vec![false; all.len()];
     let at = |n: NodeRef| pos[n.0 as usize][n.1 as usize][n.2 as usize];
     let body = |f: u32| crate::model::body_of(bodies, f as usize);
     // Whether face `f` folds shut at `p` by itself: a node of its own
@@ -50,21 +96,14 @@ pub(super) fn across_faces(
             .in_box(q - r3, q + r3)
             .any(|&m| m.0 == f && at(m).distance(q) <= r && at(m).distance(p) <= tight.min(reach(m)))
     };
-    // Each candidate looked at: its index and point on the border.
-    let mut probes: Vec<(usize, DVec3)> = Vec::new();
-    for (ci, c) in cands.iter().enumerate() {
-        let &(seg, _, t, d, q) = c;
-        if d > limit(c) || d <= 1e-9 * at(q).abs().max_element() {
-            continue;
-        }
-        let Some((surface, o)) = &faces[seg.0 as usize] else { continue };
-        let Some(poly) = o.loops.polys.get(seg.1 as usize) else { continue };
-        let Some(curve) = poly.seg.get(seg.2 as usize).and_then(|s| o.loops.curves.get(s.0 as usize)) else {
-            continue;
-        };
-        probes.push((ci, surface.point(curve.point(t).truncate())));
-    }
-    let Some(widest) = probes.iter().map(|&(ci, _)| BETWEEN * cands[ci].3).reduce(f64::max) else {
+    // Each probe looked at: its index and point on the border.
+    let probes: Vec<(usize, DVec3)> = all
+        .iter()
+        .enumerate()
+        .filter(|(_, pr)| pr.d > 1e-9 * at(pr.q).abs().max_element())
+        .map(|(i, pr)| (i, pr.p))
+        .collect();
+    let Some(widest) = probes.iter().map(|&(ci, _)| BETWEEN * all[ci].d).reduce(f64::max) else {
         return across;
     };
     let mut grid = CellGrid::new(guarded_div(1.0, cell));
@@ -114,13 +153,13 @@ pub(super) fn across_faces(
                 };
                 for &pi in probes_near {
                     let (ci, p) = probes[pi as usize];
-                    let (seg, _, _, d, q) = cands[ci];
+                    let Probe { face, q, d, .. } = all[ci];
                     let mine = q.0 == h && q.1 == k as u32 && (q.2 == i as u32 || q.2 == j as u32);
-                    if across[ci] || mine || seg.0 == h || body(seg.0) != body(h) {
+                    if across[ci] || mine || face == h || body(face) != body(h) {
                         continue;
                     }
                     let r = BETWEEN * d;
-                    if within(p, r) && !within(at(q), r) && !(pinches(seg.0, at(q), p, r) && pinches(h, at(q), p, r)) {
+                    if within(p, r) && !within(at(q), r) && !(pinches(face, at(q), p, r) && pinches(h, at(q), p, r)) {
                         across[ci] = true;
                     }
                 }
@@ -203,5 +242,72 @@ mod tests {
         assert!(mine.iter().all(|id| !beyond.contains(id)), "f {mine:?} takes a node of {beyond:?}");
         // The strip's near corners are f's nodes too: the two are sewn.
         assert!(ids(&h, false).iter().all(|id| mine.contains(id)), "{:?} {mine:?}", ids(&h, false));
+    }
+
+    /// A plane 3 by 12 cut into `f` up to u = 1, a strip `w` wide and `g`
+    /// beyond it, each border with a node every 2 along v, the strip's on
+    /// both its sides beside its neighbours'. Returns the ids of `f`'s,
+    /// the strip's near and far, and `g`'s nodes along the strip's long
+    /// sides (ends left out), with `tight` 0.4 and `sew` 0.5.
+    fn strip_ids(w: f64) -> [Vec<u32>; 4] {
+        let pts: Vec<Vec<DVec3>> = alloc::vec![
+            alloc::vec![DVec3::ZERO, DVec3::new(0.0, 12.0, 0.0)],
+            alloc::vec![DVec3::new(3.0, 0.0, 0.0), DVec3::new(3.0, 12.0, 0.0)],
+        ];
+        let plane = NurbsSurface::try_new(
+            [1, 1],
+            alloc::vec![0.0, 0.0, 3.0, 3.0],
+            alloc::vec![0.0, 0.0, 12.0, 12.0],
+            &pts,
+            None,
+        )
+        .unwrap();
+        let side = |u: f64, up: bool| -> Vec<(f64, f64)> {
+            let v = (0..=6).map(|i| f64::from(2 * i));
+            if up {
+                v.map(|v| (u, v)).collect()
+            } else {
+                v.rev().map(|v| (u, v)).collect()
+            }
+        };
+        let u1 = 1.0 + w;
+        let fp: Vec<(f64, f64)> = [(0.0, 0.0)].into_iter().chain(side(1.0, true)).chain([(0.0, 12.0)]).collect();
+        let hp: Vec<(f64, f64)> = side(1.0, true).into_iter().chain(side(u1, false)).collect();
+        let gp: Vec<(f64, f64)> = side(u1, true).into_iter().chain([(3.0, 12.0), (3.0, 0.0)]).collect();
+        let (fc, fuv) = polygon(&fp);
+        let (hc, huv) = polygon(&hp);
+        let (gc, guv) = polygon(&gp);
+        let (mut f, mut h, mut g) = (outline(&fc, &fuv), outline(&hc, &huv), outline(&gc, &guv));
+        {
+            let s = &plane as &dyn Surface;
+            let mut faces = alloc::vec![Some((s, &mut f)), Some((s, &mut h)), Some((s, &mut g))];
+            unify(&mut faces, &[], &[0.0; 3], 0.5, 0.4, 1.0);
+        }
+        let ids = |o: &Outline<'_>, u: f64| -> Vec<u32> {
+            let poly = &o.loops.polys[0];
+            poly.uv
+                .iter()
+                .zip(&o.gids[0])
+                .filter(|(q, _)| (q.x - u).abs() < 1e-9 && q.y > 1.0 && q.y < 11.0)
+                .map(|(_, &g)| g)
+                .collect()
+        };
+        [ids(&f, 1.0), ids(&h, 1.0), ids(&h, u1), ids(&g, u1)]
+    }
+
+    /// A strip narrower than `tight` but wider than a gap, with faces
+    /// along both its sides, keeps its sides apart when nodes are named:
+    /// folding it where its side nodes face each other (while no node of
+    /// one neighbour went onto its far side) left it half folded, the
+    /// neighbours overlapping it. Narrower than a gap it folds shut.
+    #[test]
+    fn a_strip_between_faces_keeps_its_sides_when_named() {
+        let [f, near, far, g] = strip_ids(0.1);
+        assert_eq!(f.len(), 5, "{f:?}");
+        assert!(f.iter().all(|id| !g.contains(id) && !far.contains(id)), "f {f:?} g {g:?} far side {far:?}");
+        assert!(near.iter().all(|id| f.contains(id)), "near side {near:?} f {f:?}");
+        assert!(far.iter().all(|id| g.contains(id)), "far side {far:?} g {g:?}");
+        let [f, _, _, g] = strip_ids(0.04);
+        assert!(!f.is_empty() && f.iter().all(|id| g.contains(id)), "a gap: f {f:?} g {g:?}");
     }
 }

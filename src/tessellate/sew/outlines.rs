@@ -14,6 +14,10 @@ use crate::tessellate::trim::Polyline;
 const BEYOND: f64 = -2.0;
 /// Nodes a pair of faces needs before its own gaps set its sewing distance.
 const PAIR_MIN: usize = 3;
+/// Share of `tight` below which a face's two sides are one however other
+/// faces lie along them: a gap of the model's, as the sewing closes gaps
+/// below an eighth of its distance whatever the rest of the model needs.
+const GAP: f64 = 0.125;
 
 /// A node of some face's outline: face, loop, index.
 pub(super) type NodeRef = (u32, u32, u32);
@@ -37,7 +41,8 @@ type Additions = PerNode<Vec<(f64, f64, NodeRef)>>;
 /// curve's nearest point (unless it is within reach of a node there
 /// already, or a narrow face lies between: [`super::across::across_faces`]).
 /// Then nodes within both reaches of each other get one id in
-/// [`Outline::gids`], and a node left alone one short segment from a
+/// [`Outline::gids`] (never a strip's two sides where other faces run
+/// along both: [`folds_across`]), and a node left alone one short segment from a
 /// shared node takes its id (a trim curve shorter than the gaps). Within
 /// one face (a seam) `tight` takes the place of `sew`: a face's loops meet
 /// themselves exactly, and a face narrower than `sew` must not be folded
@@ -574,12 +579,23 @@ struct Clusters<'n> {
     nodes: &'n [(u32, DVec3)],
     reach: &'n [f64],
     tight: f64,
+    /// Pairs of nodes of one face (lower index first) never in one
+    /// cluster: a strip's two sides with other faces' borders on them.
+    apart: crate::collections::HashSet<(u32, u32)>,
 }
 
 impl<'n> Clusters<'n> {
     fn new(nodes: &'n [(u32, DVec3)], reach: &'n [f64], tight: f64) -> Self {
         let n = nodes.len() as u32;
-        Self { parent: (0..n).collect(), next: (0..n).collect(), size: alloc::vec![1; n as usize], nodes, reach, tight }
+        Self {
+            parent: (0..n).collect(),
+            next: (0..n).collect(),
+            size: alloc::vec![1; n as usize],
+            nodes,
+            reach,
+            tight,
+            apart: crate::collections::HashSet::default(),
+        }
     }
 
     fn find(&mut self, mut x: u32) -> u32 {
@@ -599,27 +615,41 @@ impl<'n> Clusters<'n> {
 
     /// The nodes of the cluster of root `x`, the root first.
     fn members(&self, x: u32) -> impl Iterator<Item = (u32, DVec3, f64)> + '_ {
+        self.member_ids(x).map(|i| self.node(i))
+    }
+
+    /// The nodes of the cluster of root `x` by index, the root first.
+    fn member_ids(&self, x: u32) -> impl Iterator<Item = u32> + '_ {
         let mut at = Some(x);
         core::iter::from_fn(move || {
             let i = at?;
             let n = self.next[i as usize];
             at = (n != x).then_some(n);
-            Some(self.node(i))
+            Some(i)
         })
+    }
+
+    /// Whether nodes `i` and `j` must stay apart (see `apart`).
+    fn kept_apart(&self, i: u32, j: u32) -> bool {
+        !self.apart.is_empty() && self.apart.contains(&(i.min(j), i.max(j)))
     }
 
     /// Joins the clusters of `a` and `b` unless that would make two
     /// nodes of one face one node that could not be one directly
-    /// (farther apart than `tight` or than either's reach).
+    /// (farther apart than `tight` or than either's reach, or kept apart).
     fn union(&mut self, a: u32, b: u32) {
         let (x, y) = (self.find(a), self.find(b));
         if x == y {
             return;
         }
         let tight = self.tight;
-        let clash = self
-            .members(x)
-            .any(|(f, p, rp)| self.members(y).any(|(g, q, rq)| f == g && p.distance(q) > tight.min(rp).min(rq)));
+        let clash = self.member_ids(x).any(|i| {
+            let (f, p, rp) = self.node(i);
+            self.member_ids(y).any(|j| {
+                let (g, q, rq) = self.node(j);
+                f == g && (p.distance(q) > tight.min(rp).min(rq) || self.kept_apart(i, j))
+            })
+        });
         if clash {
             return;
         }
@@ -631,7 +661,11 @@ impl<'n> Clusters<'n> {
     fn absorb(&mut self, a: u32, b: u32) -> bool {
         let (x, y) = (self.find(a), self.find(b));
         let (f, p, _) = self.node(x);
-        if x == y || self.members(y).any(|(g, q, _)| g == f && p.distance(q) > self.tight) {
+        let far = |j: u32| {
+            let (g, q, _) = self.node(j);
+            g == f && (p.distance(q) > self.tight || self.kept_apart(x, j))
+        };
+        if x == y || self.member_ids(y).any(far) {
             return false;
         }
         self.merge(x, y);
@@ -647,10 +681,9 @@ impl<'n> Clusters<'n> {
         self.next.swap(small as usize, big as usize);
     }
 
-    /// Joins nodes of one body within `sew` (`tight` inside one face) and
-    /// within both their reaches, nearest pairs first, so that a chain of
-    /// close nodes is cut where its nodes are farthest apart.
-    fn join_near(&mut self, bodies: &[u32], sew: f64) {
+    /// The pairs of nodes of one body within `sew` (`tight` inside one
+    /// face) and within both their reaches: (distance, node, node).
+    fn near_pairs(&self, bodies: &[u32], sew: f64) -> Vec<(f64, u32, u32)> {
         let (nodes, reach, tight) = (self.nodes, self.reach, self.tight);
         let mut grid = CellGrid::new(1.0 / sew);
         for (i, &(_, p)) in nodes.iter().enumerate() {
@@ -674,6 +707,12 @@ impl<'n> Clusters<'n> {
                 }
             }
         }
+        pairs
+    }
+
+    /// Joins the pairs, nearest first, so that a chain of close nodes is
+    /// cut where its nodes are farthest apart.
+    fn join(&mut self, mut pairs: Vec<(f64, u32, u32)>) {
         crate::sort::by_f64(&mut pairs, |x| x.0);
         for (_, a, b) in pairs {
             self.union(a, b);
@@ -730,8 +769,10 @@ fn name_nodes(
     sew: f64,
     tight: f64,
 ) -> u32 {
-    let (flat, index, r_flat) = flat_nodes(faces, radius_before, twins);
+    let (flat, index, r_flat, pos) = flat_nodes(faces, radius_before, twins);
     let mut cl = Clusters::new(&flat, &r_flat, tight);
+    let pairs = if sew > 0.0 { cl.near_pairs(bodies, sew) } else { Vec::new() };
+    cl.apart = folds_across(faces, bodies, &pos, &index, &r_flat, &pairs, sew, tight);
     // Twins first (they are one node by construction), then neighbours by distance.
     let id_of = |n: NodeRef, index: &PerNode<u32>| index[n.0 as usize][n.1 as usize].get(n.2 as usize).copied();
     for &(n, q) in twins {
@@ -740,7 +781,7 @@ fn name_nodes(
         }
     }
     if sew > 0.0 {
-        cl.join_near(bodies, sew);
+        cl.join(pairs);
         cl.absorb_jogs(&index, sew);
     }
     // Compact ids.
@@ -758,14 +799,71 @@ fn name_nodes(
     ids.len() as u32
 }
 
+/// The pairs of nodes of one face (sides of it within `tight`, wider than
+/// `GAP · tight`) with another face's border between them
+/// ([`super::across::between`]): a strip whose neighbours each take one of
+/// its sides, the insertions that would fold it shut having been refused
+/// for the same reason. Joining its sides at some nodes (directly or through
+/// its neighbours' nodes) left it half folded, its neighbours overlapping
+/// it there. `index`, `reach`: each outline node's place in the list the
+/// `pairs` index and its reach there.
+#[allow(clippy::too_many_arguments)]
+fn folds_across(
+    faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
+    bodies: &[u32],
+    pos: &PerNode<DVec3>,
+    index: &PerNode<u32>,
+    reach: &[f64],
+    pairs: &[(f64, u32, u32)],
+    sew: f64,
+    tight: f64,
+) -> crate::collections::HashSet<(u32, u32)> {
+    let mut refs: Vec<NodeRef> = alloc::vec![(0, 0, 0); reach.len()];
+    for (fi, f) in index.iter().enumerate() {
+        for (k, l) in f.iter().enumerate() {
+            for (i, &x) in l.iter().enumerate() {
+                if let Some(r) = refs.get_mut(x as usize) {
+                    *r = (fi as u32, k as u32, i as u32);
+                }
+            }
+        }
+    }
+    let at = |n: NodeRef| pos[n.0 as usize][n.1 as usize][n.2 as usize];
+    let one_face: Vec<(u32, u32)> = pairs
+        .iter()
+        .filter(|pr| pr.0 > GAP * tight && refs[pr.1 as usize].0 == refs[pr.2 as usize].0)
+        .map(|pr| (pr.1, pr.2))
+        .collect();
+    if one_face.is_empty() {
+        return crate::collections::HashSet::default();
+    }
+    let mut nodes = CellGrid::new(guarded_div(1.0, sew));
+    for &n in &refs {
+        nodes.insert(at(n), n);
+    }
+    // Each pair both ways: a face may lie beside either end only.
+    let probes: Vec<super::across::Probe> = one_face
+        .iter()
+        .flat_map(|&(a, b)| [(a, b), (b, a)])
+        .map(|(a, b)| {
+            let (na, nb) = (refs[a as usize], refs[b as usize]);
+            super::across::Probe { face: na.0, p: at(na), q: nb, d: at(na).distance(at(nb)) }
+        })
+        .collect();
+    let reach_of = |n: NodeRef| reach[index[n.0 as usize][n.1 as usize][n.2 as usize] as usize];
+    let across = super::across::between(faces, bodies, pos, &nodes, &probes, &reach_of, sew, tight);
+    one_face.iter().zip(across.chunks(2)).filter(|(_, x)| x.iter().any(|&x| x)).map(|(&pr, _)| pr).collect()
+}
+
 /// Every outline node in one list: its face and place, where each node
-/// went in it, and its reach after insertion (a new node has its twin's,
-/// an old one keeps its own).
+/// went in it, its reach after insertion (a new node has its twin's, an
+/// old one keeps its own), and each node's point.
+#[allow(clippy::type_complexity)]
 fn flat_nodes(
     faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
     radius_before: &PerNode<f64>,
     twins: &[(NodeRef, NodeRef)],
-) -> (Vec<(u32, DVec3)>, PerNode<u32>, Vec<f64>) {
+) -> (Vec<(u32, DVec3)>, PerNode<u32>, Vec<f64>, PerNode<DVec3>) {
     let pos = positions(faces);
     let mut radius: PerNode<f64> = per_node(&pos, 0.0);
     let mut index: PerNode<u32> = per_node(&pos, 0);
@@ -794,7 +892,7 @@ fn flat_nodes(
         radius[n.0 as usize][n.1 as usize][n.2 as usize] = r;
     }
     let r_flat: Vec<f64> = radius.iter().flatten().flatten().copied().collect();
-    (flat, index, r_flat)
+    (flat, index, r_flat, pos)
 }
 
 #[cfg(test)]
