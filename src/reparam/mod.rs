@@ -70,48 +70,77 @@ pub struct ReparamFace {
 /// step 1) and, beyond the paper, the opposite and middle iso-lines, since one
 /// poor row can hide anywhere. Each line is cut into 50 equal parameter steps
 /// of model-space lengths `L_i`; with `C` their mean, the ratio is the
-/// largest `max(L_i / C, C / L_i)`. Lines of no length (poles) are left out.
+/// largest `max(L_i / C, C / L_i)`. Lines of no length (poles) are left out,
+/// and so are lines that turn back ([`turns_back`]) where they would flag
+/// the face: their steps shrink to nothing at the fold however the
+/// parameters run, and a rebuild, which must turn back too, cannot even them.
 pub fn step_ratio(surface: &dyn Surface) -> f64 {
     let [lo, hi] = surface.domain();
-    let mut lines: Vec<Vec<f64>> = Vec::with_capacity(6);
+    let mut lines: Vec<Vec<DVec3>> = Vec::with_capacity(6);
     let mut longest = 0.0f64;
     for along_u in [true, false] {
         for f in [0.0, 0.5, 1.0] {
-            let mut prev: Option<DVec3> = None;
-            let mut steps = Vec::with_capacity(STEPS);
-            for k in 0..=STEPS {
-                let a = k as f64 / STEPS as f64;
-                let uv = if along_u {
-                    DVec2::new(lo.x + (hi.x - lo.x) * a, lo.y + (hi.y - lo.y) * f)
-                } else {
-                    DVec2::new(lo.x + (hi.x - lo.x) * f, lo.y + (hi.y - lo.y) * a)
-                };
-                let p = surface.point(uv);
-                if let Some(q) = prev {
-                    steps.push(p.distance(q));
-                }
-                prev = Some(p);
-            }
-            let total: f64 = steps.iter().sum();
+            let pts: Vec<DVec3> = (0..=STEPS)
+                .map(|k| {
+                    let a = k as f64 / STEPS as f64;
+                    let uv = if along_u {
+                        DVec2::new(lo.x + (hi.x - lo.x) * a, lo.y + (hi.y - lo.y) * f)
+                    } else {
+                        DVec2::new(lo.x + (hi.x - lo.x) * f, lo.y + (hi.y - lo.y) * a)
+                    };
+                    surface.point(uv)
+                })
+                .collect();
+            let total: f64 = pts.windows(2).map(|w| w[0].distance(w[1])).sum();
             if total.is_finite() {
                 longest = longest.max(total);
-                lines.push(steps);
+                lines.push(pts);
             }
         }
     }
     let mut worst = 1.0f64;
-    for steps in &lines {
-        let total: f64 = steps.iter().sum();
+    for pts in &lines {
+        let total: f64 = pts.windows(2).map(|w| w[0].distance(w[1])).sum();
         if total <= 1e-9 * longest {
             continue;
         }
         let c = total / STEPS as f64;
-        for &l in steps {
+        let mut line = 1.0f64;
+        for w in pts.windows(2) {
+            let l = w[0].distance(w[1]);
             let r = if l > 0.0 { (l / c).max(c / l) } else { 1e9 };
-            worst = worst.max(r.min(1e9));
+            line = line.max(r.min(1e9));
         }
+        if line > RATIO_LIMIT && turns_back(pts, c) {
+            continue;
+        }
+        worst = worst.max(line);
     }
     worst
+}
+
+/// Whether the polyline `pts` (an iso-line's samples, mean step `c`) turns
+/// back on itself at a fold of the surface (a pleat, where the control net
+/// doubles back and the normal reverses): its chord turns past a right
+/// angle from one step to the next (however the fold falls between the
+/// samples, the steps either side point apart, so one of the two turns at
+/// it is), and it runs more than a mean step out to the turn and back
+/// from it. A narrower hook (a wrinkle along a border, a fraction of a step)
+/// is one a rebuild on even parameters smooths over, so its line counts.
+fn turns_back(pts: &[DVec3], c: f64) -> bool {
+    let steps: Vec<DVec3> = pts.windows(2).map(|w| w[1] - w[0]).filter(|d| d.length_squared() > 0.0).collect();
+    (1..steps.len()).any(|k| {
+        if steps[k - 1].dot(steps[k]) >= 0.0 {
+            return false;
+        }
+        // The way it arrived, over the two steps before the turn (one may
+        // be the fold's own short step, pointing aside), and how far the
+        // line runs along it out to the turn and back from it.
+        let way = (steps[k - 1] + if k >= 2 { steps[k - 2] } else { DVec3::ZERO }).normalize_or_zero();
+        let back: f64 = steps[k..].iter().map(|d| -d.dot(way)).take_while(|&x| x > 0.0).sum();
+        let out: f64 = steps[..k].iter().rev().map(|d| d.dot(way)).take_while(|&x| x > 0.0).sum();
+        out.min(back) > c
+    })
 }
 
 /// A model whose poorly parameterized faces were rebuilt (paper 001's output
@@ -555,6 +584,52 @@ mod tests {
         let k = vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
         let even = NurbsSurface::try_new([3, 3], k.clone(), k, &pts, None).unwrap();
         assert!(step_ratio(&even) < RATIO_LIMIT, "ratio {}", step_ratio(&even));
+    }
+
+    /// A strip pleated along v (its control net runs out to y = 6 and back
+    /// over itself, 2e-3 higher), its u parameters crowded as
+    /// [`crowded`]'s when `crowd`, else even.
+    fn pleated(crowd: bool) -> NurbsSurface {
+        let xs: Vec<f64> = if crowd {
+            vec![0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 5.0, 10.0]
+        } else {
+            (0..11).map(|i| i as f64).collect()
+        };
+        let (ys, zs) = ([0.0, 3.0, 6.0, 3.0, 0.0], [0.0, 0.0, 0.001, 0.002, 0.002]);
+        let pts: Vec<Vec<DVec3>> = xs.iter().map(|&x| (0..5).map(|j| DVec3::new(x, ys[j], zs[j])).collect()).collect();
+        let mut ku = vec![0.0; 4];
+        ku.extend((1..8).map(|k| k as f64 / 8.0));
+        ku.extend([1.0; 4]);
+        NurbsSurface::try_new([3, 3], ku, vec![0.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0], &pts, None).unwrap()
+    }
+
+    /// A pleat (as OCC131-2's face 0, where the normal reverses along the
+    /// fold) slows its v lines to nothing where they turn back, which no
+    /// rebuild evens out: its even u lines decide, and the face is not
+    /// flagged. The same pleat with crowded u lines still is.
+    #[test]
+    fn ratio_test_leaves_out_lines_that_turn_back() {
+        let even = pleated(false);
+        let line =
+            |p: fn(f64) -> DVec2| (0..=STEPS).map(|k| even.point(p(k as f64 / STEPS as f64))).collect::<Vec<_>>();
+        let back = |pts: Vec<DVec3>| {
+            let c = pts.windows(2).map(|w| w[0].distance(w[1])).sum::<f64>() / STEPS as f64;
+            turns_back(&pts, c)
+        };
+        assert!(back(line(|t| DVec2::new(0.5, t))), "the pleat's v lines turn back");
+        assert!(!back(line(|t| DVec2::new(t, 0.25))), "its u lines do not");
+        // Between samples too: the fold 0.3 of a step past one.
+        assert!(back(line(|t| DVec2::new(0.5, (t + 0.3 / STEPS as f64).min(1.0)))));
+        // A hook narrower than a step (a wrinkle the rebuild smooths over)
+        // does not count, at either end (linkrods' faces 25 and 26).
+        let mut hooked: Vec<DVec3> = (0..=STEPS).map(|k| DVec3::new(k as f64, 0.0, 0.0)).collect();
+        hooked[STEPS] = DVec3::new(STEPS as f64 - 1.2, 0.0, 0.0);
+        assert!(!back(hooked));
+        let hooked: Vec<DVec3> = (0..=STEPS).map(|k| DVec3::new(0.5 - (k as f64 - 1.0).abs(), 0.0, 0.0)).collect();
+        assert!(!back(hooked));
+        assert!(step_ratio(&even) <= RATIO_LIMIT, "ratio {}", step_ratio(&even));
+        let crowd = pleated(true);
+        assert!(step_ratio(&crowd) > RATIO_LIMIT, "ratio {}", step_ratio(&crowd));
     }
 
     /// A polyline loop that closes with a stub of no length on the border
