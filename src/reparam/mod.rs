@@ -71,7 +71,7 @@ pub struct ReparamFace {
 /// poor row can hide anywhere. Each line is cut into 50 equal parameter steps
 /// of model-space lengths `L_i`; with `C` their mean, the ratio is the
 /// largest `max(L_i / C, C / L_i)`. Lines of no length (poles) are left out,
-/// and so are lines that turn back ([`turns_back`]) where they would flag
+/// and so are lines that turn back (`turns_back`) where they would flag
 /// the face: their steps shrink to nothing at the fold however the
 /// parameters run, and a rebuild, which must turn back too, cannot even them.
 pub fn step_ratio(surface: &dyn Surface) -> f64 {
