@@ -20,7 +20,10 @@ const BETWEEN: f64 = 0.5;
 /// `BETWEEN · d` of `P` but not as near `q`: that face lies between them,
 /// a strip narrower than the sewing distance, and `q` on the border would
 /// lay the border's face over it (the two overlap on the strip, and the
-/// strip's sides become a crack no join can close the right way up). Where
+/// strip's sides become a crack no join can close the right way up). A
+/// piece of `q`'s own face counts within `d` of `P` where it is farther
+/// than `d` from `q`: `P` lies as near that face's other side as `q` is
+/// (a fitted face's border halfway across a strip). Where
 /// both faces at `P` fold shut there by themselves (each has a node of its
 /// own at `q` within `tight` and its `reach` of `P`: a loop that doubles
 /// back on itself), all of them take `q` and the insertion stands.
@@ -103,7 +106,7 @@ pub(super) fn between(
         .filter(|(_, pr)| pr.d > 1e-9 * at(pr.q).abs().max_element())
         .map(|(i, pr)| (i, pr.p))
         .collect();
-    let Some(widest) = probes.iter().map(|&(ci, _)| BETWEEN * all[ci].d).reduce(f64::max) else {
+    let Some(widest) = probes.iter().map(|&(ci, _)| all[ci].d).reduce(f64::max) else {
         return across;
     };
     let mut grid = CellGrid::new(guarded_div(1.0, cell));
@@ -158,7 +161,10 @@ pub(super) fn between(
                     if across[ci] || mine || face == h || body(face) != body(h) {
                         continue;
                     }
-                    let r = BETWEEN * d;
+                    // Another piece of `q`'s own face at least as near `p`
+                    // as `q` is, but farther from `q` than `p`: `p` lies
+                    // across that face, by its other side.
+                    let r = if h == q.0 && within(p, d) && !within(at(q), d) { d } else { BETWEEN * d };
                     if within(p, r) && !within(at(q), r) && !(pinches(face, at(q), p, r) && pinches(h, at(q), p, r)) {
                         across[ci] = true;
                     }
@@ -309,5 +315,57 @@ mod tests {
         assert!(far.iter().all(|id| g.contains(id)), "far side {far:?} g {g:?}");
         let [f, _, _, g] = strip_ids(0.04);
         assert!(!f.is_empty() && f.iter().all(|id| g.contains(id)), "a gap: f {f:?} g {g:?}");
+    }
+
+    /// A strip 0.3 wide (wider than `tight`) beside a face `f` of another
+    /// surface 0.2 above it, whose border runs 0.1 inside the strip (a
+    /// fitted face off its neighbours): the strip's far side, its nodes
+    /// between `f`'s, lies about as near `f`'s border (0.28) as its near
+    /// side does (0.22). Taking a far-side node put `f` over the strip
+    /// there, its border zigzagging between the strip's two sides (edges
+    /// of three faces); `f` takes only near-side nodes.
+    #[test]
+    fn a_node_is_not_sewn_across_its_own_face() {
+        let plane = |z: f64| {
+            let pts: Vec<Vec<DVec3>> = alloc::vec![
+                alloc::vec![DVec3::new(0.0, 0.0, z), DVec3::new(0.0, 12.0, z)],
+                alloc::vec![DVec3::new(3.0, 0.0, z), DVec3::new(3.0, 12.0, z)],
+            ];
+            NurbsSurface::try_new(
+                [1, 1],
+                alloc::vec![0.0, 0.0, 3.0, 3.0],
+                alloc::vec![0.0, 0.0, 12.0, 12.0],
+                &pts,
+                None,
+            )
+            .unwrap()
+        };
+        let (low, high) = (plane(0.0), plane(0.2));
+        let even = |u: f64| (0..=6).map(move |i| (u, f64::from(2 * i)));
+        let odd: Vec<f64> = [0.0].into_iter().chain((0..6).map(|i| f64::from(2 * i + 1))).chain([12.0]).collect();
+        let fp: Vec<(f64, f64)> = [(0.0, 0.0)].into_iter().chain(even(1.1)).chain([(0.0, 12.0)]).collect();
+        let hp: Vec<(f64, f64)> = even(1.0).chain(odd.iter().rev().map(|&v| (1.3, v))).collect();
+        let (fc, fuv) = polygon(&fp);
+        let (hc, huv) = polygon(&hp);
+        let (mut f, mut h) = (outline(&fc, &fuv), outline(&hc, &huv));
+        {
+            let (sl, sh) = (&low as &dyn Surface, &high as &dyn Surface);
+            let mut faces = alloc::vec![Some((sh, &mut f)), Some((sl, &mut h))];
+            unify(&mut faces, &[], &[0.0; 2], 0.5, 0.25, 1.0);
+        }
+        let ids = |o: &Outline<'_>, lo: f64, hi: f64| -> Vec<u32> {
+            let poly = &o.loops.polys[0];
+            poly.uv
+                .iter()
+                .zip(&o.gids[0])
+                .filter(|(q, _)| q.x > lo && q.x < hi && q.y > 0.5 && q.y < 11.5)
+                .map(|(_, &g)| g)
+                .collect()
+        };
+        let (mine, near, far) = (ids(&f, 0.5, 2.0), ids(&h, 0.9, 1.1), ids(&h, 1.2, 1.4));
+        assert_eq!(far.len(), 6, "{far:?}");
+        assert!(mine.iter().all(|id| !far.contains(id)), "f {mine:?} takes a node of the far side {far:?}");
+        // The near side is f's: the two are sewn.
+        assert!(near.iter().all(|id| mine.contains(id)), "near side {near:?} f {mine:?}");
     }
 }
