@@ -410,7 +410,7 @@ function markdown(rows, meta) {
   out.push('');
   out.push('## Edges per file (the yardstick\'s counts; OCCT at surfmesh\'s deflection)');
   out.push('');
-  out.push('surfmesh\'s own report beside them: its weld distance and bodies can differ from the yardstick\'s.');
+  out.push('surfmesh\'s own report beside them: its weld distance can differ from the yardstick\'s. The yardstick counts per body, finding each face\'s body from the model faces nearest it; faces of two bodies that coincide and face one way can go to either.');
   out.push('');
   out.push('| file | rel. tol | surfmesh non-manifold | OCCT non-manifold | surfmesh cracks | OCCT cracks | surfmesh boundary | OCCT boundary | surfmesh report: free / non-manifold / inverted |');
   out.push('|---|---|---:|---:|---:|---:|---:|---:|---|');
