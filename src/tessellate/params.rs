@@ -347,20 +347,7 @@ fn demand_all(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits) -> Demand {
         all.fold = all.fold.max(d.fold);
         all.sag = all.sag.max(d.sag);
     };
-    for p in probes {
-        match &p.inside {
-            None => take(demand_parts(p.eval, a, b, lim, p.one_sided)),
-            Some(pieces) => {
-                let eps = (b - a) * 1e-9;
-                for &(lo, hi) in pieces {
-                    let (x, y) = (a.max(lo), b.min(hi));
-                    if y - x > eps {
-                        take(demand_parts(p.eval, x, y, lim, p.one_sided));
-                    }
-                }
-            }
-        }
-    }
+    each_part(probes, a, b, |p, x, y| take(demand_parts(p.eval, x, y, lim, p.one_sided)));
     all
 }
 
@@ -375,23 +362,28 @@ fn over_probes(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits, test: Interva
         need = need.max(n);
         sag = sag.max(s);
     };
+    each_part(probes, a, b, |p, x, y| take(test(p.eval, x, y, lim, p.one_sided)));
+    (need, sag)
+}
+
+/// Calls `f` with each probe and each part `[x, y]` of `[a, b]` where it
+/// matters: the whole interval, or only the parts inside the probe's
+/// region (a piece a rounding error long says nothing).
+fn each_part<'e>(probes: &[Probe<'e>], a: f64, b: f64, mut f: impl FnMut(&Probe<'e>, f64, f64)) {
     for p in probes {
         match &p.inside {
-            None => take(test(p.eval, a, b, lim, p.one_sided)),
+            None => f(p, a, b),
             Some(pieces) => {
-                // Only the part of [a, b] inside the region is tested; a piece
-                // a rounding error long says nothing.
                 let eps = (b - a) * 1e-9;
                 for &(lo, hi) in pieces {
                     let (x, y) = (a.max(lo), b.min(hi));
                     if y - x > eps {
-                        take(test(p.eval, x, y, lim, p.one_sided));
+                        f(p, x, y);
                     }
                 }
             }
         }
     }
-    (need, sag)
 }
 
 /// Fine intervals whose demand [`equidistribute`] sums.
