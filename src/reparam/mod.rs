@@ -562,6 +562,15 @@ mod tests {
     use super::*;
     use crate::nurbs::NurbsSurface;
 
+    /// A bicubic over 11 by 5 control points, on even knots in u (eighths)
+    /// and one inner knot at 0.5 in v.
+    fn eleven_by_five(pts: &[Vec<DVec3>]) -> NurbsSurface {
+        let mut ku = vec![0.0; 4];
+        ku.extend((1..8).map(|k| k as f64 / 8.0));
+        ku.extend([1.0; 4]);
+        NurbsSurface::try_new([3, 3], ku, vec![0.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0], pts, None).unwrap()
+    }
+
     /// A wavy sheet whose u parameter crowds: 90% of its range covers the first 5% of x.
     fn crowded() -> NurbsSurface {
         let xs = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 5.0, 10.0];
@@ -569,10 +578,7 @@ mod tests {
             .iter()
             .map(|&x| (0..5).map(|j| DVec3::new(x, j as f64, (x * 0.6).sin() + 0.2 * j as f64)).collect())
             .collect();
-        let mut ku = vec![0.0; 4];
-        ku.extend((1..8).map(|k| k as f64 / 8.0));
-        ku.extend([1.0; 4]);
-        NurbsSurface::try_new([3, 3], ku, vec![0.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0], &pts, None).unwrap()
+        eleven_by_five(&pts)
     }
 
     #[test]
@@ -597,10 +603,7 @@ mod tests {
         };
         let (ys, zs) = ([0.0, 3.0, 6.0, 3.0, 0.0], [0.0, 0.0, 0.001, 0.002, 0.002]);
         let pts: Vec<Vec<DVec3>> = xs.iter().map(|&x| (0..5).map(|j| DVec3::new(x, ys[j], zs[j])).collect()).collect();
-        let mut ku = vec![0.0; 4];
-        ku.extend((1..8).map(|k| k as f64 / 8.0));
-        ku.extend([1.0; 4]);
-        NurbsSurface::try_new([3, 3], ku, vec![0.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0], &pts, None).unwrap()
+        eleven_by_five(&pts)
     }
 
     /// A pleat (as OCC131-2's face 0, where the normal reverses along the

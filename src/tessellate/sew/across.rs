@@ -184,6 +184,16 @@ mod tests {
     use alloc::vec::Vec;
     use glam::{DVec2, DVec3};
 
+    /// The plane z = `z` over 3 by 12, its (u,v) its (x,y).
+    fn plane_at(z: f64) -> NurbsSurface {
+        let pts: Vec<Vec<DVec3>> = alloc::vec![
+            alloc::vec![DVec3::new(0.0, 0.0, z), DVec3::new(0.0, 12.0, z)],
+            alloc::vec![DVec3::new(3.0, 0.0, z), DVec3::new(3.0, 12.0, z)],
+        ];
+        NurbsSurface::try_new([1, 1], alloc::vec![0.0, 0.0, 3.0, 3.0], alloc::vec![0.0, 0.0, 12.0, 12.0], &pts, None)
+            .unwrap()
+    }
+
     /// The outline of the polygon `corners` in (u,v), one straight curve and
     /// one segment per side.
     fn polygon(corners: &[(f64, f64)]) -> (Vec<NurbsCurve>, Vec<DVec2>) {
@@ -219,18 +229,7 @@ mod tests {
     /// strip's corner that lies on its border.
     #[test]
     fn a_node_is_not_sewn_across_a_narrow_face() {
-        let pts: Vec<Vec<DVec3>> = alloc::vec![
-            alloc::vec![DVec3::ZERO, DVec3::new(0.0, 12.0, 0.0)],
-            alloc::vec![DVec3::new(3.0, 0.0, 0.0), DVec3::new(3.0, 12.0, 0.0)],
-        ];
-        let plane = NurbsSurface::try_new(
-            [1, 1],
-            alloc::vec![0.0, 0.0, 3.0, 3.0],
-            alloc::vec![0.0, 0.0, 12.0, 12.0],
-            &pts,
-            None,
-        )
-        .unwrap();
+        let plane = plane_at(0.0);
         let (fc, fuv) = polygon(&[(0.0, 0.0), (1.0, 0.0), (1.0, 12.0), (0.0, 12.0)]);
         let (hc, huv) = polygon(&[(1.0, 0.8), (1.3, 1.0), (1.3, 11.0), (1.0, 11.0)]);
         let (gc, guv) = polygon(&[(1.3, 1.0), (3.0, 1.0), (3.0, 11.0), (1.3, 11.0)]);
@@ -256,18 +255,7 @@ mod tests {
     /// the strip's near and far, and `g`'s nodes along the strip's long
     /// sides (ends left out), with `tight` 0.4 and `sew` 0.5.
     fn strip_ids(w: f64) -> [Vec<u32>; 4] {
-        let pts: Vec<Vec<DVec3>> = alloc::vec![
-            alloc::vec![DVec3::ZERO, DVec3::new(0.0, 12.0, 0.0)],
-            alloc::vec![DVec3::new(3.0, 0.0, 0.0), DVec3::new(3.0, 12.0, 0.0)],
-        ];
-        let plane = NurbsSurface::try_new(
-            [1, 1],
-            alloc::vec![0.0, 0.0, 3.0, 3.0],
-            alloc::vec![0.0, 0.0, 12.0, 12.0],
-            &pts,
-            None,
-        )
-        .unwrap();
+        let plane = plane_at(0.0);
         let side = |u: f64, up: bool| -> Vec<(f64, f64)> {
             let v = (0..=6).map(|i| f64::from(2 * i));
             if up {
@@ -326,21 +314,7 @@ mod tests {
     /// of three faces); `f` takes only near-side nodes.
     #[test]
     fn a_node_is_not_sewn_across_its_own_face() {
-        let plane = |z: f64| {
-            let pts: Vec<Vec<DVec3>> = alloc::vec![
-                alloc::vec![DVec3::new(0.0, 0.0, z), DVec3::new(0.0, 12.0, z)],
-                alloc::vec![DVec3::new(3.0, 0.0, z), DVec3::new(3.0, 12.0, z)],
-            ];
-            NurbsSurface::try_new(
-                [1, 1],
-                alloc::vec![0.0, 0.0, 3.0, 3.0],
-                alloc::vec![0.0, 0.0, 12.0, 12.0],
-                &pts,
-                None,
-            )
-            .unwrap()
-        };
-        let (low, high) = (plane(0.0), plane(0.2));
+        let (low, high) = (plane_at(0.0), plane_at(0.2));
         let even = |u: f64| (0..=6).map(move |i| (u, f64::from(2 * i)));
         let odd: Vec<f64> = [0.0].into_iter().chain((0..6).map(|i| f64::from(2 * i + 1))).chain([12.0]).collect();
         let fp: Vec<(f64, f64)> = [(0.0, 0.0)].into_iter().chain(even(1.1)).chain([(0.0, 12.0)]).collect();
