@@ -29,6 +29,8 @@ pub mod pipeline;
 mod refine;
 mod sew;
 mod tessellated;
+#[cfg(feature = "std")]
+mod touching;
 mod trial;
 #[cfg(feature = "std")]
 mod trim;

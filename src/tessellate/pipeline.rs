@@ -394,6 +394,8 @@ impl<'m> Plan<'m> {
             }
             w.mesh.rest();
         }
+        #[cfg(feature = "std")]
+        super::touching::part_touching(&mut works.faces, self.weld());
         works.check("improving", Known::MENDED);
     }
 

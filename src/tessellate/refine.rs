@@ -24,7 +24,7 @@ pub(crate) use limits::{Criteria, Lift, Outcome, FOLD_TURN};
 use limits::{Packed, STALE};
 pub(crate) use mend::count_folded;
 
-const NONE: u32 = u32::MAX;
+pub(crate) const NONE: u32 = u32::MAX;
 
 /// Twice the signed area of the (u,v) triangle `w`: positive when its
 /// corners run counter-clockwise.

@@ -154,7 +154,13 @@ impl WorkMesh {
     /// each new triangle with its side away from the new vertex (running as
     /// the triangle does), or `None`, with the mesh as it was, when `uv` is
     /// not well inside or a new triangle folds or fails the limits.
-    fn split_at(&mut self, surface: &dyn Surface, c: &Criteria, t: u32, uv: DVec2) -> Option<Vec<(u32, u32, u32)>> {
+    pub(crate) fn split_at(
+        &mut self,
+        surface: &dyn Surface,
+        c: &Criteria,
+        t: u32,
+        uv: DVec2,
+    ) -> Option<Vec<(u32, u32, u32)>> {
         let tv = self.tris[t as usize];
         let tuv = self.uv(t as usize);
         let sense = uv_area(tuv);
