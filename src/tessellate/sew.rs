@@ -95,6 +95,8 @@ pub(super) fn nearest_fraction(dist: &dyn Fn(f64) -> f64, s0: f64) -> (f64, f64)
 #[cfg(feature = "std")]
 mod across;
 #[cfg(feature = "std")]
+mod inside;
+#[cfg(feature = "std")]
 mod outlines;
 #[cfg(feature = "std")]
 mod slide;

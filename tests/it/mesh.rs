@@ -819,3 +819,19 @@ fn mesh_warns_when_a_grid_direction_reaches_its_cap() {
     assert_eq!(capped[0].face, Some(1));
     assert_eq!(r.report.faces_skipped, 1, "{:?}", r.report.warnings);
 }
+
+/// Two domes 0.5 apart (a wall thinner than the sewing distance at 1e-2,
+/// 0.72) closed by a rim at their equators: their seams run side by side.
+/// A seam's inner nodes are no border another face meets, so the seams
+/// stay apart; sewn together, every edge along them had four triangles.
+#[test]
+fn mesh_thin_wall_keeps_the_seams_of_its_two_sides_apart() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/thin_dome.json");
+    let model = surfmesh::read_json(&std::fs::read(path).unwrap()).unwrap();
+    for rel in [1e-2, 1e-3] {
+        let rep = mesh(&model, rel).report;
+        assert!(rep.max_deviation <= rep.tolerance, "@ {rel}: deviation {} > {}", rep.max_deviation, rep.tolerance);
+        let edges = (rep.free_edges, rep.boundary_edges, rep.nonmanifold_edges, rep.inverted_triangles);
+        assert_eq!(edges, (0, 0, 0, 0), "@ {rel}: cracks, open, non-manifold edges, inverted triangles");
+    }
+}

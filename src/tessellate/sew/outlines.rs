@@ -5,6 +5,7 @@ use crate::numeric::{guarded_div, TINY};
 use alloc::vec::Vec;
 use glam::DVec3;
 
+use super::inside::Inside;
 use super::nearest_fraction;
 use crate::nurbs::Surface;
 use crate::tessellate::face::Outline;
@@ -46,7 +47,9 @@ type Additions = PerNode<Vec<(f64, f64, NodeRef)>>;
 /// shared node takes its id (a trim curve shorter than the gaps). Within
 /// one face (a seam) `tight` takes the place of `sew`: a face's loops meet
 /// themselves exactly, and a face narrower than `sew` must not be folded
-/// shut. Returns the ids given.
+/// shut. A node or segment that its face lies all around (a seam's:
+/// [`Inside`]) takes no other face's node, nor goes into another's border.
+/// Returns the ids given.
 ///
 /// `reach`: how far a node may lie from the other border's chord
 /// (chordal tolerance plus `sew`). `moved`: per face, how far its border
@@ -62,7 +65,9 @@ pub(crate) fn unify(
 ) -> u32 {
     let tight = tight.min(sew).max(0.0);
     let sew = if sew.is_finite() { sew.max(0.0) } else { 0.0 };
-    let pos = super::slide::slide_nodes(faces, bodies, moved, sew);
+    let pos = positions(faces);
+    let inside = Inside::new(faces, &pos, tight);
+    let pos = super::slide::slide_nodes(faces, pos, &inside, bodies, moved, sew);
     let (mut total, mut count) = (0.0, 0usize);
     for p in pos.iter().flatten() {
         for i in 0..p.len() {
@@ -76,7 +81,7 @@ pub(crate) fn unify(
     let mut twins: Vec<(NodeRef, NodeRef)> = Vec::new();
     let (mut sew_used, mut radius) = (tight, None);
     if sew > 0.0 && reach.is_finite() {
-        let (adds, r, used) = insertions(faces, bodies, moved, &pos, sew, tight, reach, total / count as f64);
+        let (adds, r, used) = insertions(faces, bodies, moved, &pos, &inside, sew, tight, reach, total / count as f64);
         (sew_used, radius) = (used, Some(r));
         twins = insert(faces, &adds);
     }
@@ -223,6 +228,7 @@ fn insertions(
     bodies: &[u32],
     moved: &[f64],
     pos: &PerNode<DVec3>,
+    inside: &Inside,
     sew: f64,
     tight: f64,
     reach: f64,
@@ -238,7 +244,7 @@ fn insertions(
             }
         }
     }
-    let (cands, mut near) = candidates(faces, bodies, pos, &grid, &radius, tight, reach);
+    let (cands, mut near) = candidates(faces, bodies, pos, inside, &grid, &radius, tight, reach);
     // The nearest faces only set the distances: dropped before the
     // additions are made, where the mesh phase of a large assembly peaked.
     let nearest_face = core::mem::take(&mut near.nearest_face);
@@ -266,10 +272,12 @@ fn insertions(
 /// than `sew` is not sewn across its neck. Those tests need the distances
 /// noted here, so a pair that can only tell a distance is not kept (on a
 /// plate of 1000 holes those were most of 12 MB of pairs).
+#[allow(clippy::too_many_arguments)]
 fn candidates(
     faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
     bodies: &[u32],
     pos: &PerNode<DVec3>,
+    inside: &Inside,
     grid: &CellGrid<NodeRef>,
     radius: &PerNode<f64>,
     tight: f64,
@@ -301,6 +309,10 @@ fn candidates(
                 for &qn in grid.near_segment(pa, pb, reach) {
                     let (g, kk, jj) = (qn.0 as usize, qn.1 as usize, qn.2 as usize);
                     if qn == na || qn == nb || body(g) != body(fi) {
+                        continue;
+                    }
+                    // No other face meets a face inside it (a seam's inner node or segment).
+                    if g != fi && (inside.at(qn) || inside.along(na)) {
                         continue;
                     }
                     let q = at(qn);
@@ -582,6 +594,9 @@ struct Clusters<'n> {
     /// Pairs of nodes of one face (lower index first) never in one
     /// cluster: a strip's two sides with other faces' borders on them.
     apart: crate::collections::HashSet<(u32, u32)>,
+    /// Per node, whether its face lies all around it ([`Inside`]): it is
+    /// never one with another face's node. Empty: none is.
+    inside: Vec<bool>,
 }
 
 impl<'n> Clusters<'n> {
@@ -595,6 +610,7 @@ impl<'n> Clusters<'n> {
             reach,
             tight,
             apart: crate::collections::HashSet::default(),
+            inside: Vec::new(),
         }
     }
 
@@ -627,6 +643,11 @@ impl<'n> Clusters<'n> {
             at = (n != x).then_some(n);
             Some(i)
         })
+    }
+
+    /// Whether node `i` lies inside its face (see `inside`).
+    fn is_inside(&self, i: u32) -> bool {
+        self.inside.get(i as usize).copied().unwrap_or(false)
     }
 
     /// Whether nodes `i` and `j` must stay apart (see `apart`).
@@ -697,7 +718,7 @@ impl<'n> Clusters<'n> {
                     continue;
                 }
                 let (fj, q) = nodes[j as usize];
-                if body(fi) != body(fj) {
+                if body(fi) != body(fj) || (fi != fj && (self.is_inside(i as u32) || self.is_inside(j))) {
                     continue;
                 }
                 let d = p.distance(q);
@@ -737,7 +758,7 @@ impl<'n> Clusters<'n> {
                 let n = ring.len();
                 for i in 0..n {
                     let a = ring[i];
-                    if shared_before[a as usize] {
+                    if shared_before[a as usize] || self.is_inside(a) {
                         continue;
                     }
                     let p = nodes[a as usize].1;
@@ -771,6 +792,7 @@ fn name_nodes(
 ) -> u32 {
     let (flat, index, r_flat, pos) = flat_nodes(faces, radius_before, twins);
     let mut cl = Clusters::new(&flat, &r_flat, tight);
+    cl.inside = Inside::new(faces, &pos, tight).node.into_iter().flatten().flatten().collect();
     let pairs = if sew > 0.0 { cl.near_pairs(bodies, sew) } else { Vec::new() };
     cl.apart = folds_across(faces, bodies, &pos, &index, &r_flat, &pairs, sew, tight);
     // Twins first (they are one node by construction), then neighbours by distance.

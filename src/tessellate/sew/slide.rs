@@ -3,7 +3,8 @@
 
 use glam::DVec3;
 
-use super::outlines::{positions, PerNode};
+use super::inside::Inside;
+use super::outlines::PerNode;
 use crate::collections::CellGrid;
 use crate::nurbs::Surface;
 use crate::tessellate::face::Outline;
@@ -24,15 +25,17 @@ const SNAP_SHARE: f64 = 0.3;
 /// narrower than that would be sewn shut). The two are then one node. A
 /// rebuilt face (`moved` > 0) slides onto the others and never the others
 /// onto it; of two faces not rebuilt the earlier slides; two rebuilt faces
-/// keep their own nodes. Returns each node's point on its face's surface,
-/// as [`positions`] gives it, after the slides.
+/// keep their own nodes. A node inside its face ([`Inside`]: a seam's) neither
+/// slides nor is slid onto. `pos`: each node's point on its face's surface
+/// ([`super::outlines::positions`]), returned as it is after the slides.
 pub(super) fn slide_nodes(
     faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>],
+    mut pos: PerNode<DVec3>,
+    inside: &Inside,
     bodies: &[u32],
     moved: &[f64],
     sew: f64,
 ) -> PerNode<DVec3> {
-    let mut pos = positions(faces);
     // A face alone (a trial mesh) has no other face to slide onto.
     if sew <= 0.0 || faces.iter().flatten().nth(1).is_none() {
         return pos;
@@ -70,7 +73,7 @@ pub(super) fn slide_nodes(
                 let h = (i + n - 1) % n;
                 let ((cb, tp, ti), (ca, ti2, tn)) = (poly.seg[h], poly.seg[i]);
                 // Inner nodes of one curve only: a curve's end is a corner.
-                if cb != ca || ca != poly.at[i].curve || ti != ti2 {
+                if cb != ca || ca != poly.at[i].curve || ti != ti2 || inside.at((fi as u32, k as u32, i as u32)) {
                     continue;
                 }
                 let Some(c) = o.loops.curves.get(ca as usize) else { continue };
@@ -87,7 +90,7 @@ pub(super) fn slide_nodes(
                     .in_box(here - r, here + r)
                     .filter(|m| {
                         let g = m.0 as usize;
-                        g != fi && body(g) == body(fi) && !is_moved(g) && (g > fi || is_moved(fi))
+                        g != fi && body(g) == body(fi) && !is_moved(g) && (g > fi || is_moved(fi)) && !inside.at(**m)
                     })
                     .map(|m| {
                         let q = pos[m.0 as usize][m.1 as usize][m.2 as usize];
