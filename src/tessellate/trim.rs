@@ -174,6 +174,9 @@ pub(crate) fn prepare_loops<'a>(
     if let Some(&li) = flat.first().filter(|_| out.polys.is_empty()) {
         return Err(Error::Mesh { face, message: format!("loop {li} encloses no area") });
     }
+    if out.polys.is_empty() {
+        return Err(Error::Mesh { face, message: "no trim loop bounds the face".into() });
+    }
     let (order, file_ccw) = orient_loops(&mut out, areas, kept);
     untangle(face, &mut out, &order, &file_ccw)?;
     if !flat.is_empty() {
@@ -619,6 +622,19 @@ mod tests {
         // Each segment starts at its node's parameter on the same curve.
         for (s, at) in poly.seg.iter().zip(&poly.at) {
             assert_eq!((s.0, s.1), (at.curve, at.t));
+        }
+    }
+
+    /// No loop at all is an error naming the face, not a panic in ordering
+    /// the loops (no caller passes none today; a caller that did got an
+    /// index past the end).
+    #[test]
+    fn no_loops_is_an_error_naming_the_face() {
+        let surface = crate::FaceSurface::Nurbs(crate::nurbs::analytic::xy_plane(1.0));
+        let lim = Limits { tol: 1e-3, angle: 0.5, max_edge: f64::INFINITY, min_edge: 1e-6 };
+        match prepare_loops(7, &surface, &[], &lim) {
+            Err(Error::Mesh { face: 7, message }) => assert!(message.contains("no trim loop"), "{message}"),
+            other => panic!("expected a mesh error for face 7, got {:?}", other.map(|l| l.polys.len())),
         }
     }
 
