@@ -434,6 +434,24 @@ fn segments_meet(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
     on(c, d, a, d1) || on(c, d, b, d2) || on(a, b, c, d3) || on(a, b, d, d4)
 }
 
+/// Whether segments `ab` and `cd` cross, each one's ends more than `noise`
+/// to either side of the other's line.
+fn segments_cross_by(a: DVec2, b: DVec2, c: DVec2, d: DVec2, noise: f64) -> bool {
+    let side = |p: DVec2, q: DVec2, r: DVec2| {
+        let o = orient(p, q, r);
+        let reach = noise * p.distance(q);
+        if o > reach {
+            1
+        } else if o < -reach {
+            -1
+        } else {
+            0
+        }
+    };
+    let (d1, d2, d3, d4) = (side(c, d, a), side(c, d, b), side(a, b, c), side(a, b, d));
+    d1 * d2 < 0 && d3 * d4 < 0
+}
+
 /// Two loop segments that cross or touch: (loop, segment) of each, and
 /// whether they are neighbours folding back onto each other.
 pub(crate) struct Crossing {
@@ -517,25 +535,112 @@ fn first_crossing(loops: &Loops<'_>) -> Option<Crossing> {
     crossings(loops, |_| true)
 }
 
+/// One loop segment from `a` to `b` for the pair search: segment `idx` of
+/// loop `lp` (of `len` segments), or, `half` set, one half of it bent out to
+/// its curve's middle point.
+struct Seg {
+    a: DVec2,
+    b: DVec2,
+    lp: usize,
+    idx: usize,
+    len: usize,
+    half: bool,
+}
+
 /// Calls `stop` with each pair of loop segments that cross or touch (a
 /// pair in two grid cells may come twice) until it returns true; returns
 /// that pair.
 pub(crate) fn crossings(loops: &Loops<'_>, mut stop: impl FnMut(&Crossing) -> bool) -> Option<Crossing> {
-    struct Seg {
-        a: DVec2,
-        b: DVec2,
-        lp: usize,
-        idx: usize,
-        len: usize,
-    }
     let mut segs = Vec::new();
     for (k, p) in loops.polys.iter().enumerate() {
         let n = p.uv.len();
         for i in 0..n {
-            segs.push(Seg { a: p.uv[i], b: p.uv[(i + 1) % n], lp: k, idx: i, len: n });
+            segs.push(Seg { a: p.uv[i], b: p.uv[(i + 1) % n], lp: k, idx: i, len: n, half: false });
         }
     }
-    let (lo, hi) = loops.bounds();
+    let mut found = None;
+    near_pairs(&segs, loops.bounds(), |s, t| {
+        if s.lp == t.lp {
+            let n = s.len;
+            let adjacent = (s.idx + 1) % n == t.idx || (t.idx + 1) % n == s.idx;
+            if adjacent {
+                // Neighbours share one node; they only conflict if they fold back.
+                let (shared, p, q) = if (s.idx + 1) % n == t.idx { (s.b, s.a, t.b) } else { (s.a, s.b, t.a) };
+                let folds = orient(shared, p, q) == 0.0 && (p - shared).dot(q - shared) > 0.0;
+                let x = Crossing { a: (s.lp, s.idx), b: (t.lp, t.idx), folds: true };
+                if folds && n > 2 && stop(&x) {
+                    found = Some(x);
+                    return true;
+                }
+                return false;
+            }
+        }
+        if segments_meet(s.a, s.b, t.a, t.b) {
+            let x = Crossing { a: (s.lp, s.idx), b: (t.lp, t.idx), folds: false };
+            if stop(&x) {
+                found = Some(x);
+                return true;
+            }
+        }
+        false
+    });
+    found
+}
+
+/// Calls `stop` with each pair of loop segments (loop, segment) where the
+/// first, halved on its curve, would cross the second as it stands, until
+/// it returns true. Such a chord bulges past the other: their curves come
+/// closer than the chords' sagitta (a spike of the trim region narrower than
+/// its sides sag), so a split of either, as refinement makes them, would
+/// fold, and a triangle between them spans the region's two sides turned.
+/// `middle(k, i)` is the (u,v) middle of segment `i` of loop `k` on its
+/// curve, `None` where it has none to halve.
+pub(crate) fn bulge_crossings(
+    loops: &Loops<'_>,
+    middle: impl Fn(usize, usize) -> Option<DVec2>,
+    mut stop: impl FnMut((usize, usize), (usize, usize)) -> bool,
+) -> bool {
+    let mut segs = Vec::new();
+    for (k, p) in loops.polys.iter().enumerate() {
+        let n = p.uv.len();
+        for i in 0..n {
+            let (a, b) = (p.uv[i], p.uv[(i + 1) % n]);
+            segs.push(Seg { a, b, lp: k, idx: i, len: n, half: false });
+            if let Some(m) = middle(k, i).filter(|m| m.is_finite() && *m != a && *m != b) {
+                segs.push(Seg { a, b: m, lp: k, idx: i, len: n, half: true });
+                segs.push(Seg { a: m, b, lp: k, idx: i, len: n, half: true });
+            }
+        }
+    }
+    let (mut lo, mut hi) = loops.bounds();
+    for s in &segs {
+        lo = lo.min(s.b);
+        hi = hi.max(s.b);
+    }
+    // Sides on one line that rounding zigzags do not cross.
+    let noise = 1e-12 * lo.distance(hi);
+    near_pairs(&segs, (lo, hi), |s, t| {
+        // A half against a chord of another segment.
+        let (h, c) = match (s.half, t.half) {
+            (true, false) => (s, t),
+            (false, true) => (t, s),
+            _ => return false,
+        };
+        // A half meets its own chord and its neighbours at their shared
+        // nodes: only a half away from a node can cross there.
+        let shares = |x: DVec2| x == c.a || x == c.b;
+        if (h.lp == c.lp && h.idx == c.idx) || shares(h.a) || shares(h.b) {
+            return false;
+        }
+        segments_cross_by(h.a, h.b, c.a, c.b, noise) && stop((h.lp, h.idx), (c.lp, c.idx))
+    })
+}
+
+/// Calls `visit` with each pair of segments `segs` whose boxes share a cell
+/// of a uniform grid over `bounds` (a pair in two cells may come twice)
+/// until it returns true; returns whether it did.
+fn near_pairs(segs: &[Seg], bounds: (DVec2, DVec2), mut visit: impl FnMut(&Seg, &Seg) -> bool) -> bool {
+    let (lo, hi) = bounds;
     let cells = (crate::math::sqrt(segs.len() as f64) as usize).clamp(1, 512);
     let size = (hi - lo).max(DVec2::splat(TINY)) / cells as f64;
     let cell_of = |p: DVec2| {
@@ -555,31 +660,13 @@ pub(crate) fn crossings(loops: &Loops<'_>, mut stop: impl FnMut(&Crossing) -> bo
     for bucket in &grid {
         for (ii, &i) in bucket.iter().enumerate() {
             for &j in &bucket[ii + 1..] {
-                let (s, t) = (&segs[i as usize], &segs[j as usize]);
-                if s.lp == t.lp {
-                    let n = s.len;
-                    let adjacent = (s.idx + 1) % n == t.idx || (t.idx + 1) % n == s.idx;
-                    if adjacent {
-                        // Neighbours share one node; they only conflict if they fold back.
-                        let (shared, p, q) = if (s.idx + 1) % n == t.idx { (s.b, s.a, t.b) } else { (s.a, s.b, t.a) };
-                        let folds = orient(shared, p, q) == 0.0 && (p - shared).dot(q - shared) > 0.0;
-                        let x = Crossing { a: (s.lp, s.idx), b: (t.lp, t.idx), folds: true };
-                        if folds && n > 2 && stop(&x) {
-                            return Some(x);
-                        }
-                        continue;
-                    }
-                }
-                if segments_meet(s.a, s.b, t.a, t.b) {
-                    let x = Crossing { a: (s.lp, s.idx), b: (t.lp, t.idx), folds: false };
-                    if stop(&x) {
-                        return Some(x);
-                    }
+                if visit(&segs[i as usize], &segs[j as usize]) {
+                    return true;
                 }
             }
         }
     }
-    None
+    false
 }
 
 #[cfg(test)]

@@ -9,14 +9,20 @@
 //! both, and the triangles between them go missing: a crack. Here such
 //! chords are halved again, in every face that shares them, so the sewn
 //! borders stay one.
+//!
+//! So are chords that do not cross yet but would once refinement splits
+//! one on its curve: two sides of a spike narrower than their chords'
+//! sagitta. A triangle between such chords spans the spike turned over,
+//! and no split can mend it, as each would fold in (u,v).
 
 use alloc::vec::Vec;
 use glam::DVec3;
 
 use super::nearest_fraction;
+use crate::collections::{HashMap, HashSet};
 use crate::nurbs::Surface;
 use crate::tessellate::face::Outline;
-use crate::tessellate::trim::crossings;
+use crate::tessellate::trim::{bulge_crossings, crossings};
 
 /// Most rounds of halving; curves that really cross stay crossing after it.
 const MAX_ROUNDS: usize = 16;
@@ -30,10 +36,21 @@ const MAX_CUTS: usize = 4096;
 /// its two end ids); `ids` is the count of node ids given so far, and the
 /// count after the new nodes is returned. Each face's new node lies at its
 /// own curve's point nearest the first face's middle point, under one id.
+/// A segment that another's halving would cross ([`bulge_crossings`]) is
+/// halved too, and that other with it, where every face along them has
+/// them under the same ids.
 pub(crate) fn split_crossing_chords(faces: &mut [Option<(&dyn Surface, &mut Outline<'_>)>], mut ids: u32) -> u32 {
+    // Per face, how many more chords may be halved for bulging: as many
+    // as it has nodes, so curves that run closer than their own sag
+    // anywhere (nearly one curve twice) cannot double its nodes each round.
+    let mut allowance: Vec<usize> =
+        faces.iter().map(|f| f.as_ref().map_or(0, |(_, o)| o.gids.iter().map(Vec::len).sum())).collect();
     for _ in 0..MAX_ROUNDS {
         let mut cuts: Vec<((u32, u32), DVec3)> = Vec::new();
-        for (surface, o) in faces.iter().flatten() {
+        let (pairs, alone) = border_uses(faces);
+        for ((surface, o), allowance) in
+            faces.iter().zip(allowance.iter_mut()).filter_map(|(f, a)| Some((f.as_ref()?, a)))
+        {
             let note = |k: usize, i: usize, cuts: &mut Vec<((u32, u32), DVec3)>| {
                 let (Some(poly), Some(g)) = (o.loops.polys.get(k), o.gids.get(k)) else { return };
                 let n = poly.uv.len();
@@ -54,6 +71,35 @@ pub(crate) fn split_crossing_chords(faces: &mut [Option<(&dyn Surface, &mut Outl
                 }
                 cuts.len() >= MAX_CUTS
             });
+            // A chord its neighbour's split would cross: both halved, so
+            // each side keeps to its curve closer than the two come.
+            let middle = |k: usize, i: usize| {
+                let &(c, ta, tb) = o.loops.polys.get(k)?.seg.get(i)?;
+                let tm = 0.5 * (ta + tb);
+                (tm != ta && tm != tb).then(|| o.loops.curves.get(c as usize).map(|c| c.point(tm).truncate()))?
+            };
+            // Only where every face along the segment takes its node: one
+            // that sewing left beside another face's border under other ids
+            // would open a crack there.
+            let cuttable = |k: usize, i: usize| {
+                let Some(g) = o.gids.get(k) else { return false };
+                let n = g.len();
+                let (ga, gb) = (g[i % n.max(1)], g[(i + 1) % n.max(1)]);
+                pairs.get(&(ga.min(gb), ga.max(gb))).is_some_and(|&c| c > 1)
+                    || (alone.contains(&ga) && alone.contains(&gb))
+            };
+            bulge_crossings(&o.loops, middle, |h, c| {
+                // The crossed chord is halved first: the bulging one alone
+                // would put its node past the other, a crossing of chords.
+                if *allowance > 0 && cuttable(c.0, c.1) {
+                    *allowance -= 1;
+                    note(c.0, c.1, &mut cuts);
+                    if cuttable(h.0, h.1) {
+                        note(h.0, h.1, &mut cuts);
+                    }
+                }
+                cuts.len() >= MAX_CUTS
+            });
         }
         if cuts.is_empty() {
             break;
@@ -67,6 +113,31 @@ pub(crate) fn split_crossing_chords(faces: &mut [Option<(&dyn Surface, &mut Outl
         ids += cuts.len() as u32;
     }
     ids
+}
+
+/// How many faces have each border segment (by its end ids, lower first),
+/// and the ids of nodes on one face's border only.
+fn border_uses(faces: &[Option<(&dyn Surface, &mut Outline<'_>)>]) -> (HashMap<(u32, u32), u32>, HashSet<u32>) {
+    let mut pairs: HashMap<(u32, u32), u32> = HashMap::default();
+    let mut face_of: HashMap<u32, Option<usize>> = HashMap::default();
+    for (f, (_, o)) in faces.iter().enumerate().filter_map(|(f, x)| x.as_ref().map(|x| (f, x))) {
+        let mut mine: Vec<(u32, u32)> = Vec::new();
+        for g in &o.gids {
+            let n = g.len();
+            for i in 0..n {
+                let (ga, gb) = (g[i], g[(i + 1) % n]);
+                mine.push((ga.min(gb), ga.max(gb)));
+                face_of.entry(ga).and_modify(|x| *x = x.filter(|&x| x == f)).or_insert(Some(f));
+            }
+        }
+        mine.sort_unstable();
+        mine.dedup();
+        for p in mine {
+            *pairs.entry(p).or_insert(0) += 1;
+        }
+    }
+    let alone = face_of.into_iter().filter(|(g, f)| f.is_some() && *g != u32::MAX).map(|(g, _)| g).collect();
+    (pairs, alone)
 }
 
 /// Adds the new node of every segment of `o` whose end ids are in `cuts`
@@ -175,5 +246,70 @@ mod tests {
             assert_eq!(at, k, "{:?}", o.gids[0]);
             assert!(o.loops.polys[0].uv[at].distance(p(0.0, 1.0)) < 1e-9, "{:?}", o.loops.polys[0].uv);
         }
+    }
+
+    /// A crescent between two arcs from one tip `T`, as one face: at the
+    /// tip the left side's curve bends past the right side's chord, though
+    /// the three chords make a triangle. Both are halved until no halving
+    /// of one would cross the other, and the loop crosses nowhere.
+    fn crescent() -> [NurbsCurve; 3] {
+        let p = |x: f64, y: f64| DVec2::new(x, y);
+        [
+            arc(p(0.0, 0.0), p(2.0, 5.0), p(0.0, 10.0)),
+            line(p(0.0, 10.0), p(-1.0, 10.0)),
+            arc(p(-1.0, 10.0), p(1.6, 5.0), p(0.0, 0.0)),
+        ]
+    }
+
+    /// Each segment's (u,v) middle on its curve.
+    fn middles<'a>(o: &'a Outline<'_>) -> impl Fn(usize, usize) -> Option<DVec2> + 'a {
+        |k, i| {
+            let (c, ta, tb) = o.loops.polys[k].seg[i];
+            Some(o.loops.curves[c as usize].point(0.5 * (ta + tb)).truncate())
+        }
+    }
+
+    #[test]
+    fn chords_of_a_spike_narrower_than_their_sag_are_halved() {
+        let plane = crate::nurbs::analytic::xy_plane(20.0);
+        let curves = crescent();
+        let mut a = outline(&curves, &[&[(0, 0), (1, 1), (2, 2)]]);
+        assert!(crossings(&a.loops, |_| true).is_none(), "the test's chords must not cross");
+        assert!(
+            bulge_crossings(&a.loops, middles(&a), |_, _| true),
+            "the left arc's halves must cross the right chord"
+        );
+        let ids = {
+            let mut faces = alloc::vec![Some((&plane as &dyn Surface, &mut a))];
+            split_crossing_chords(&mut faces, 3)
+        };
+        assert!(ids > 3, "both arcs are halved");
+        assert!(!bulge_crossings(&a.loops, middles(&a), |_, _| true), "{:?}", a.loops.polys[0].uv);
+        assert!(crossings(&a.loops, |_| true).is_none());
+        assert_eq!(a.gids[0].len(), a.loops.polys[0].uv.len());
+    }
+
+    /// The crescent's right arc runs along a neighbour whose border there
+    /// has other ids (a tip sewing did not join): the neighbour would not
+    /// take a node on it, so neither arc is halved for bulging.
+    #[test]
+    fn a_bulging_chord_beside_another_faces_border_is_kept() {
+        let plane = crate::nurbs::analytic::xy_plane(20.0);
+        let curves = crescent();
+        let p = |x: f64, y: f64| DVec2::new(x, y);
+        let beside = [
+            line(p(0.0, 0.0), p(5.0, 0.0)),
+            line(p(5.0, 0.0), p(5.0, 12.0)),
+            arc(p(5.0, 12.0), p(2.0, 5.0), p(0.0, 0.0)),
+        ];
+        let mut a = outline(&curves, &[&[(0, 0), (1, 1), (2, 2)]]);
+        let mut b = outline(&beside, &[&[(0, 0), (1, 7), (2, 8)]]);
+        let before = a.loops.polys[0].uv.clone();
+        let ids = {
+            let mut faces = alloc::vec![Some((&plane as &dyn Surface, &mut a)), Some((&plane as &dyn Surface, &mut b))];
+            split_crossing_chords(&mut faces, 9)
+        };
+        assert_eq!(ids, 9);
+        assert_eq!(a.loops.polys[0].uv, before);
     }
 }
