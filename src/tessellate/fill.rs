@@ -15,9 +15,8 @@ use crate::collections::HashMap;
 use alloc::vec::Vec;
 use glam::DVec3;
 
+use super::refine::NONE;
 use super::sew::FaceWork;
-
-const NONE: u32 = u32::MAX;
 /// The most sides a hole closed here may have.
 const MAX_SIDES: usize = 8;
 

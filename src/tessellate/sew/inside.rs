@@ -62,13 +62,18 @@ impl Inside {
 
     /// Whether node `n` lies inside its face.
     pub fn at(&self, n: NodeRef) -> bool {
-        self.node.get(n.0 as usize).and_then(|f| f.get(n.1 as usize)).and_then(|l| l.get(n.2 as usize)) == Some(&true)
+        flag(&self.node, n)
     }
 
     /// Whether segment `n` (node `n` to the next) runs along a seam.
     pub fn along(&self, n: NodeRef) -> bool {
-        self.seam.get(n.0 as usize).and_then(|f| f.get(n.1 as usize)).and_then(|l| l.get(n.2 as usize)) == Some(&true)
+        flag(&self.seam, n)
     }
+}
+
+/// Node `n`'s entry of a per-node table; `false` for a node it lacks.
+fn flag(table: &PerNode<bool>, n: NodeRef) -> bool {
+    table.get(n.0 as usize).and_then(|f| f.get(n.1 as usize)).and_then(|l| l.get(n.2 as usize)) == Some(&true)
 }
 
 /// [`Inside`] for one face: its loops' parameters `uv` and points `p`.
@@ -153,32 +158,14 @@ fn face_inside(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::nurbs::NurbsSurface;
+    use crate::nurbs::{analytic, NurbsSurface};
     use crate::tessellate::params::Limits;
     use alloc::vec;
+    use core::f64::consts::FRAC_PI_2;
 
-    const W: f64 = core::f64::consts::FRAC_1_SQRT_2;
-    const RING: [(f64, f64); 9] = [
-        (1.0, 0.0),
-        (1.0, 1.0),
-        (0.0, 1.0),
-        (-1.0, 1.0),
-        (-1.0, 0.0),
-        (-1.0, -1.0),
-        (0.0, -1.0),
-        (1.0, -1.0),
-        (1.0, 0.0),
-    ];
-
-    /// A surface of revolution about z of the rational profile `(rho, z, weight)`, its
-    /// parameters round the axis first.
-    fn revolved(profile: &[(f64, f64, f64)], knots: Vec<f64>, degree: usize) -> NurbsSurface {
-        let net: Vec<Vec<DVec3>> =
-            RING.iter().map(|&(x, y)| profile.iter().map(|&(r, z, _)| DVec3::new(r * x, r * y, z)).collect()).collect();
-        let w: Vec<Vec<f64>> =
-            (0..9).map(|i| profile.iter().map(|&(_, _, pw)| pw * if i % 2 == 1 { W } else { 1.0 }).collect()).collect();
-        let ring = vec![0.0, 0.0, 0.0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1.0, 1.0, 1.0];
-        NurbsSurface::try_new([2, degree], ring, knots, &net, Some(&w)).expect("surface")
+    /// The surface `profile` (a curve in the xz plane) sweeps about the z axis, a whole turn.
+    fn revolved(profile: &crate::NurbsCurve) -> NurbsSurface {
+        analytic::revolve(profile, DVec3::ZERO, DVec3::Z, 0.0, core::f64::consts::TAU).expect("surface")
     }
 
     /// Inside flags of an untrimmed surface's outline, with each node's point.
@@ -197,8 +184,8 @@ mod tests {
     /// among them) do not.
     #[test]
     fn a_domes_seam_and_pole_lie_inside_it_and_its_rim_does_not() {
-        let dome =
-            revolved(&[(10.0, 0.0, 1.0), (10.0, 10.0, W), (0.0, 10.0, 1.0)], vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0], 2);
+        let quarter = analytic::circle_arc(DVec3::ZERO, DVec3::X, DVec3::Z, 10.0, 0.0, FRAC_PI_2).expect("arc");
+        let dome = revolved(&quarter);
         let nodes = flags(&dome, 0.05, 1e-3);
         let (mut seam, mut rim) = (0, 0);
         for (p, inside) in nodes {
@@ -217,7 +204,8 @@ mod tests {
     /// segments are shorter than `tight` but are no pole's.
     #[test]
     fn a_circle_narrower_than_tight_is_no_pole() {
-        let tube = revolved(&[(0.02, 0.0, 1.0), (0.02, 10.0, 1.0)], vec![0.0, 0.0, 1.0, 1.0], 1);
+        let side = analytic::line(DVec3::new(0.02, 0.0, 0.0), DVec3::new(0.02, 0.0, 10.0), 0.0, 1.0).expect("line");
+        let tube = revolved(&side);
         let nodes = flags(&tube, 1e-3, 0.1);
         assert!(nodes.len() > 8 && nodes.iter().all(|n| !n.1), "{nodes:?}");
     }
