@@ -25,8 +25,8 @@ pub use bbox::Aabb;
 pub use curve::{CurveDerivs, NurbsCurve};
 pub use error::NurbsError;
 pub use knots::{BasisDers, KnotVector};
-pub(crate) use project::project_until;
 pub use project::{project_to_surface, CurveProjection, Projection, ProjectionOptions};
+pub(crate) use project::{project_until, project_with, SurfaceFacts};
 pub use surface::NurbsSurface;
 
 /// Highest degree accepted (basis functions use fixed-size scratch arrays).

@@ -1,7 +1,9 @@
 //! Closest-point projection onto a surface (Newton with safeguards).
 
 use crate::numeric::{guarded_div, TINY};
+use alloc::borrow::Cow;
 use alloc::vec::Vec;
+use core::cell::OnceCell;
 use glam::{DVec2, DVec3};
 
 use super::{Surface, SurfaceDerivs};
@@ -90,16 +92,30 @@ pub(crate) fn project_until(
     options: &ProjectionOptions,
     enough: f64,
 ) -> Projection {
+    project_with(surface, &SurfaceFacts::default(), target, hint, options, enough)
+}
+
+/// As [`project_until`], with what earlier projections onto the same
+/// surface learnt about it (`facts`, which must belong to `surface`): a
+/// caller projecting many points onto one surface pays for its knots, seams,
+/// collapsed edges and search grid once. The results are the same.
+pub(crate) fn project_with(
+    surface: &dyn Surface,
+    facts: &SurfaceFacts,
+    target: DVec3,
+    hint: Option<DVec2>,
+    options: &ProjectionOptions,
+    enough: f64,
+) -> Projection {
     let [lo, hi] = surface.domain();
-    let mut seams = Seams::default();
-    let breaks = [surface.breaks(true), surface.breaks(false)];
+    let breaks = facts.breaks(surface);
     let starts = match hint {
         Some(h) if h.is_finite() => Starts::one(h.clamp(lo, hi)),
-        _ => coarse_search(surface, target, options.search_samples.max(2)),
+        _ => coarse_search(surface, facts, target, options.search_samples.max(2)),
     };
     let mut best: Option<Projection> = None;
     for &uv in &starts.uv[..starts.len] {
-        let pr = newton(surface, target, uv, options, &mut seams, &breaks, enough);
+        let pr = newton(surface, target, uv, options, facts, breaks, enough);
         if best.is_none_or(|b| pr.distance < b.distance) {
             best = Some(pr);
         }
@@ -116,9 +132,9 @@ pub(crate) fn project_until(
         return best;
     }
     let retries =
-        off_collapsed_edge(surface, target, best.uv).into_iter().chain(across_creases(surface, best.uv, &breaks));
+        off_collapsed_edge(surface, facts, target, best.uv).into_iter().chain(across_creases(surface, best.uv, breaks));
     for uv in retries {
-        let pr = newton(surface, target, uv, options, &mut seams, &breaks, enough);
+        let pr = newton(surface, target, uv, options, facts, breaks, enough);
         if pr.distance < best.distance {
             best = pr;
         }
@@ -176,7 +192,7 @@ fn across_creases(surface: &dyn Surface, uv: DVec2, breaks: &[Vec<f64>; 2]) -> i
 /// or stops on the edge. When `uv` lies within 5% of the domain of such an
 /// edge, returns the best of a few parameters around the pole at the same
 /// distance from the edge (just off it when `uv` is on it), as a new start.
-fn off_collapsed_edge(surface: &dyn Surface, target: DVec3, uv: DVec2) -> Option<DVec2> {
+fn off_collapsed_edge(surface: &dyn Surface, facts: &SurfaceFacts, target: DVec3, uv: DVec2) -> Option<DVec2> {
     const SAMPLES: usize = 16;
     const BAND: f64 = 0.05;
     let [lo, hi] = surface.domain();
@@ -189,15 +205,7 @@ fn off_collapsed_edge(surface: &dyn Surface, target: DVec3, uv: DVec2) -> Option
             if gap.is_nan() || gap > BAND * size[axis] {
                 continue;
             }
-            let at = |f: f64| {
-                let mut q = DVec2::ZERO;
-                q[axis] = bound;
-                q[along] = lo[along] + size[along] * f;
-                surface.point(q)
-            };
-            let (a, b, c) = (at(0.0), at(0.37), at(1.0));
-            let eps = 1e-10 * a.abs().max_element().max(b.abs().max_element()).max(c.abs().max_element());
-            if a.distance(b) > eps || a.distance(c) > eps {
+            if !facts.is_collapsed(surface, axis, bound) {
                 continue;
             }
             let off = gap.max(1e-3 * size[axis]);
@@ -227,7 +235,7 @@ fn newton(
     target: DVec3,
     start: DVec2,
     options: &ProjectionOptions,
-    seams: &mut Seams,
+    facts: &SurfaceFacts,
     breaks: &[Vec<f64>; 2],
     enough: f64,
 ) -> Projection {
@@ -271,7 +279,7 @@ fn newton(
                 }
                 surface.derivs(q)
             };
-            if let Some(found) = try_step(surface, target, uv, point, dist, &dd, seams, breaks) {
+            if let Some(found) = try_step(surface, target, uv, point, dist, &dd, facts, breaks) {
                 if best_step.is_none_or(|b| found.0 < b.0) {
                     best_step = Some(found);
                 }
@@ -304,7 +312,7 @@ fn try_step(
     point: DVec3,
     dist: f64,
     d: &SurfaceDerivs,
-    seams: &mut Seams,
+    facts: &SurfaceFacts,
     breaks: &[Vec<f64>; 2],
 ) -> Option<(f64, DVec2, DVec3)> {
     let [lo, hi] = surface.domain();
@@ -336,7 +344,7 @@ fn try_step(
         let up = step[axis] > 0.0;
         let at_end = if up { uv[axis] >= hi[axis] } else { uv[axis] <= lo[axis] };
         if at_end && step[axis] != 0.0 {
-            if seams.is_closed(surface, axis) {
+            if facts.is_closed(surface, axis) {
                 from[axis] = if up { lo[axis] } else { hi[axis] };
             } else {
                 hold[axis] = true;
@@ -378,33 +386,83 @@ fn try_step(
     None
 }
 
-/// Which directions of the domain close on themselves (a full circle of a
-/// revolved surface), found on first need.
-#[derive(Default)]
-struct Seams {
-    closed: [Option<bool>; 2],
+/// What projections learn about a surface independently of the point they
+/// project: its knot lines, which directions close on themselves (a full
+/// circle of a revolved surface), which domain edges collapse to a point, and
+/// the coarse search's grid of points. Each is found on first need.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SurfaceFacts {
+    breaks: OnceCell<[Vec<f64>; 2]>,
+    closed: [OnceCell<bool>; 2],
+    /// `[axis][0]`: the edge at the domain's low end along `axis`, `[axis][1]` the high one.
+    collapsed: [[OnceCell<bool>; 2]; 2],
+    /// The coarse search's grid: its steps per direction and its points.
+    grid: OnceCell<(usize, Vec<DVec3>)>,
 }
 
-impl Seams {
-    fn is_closed(&mut self, surface: &dyn Surface, axis: usize) -> bool {
-        if let Some(c) = self.closed[axis] {
-            return c;
-        }
+impl SurfaceFacts {
+    fn breaks(&self, surface: &dyn Surface) -> &[Vec<f64>; 2] {
+        self.breaks.get_or_init(|| [surface.breaks(true), surface.breaks(false)])
+    }
+
+    fn is_closed(&self, surface: &dyn Surface, axis: usize) -> bool {
+        *self.closed[axis].get_or_init(|| {
+            let [lo, hi] = surface.domain();
+            [0.0, 0.21, 0.5, 0.79, 1.0].iter().all(|&f| {
+                let (a, b, m) = if axis == 0 {
+                    let v = lo.y + (hi.y - lo.y) * f;
+                    (DVec2::new(lo.x, v), DVec2::new(hi.x, v), DVec2::new((lo.x + hi.x) * 0.5, v))
+                } else {
+                    let u = lo.x + (hi.x - lo.x) * f;
+                    (DVec2::new(u, lo.y), DVec2::new(u, hi.y), DVec2::new(u, (lo.y + hi.y) * 0.5))
+                };
+                let (pa, pb, pm) = (surface.point(a), surface.point(b), surface.point(m));
+                let scale = pa.length().max(pb.length()) + pa.distance(pm);
+                pa.distance(pb) <= 1e-9 * scale
+            })
+        })
+    }
+
+    /// Whether the domain edge where coordinate `axis` equals `bound` (the
+    /// domain's low or high end) is one point: three points along it agree.
+    fn is_collapsed(&self, surface: &dyn Surface, axis: usize, bound: f64) -> bool {
         let [lo, hi] = surface.domain();
-        let c = [0.0, 0.21, 0.5, 0.79, 1.0].iter().all(|&f| {
-            let (a, b, m) = if axis == 0 {
-                let v = lo.y + (hi.y - lo.y) * f;
-                (DVec2::new(lo.x, v), DVec2::new(hi.x, v), DVec2::new((lo.x + hi.x) * 0.5, v))
-            } else {
-                let u = lo.x + (hi.x - lo.x) * f;
-                (DVec2::new(u, lo.y), DVec2::new(u, hi.y), DVec2::new(u, (lo.y + hi.y) * 0.5))
+        let side = usize::from(bound != lo[axis]);
+        *self.collapsed[axis & 1][side].get_or_init(|| {
+            let along = 1 - (axis & 1);
+            let size = hi - lo;
+            let at = |f: f64| {
+                let mut q = DVec2::ZERO;
+                q[axis & 1] = bound;
+                q[along] = lo[along] + size[along] * f;
+                surface.point(q)
             };
-            let (pa, pb, pm) = (surface.point(a), surface.point(b), surface.point(m));
-            let scale = pa.length().max(pb.length()) + pa.distance(pm);
-            pa.distance(pb) <= 1e-9 * scale
-        });
-        self.closed[axis] = Some(c);
-        c
+            let (a, b, c) = (at(0.0), at(0.37), at(1.0));
+            let eps = 1e-10 * a.abs().max_element().max(b.abs().max_element()).max(c.abs().max_element());
+            // Written as the negation of "apart", so that NaN counts as collapsed.
+            !(a.distance(b) > eps || a.distance(c) > eps)
+        })
+    }
+
+    /// The points of the `(n+1)²` search grid ([`param`]), kept for the first `n` asked.
+    fn grid(&self, surface: &dyn Surface, n: usize) -> Cow<'_, [DVec3]> {
+        let make = || {
+            let [lo, hi] = surface.domain();
+            let m = n + 1;
+            let mut pts: Vec<DVec3> = Vec::with_capacity(m * m);
+            for i in 0..m {
+                for j in 0..m {
+                    pts.push(surface.point(param(lo, hi, n, i, j)));
+                }
+            }
+            pts
+        };
+        let (kept, pts) = self.grid.get_or_init(|| (n, make()));
+        if *kept == n {
+            Cow::Borrowed(pts)
+        } else {
+            Cow::Owned(make())
+        }
     }
 }
 
@@ -423,17 +481,11 @@ impl Starts {
 /// Samples an `(n+1)²` grid; returns its best distinct local minima (by
 /// distance to `target`), and when one of them lies on a collapsed edge
 /// (its point equals a grid neighbour's) also the best sample off such edges.
-fn coarse_search(surface: &dyn Surface, target: DVec3, n: usize) -> Starts {
+fn coarse_search(surface: &dyn Surface, facts: &SurfaceFacts, target: DVec3, n: usize) -> Starts {
     let [lo, hi] = surface.domain();
     let n = n.min(256);
     let m = n + 1;
-    let mut pts: Vec<DVec3> = Vec::with_capacity(m * m);
-    for i in 0..m {
-        for j in 0..m {
-            let uv = param(lo, hi, n, i, j);
-            pts.push(surface.point(uv));
-        }
-    }
+    let pts = facts.grid(surface, n);
     let dist: Vec<f64> = pts.iter().map(|p| p.distance_squared(target)).collect();
     // Points closer than this are the same point (a collapsed edge evaluates
     // to its point only up to rounding).
@@ -538,5 +590,35 @@ mod tests {
         let early = project_until(&s, target, Some(start), &opts, from_start);
         assert_eq!(early.uv, start);
         assert!(early.distance >= full.distance && early.distance <= from_start);
+    }
+    /// Facts kept across projections change no result: a cone-like surface
+    /// with a collapsed edge (u = 0) and a closed direction (v), projected on
+    /// with one set of facts, with and without hints, gives what fresh
+    /// projections give; and the facts did keep the search grid and the edge.
+    #[test]
+    fn kept_facts_give_the_same_projections() {
+        let ring = |r: f64, z: f64| -> Vec<DVec3> {
+            (0..5)
+                .map(|j| {
+                    let a = core::f64::consts::TAU * j as f64 / 4.0;
+                    DVec3::new(r * libm::cos(a), r * libm::sin(a), z)
+                })
+                .collect()
+        };
+        let pts = vec![ring(0.0, 1.0), ring(0.5, 0.5), ring(1.0, 0.0)];
+        let (ku, kv) = (vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0], vec![0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0]);
+        let s = NurbsSurface::try_new([2, 1], ku, kv, &pts, None).unwrap();
+        let facts = SurfaceFacts::default();
+        let opts = ProjectionOptions::default();
+        for (k, t) in [(0.3, 0.2, 1.2), (0.0, 0.01, 1.1), (-0.4, 0.6, 0.4), (0.9, -0.1, -0.2)].iter().enumerate() {
+            let target = DVec3::new(t.0, t.1, t.2);
+            for hint in [None, Some(DVec2::new(0.02, 0.1 * k as f64))] {
+                let fresh = project_to_surface(&s, target, hint, &opts);
+                let kept = project_with(&s, &facts, target, hint, &opts, f64::NEG_INFINITY);
+                assert_eq!(fresh, kept, "target {target} hint {hint:?}");
+            }
+        }
+        assert!(facts.grid.get().is_some_and(|(n, p)| *n == opts.search_samples && p.len() == (n + 1) * (n + 1)));
+        assert_eq!(facts.collapsed[0][0].get(), Some(&true));
     }
 }

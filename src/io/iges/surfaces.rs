@@ -25,7 +25,7 @@ use crate::nurbs::analytic::{bilinear, circle_arc, extrude, revolve, ruled, ArcP
 use crate::nurbs::join::join;
 use crate::nurbs::reparam::{reparametrized, segment};
 use crate::nurbs::seam::{rotate_seam, unroll};
-use crate::nurbs::{project_to_surface, NurbsCurve, NurbsSurface, ProjectionOptions, Surface, MAX_DEGREE};
+use crate::nurbs::{project_with, NurbsCurve, NurbsSurface, ProjectionOptions, Surface, SurfaceFacts, MAX_DEGREE};
 use crate::Error;
 
 const TAU: f64 = core::f64::consts::TAU;
@@ -40,6 +40,8 @@ pub(in crate::io) enum SurfDef {
         periods: [Option<f64>; 2],
         /// The parameter rectangle the entity asks for, when smaller than the knots' domain.
         natural: Option<[DVec2; 2]>,
+        /// What projections onto `surface` learnt about it (its loops' samples are projected one by one).
+        facts: SurfaceFacts,
     },
     /// `origin + a·x + b·y`, native coordinates `(a, b)`.
     Plane { origin: DVec3, x: DVec3, y: DVec3 },
@@ -154,7 +156,7 @@ impl SurfDef {
         match self {
             Self::Nurbs { surface, periods, .. } => {
                 let s = rotate_seam(surface, along_u, c)?;
-                Some(Self::Nurbs { surface: s, periods: *periods, natural: None })
+                Some(Self::Nurbs { surface: s, periods: *periods, natural: None, facts: SurfaceFacts::default() })
             }
             Self::Offset { base, distance } => {
                 Some(Self::Offset { base: Box::new(base.rotate_seam(along_u, c)?), distance: *distance })
@@ -169,7 +171,7 @@ impl SurfDef {
         match self {
             Self::Nurbs { surface, periods, .. } => {
                 let s = unroll(surface, along_u, a, b)?;
-                Some(Self::Nurbs { surface: s, periods: *periods, natural: None })
+                Some(Self::Nurbs { surface: s, periods: *periods, natural: None, facts: SurfaceFacts::default() })
             }
             Self::Offset { base, distance } => {
                 Some(Self::Offset { base: Box::new(base.unroll(along_u, a, b)?), distance: *distance })
@@ -186,14 +188,14 @@ impl SurfDef {
     /// futile search (a fuzzed file took seconds that way).
     pub fn invert(&self, p: DVec3, hint: Option<DVec2>, retry: &mut bool) -> Native {
         match self {
-            Self::Nurbs { surface, .. } => {
+            Self::Nurbs { surface, facts, .. } => {
                 let opts = ProjectionOptions::default();
-                let mut pr = project_to_surface(surface, p, hint, &opts);
+                let mut pr = project_with(surface, facts, p, hint, &opts, f64::NEG_INFINITY);
                 // Newton from a hint can stall (next to the domain's edge);
                 // a result far off the surface is retried by the global search.
                 let far = 1e-4 * surface.bbox().diagonal();
                 if *retry && hint.is_some() && pr.distance > far {
-                    let g = project_to_surface(surface, p, None, &opts);
+                    let g = project_with(surface, facts, p, None, &opts, f64::NEG_INFINITY);
                     if g.distance < pr.distance {
                         pr = g;
                     }
@@ -421,7 +423,7 @@ fn plane(m: &DAffine3, o: DVec3, x: DVec3, y: DVec3) -> SurfDef {
 /// A B-spline surface definition, with its closedness detected.
 pub(in crate::io) fn nurbs_def(surface: NurbsSurface) -> SurfDef {
     let periods = closed_periods(&surface);
-    SurfDef::Nurbs { surface, periods, natural: None }
+    SurfDef::Nurbs { surface, periods, natural: None, facts: SurfaceFacts::default() }
 }
 
 /// Periods of a surface whose opposite edges coincide.
@@ -497,7 +499,7 @@ fn bspline_surface(e: &Entity, m: &DAffine3) -> Result<SurfDef, Error> {
     let smaller = nlo.x > lo.x + eps.x || nlo.y > lo.y + eps.y || nhi.x < hi.x - eps.x || nhi.y < hi.y - eps.y;
     let natural = (smaller && nhi.x > nlo.x && nhi.y > nlo.y).then_some([nlo, nhi]);
     let periods = closed_periods(&s);
-    Ok(SurfDef::Nurbs { surface: s, periods, natural })
+    Ok(SurfDef::Nurbs { surface: s, periods, natural, facts: SurfaceFacts::default() })
 }
 
 /// 114: bicubic patches in power form, each turned into Bézier form.
@@ -739,7 +741,7 @@ mod tests {
             [0.0, 1.0],
         )
         .unwrap();
-        SurfDef::Nurbs { surface, periods: [None; 2], natural: None }
+        SurfDef::Nurbs { surface, periods: [None; 2], natural: None, facts: SurfaceFacts::default() }
     }
 
     /// At a pole written with control points a hair apart (3e-8 against
