@@ -203,8 +203,9 @@ impl SurfDef {
                         *retry = false;
                     }
                 }
-                let d = surface.derivs(pr.uv);
-                let (lu, lv) = (d.su.length(), d.sv.length());
+                // First derivatives only: the same values as `derivs` gives.
+                let (_, su, sv) = surface.tangents(pr.uv);
+                let (lu, lv) = (su.length(), sv.length());
                 // A collapsed edge written with control points a hair apart
                 // (3e-8 against 4.4 across it, in one STEP file) is a pole too.
                 let tiny = 1e-6 * (lu + lv);
