@@ -180,7 +180,7 @@ pub(crate) fn edge_census(
 /// (`face_of` triangle, `scale` of face; 1 for a vertex no triangle uses):
 /// each scale's vertices welded on their own, their ids following the last
 /// scale's. One scale throughout is one weld of all positions.
-fn weld_scaled(
+pub(crate) fn weld_scaled(
     mesh: &Mesh,
     face_of: &dyn Fn(usize) -> u32,
     scale: &dyn Fn(u32) -> f64,

@@ -524,7 +524,8 @@ impl<'m> Plan<'m> {
         if edges.free_edges > edges.hole_edges {
             let body_of = |f: u32| crate::model::body_of(&self.body_ids, f as usize);
             let room = tol - report.max_deviation;
-            let moved = super::holes::close_short_holes(&mut mesh, &body_of, weld, self.sew_tol, room);
+            let scale = |f: u32| self.scale_of(f as usize);
+            let moved = super::holes::close_short_holes(&mut mesh, &body_of, &scale, weld, self.sew_tol, room);
             if moved > 0.0 {
                 report.max_deviation += moved;
                 report.triangles = mesh.triangle_count();
