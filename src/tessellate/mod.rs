@@ -240,10 +240,12 @@ const BODY_SEW_SHARE: f64 = 0.05;
 
 /// Per face, the factor its body's sewing distances take of the model's:
 /// `BODY_SEW_SHARE` of the body's size (the box of its faces, `boxes`) over
-/// the tolerance `tol`, at most 1, rounded down to a power of two so that
-/// bodies of about one size are sewn together in one pass. A body of no
-/// measurable size keeps the model's distances.
-fn sewing_scales(boxes: &[crate::nurbs::Aabb], bodies: &[u32], tol: f64) -> Vec<f64> {
+/// the tolerance `tol`, but not below the body's share of the model's size
+/// `diag` (a body as large as the model keeps the model's distances, at any
+/// tolerance), at most 1, rounded down to a power of two so that bodies of
+/// about one size are sewn together in one pass. A body of no measurable
+/// size keeps the model's distances.
+fn sewing_scales(boxes: &[crate::nurbs::Aabb], bodies: &[u32], tol: f64, diag: f64) -> Vec<f64> {
     let mut body_box: crate::collections::HashMap<u32, crate::nurbs::Aabb> = crate::collections::HashMap::default();
     for (f, b) in boxes.iter().enumerate() {
         body_box.entry(crate::model::body_of(bodies, f)).or_insert(crate::nurbs::Aabb::EMPTY).union(b);
@@ -251,7 +253,7 @@ fn sewing_scales(boxes: &[crate::nurbs::Aabb], bodies: &[u32], tol: f64) -> Vec<
     (0..boxes.len())
         .map(|f| {
             let size = body_box.get(&crate::model::body_of(bodies, f)).map_or(0.0, |b| b.diagonal());
-            let k = BODY_SEW_SHARE * size / tol;
+            let k = (BODY_SEW_SHARE * size / tol).max(size / diag);
             if k.is_finite() && k > 0.0 && k < 1.0 {
                 // Mantissa cleared: the power of two at or below `k` (zero if subnormal).
                 let p = f64::from_bits(k.to_bits() & 0xFFF0_0000_0000_0000);

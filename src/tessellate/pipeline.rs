@@ -203,8 +203,11 @@ impl<'m> Plan<'m> {
         // close, not a pole.
         let body_ids = own_bodies(model, &mine, 1e-9 * diag.max(tol));
         // A sewing distance the caller sets holds for every body.
-        let sew_scale =
-            if options.sew.is_some() { alloc::vec![1.0; boxes.len()] } else { sewing_scales(&boxes, &body_ids, tol) };
+        let sew_scale = if options.sew.is_some() {
+            alloc::vec![1.0; boxes.len()]
+        } else {
+            sewing_scales(&boxes, &body_ids, tol, diag)
+        };
         Ok(Self {
             model,
             options,
