@@ -53,7 +53,7 @@ pub fn edge_counts_around_skipped(
     weld_tol: f64,
     sew_tol: f64,
 ) -> EdgeCounts {
-    edge_census(mesh, bodies, skipped, weld_tol, sew_tol).0
+    edge_census(mesh, bodies, &[], skipped, weld_tol, sew_tol).0
 }
 
 /// Where two faces' borders run side by side unjoined (see [`edge_census`]).
@@ -68,16 +68,24 @@ pub(crate) struct Gap {
 }
 
 /// As [`edge_counts_around_skipped`], with the gaps of the cracks: per pair
-/// of faces whose borders crack apart, how far apart they lie.
+/// of faces whose borders crack apart, how far apart they lie. A face's
+/// vertices weld within `weld_tol` times its `scale` (empty: 1 for all),
+/// the share of the sewing distances its body took.
 pub(crate) fn edge_census(
     mesh: &Mesh,
     bodies: &[u32],
+    scale: &[f64],
     skipped: &[SkippedFace],
     weld_tol: f64,
     sew_tol: f64,
 ) -> (EdgeCounts, Vec<Gap>) {
-    let (mut map, mut nverts) = weld_positions(&mesh.positions, weld_tol);
     let face_of = face_lookup(mesh);
+    let scale_of = |f: u32| scale.get(f as usize).copied().unwrap_or(1.0);
+    let (mut map, mut nverts) = if scale.is_empty() {
+        weld_positions(&mesh.positions, weld_tol)
+    } else {
+        weld_scaled(mesh, &face_of, &scale_of, weld_tol)
+    };
     let body_of_face = |f: u32| crate::model::body_of(bodies, f as usize);
     if !bodies.is_empty() {
         split_by_body(mesh, body_of_face, &face_of, &mut map, &mut nverts);
@@ -166,6 +174,45 @@ pub(crate) fn edge_census(
     }
     crate::sort::by_u64(&mut gaps, |g| crate::sort::pair(g.faces.0, g.faces.1));
     (out, gaps)
+}
+
+/// [`weld_positions`] within `weld` times the scale of each vertex's face
+/// (`face_of` triangle, `scale` of face; 1 for a vertex no triangle uses):
+/// each scale's vertices welded on their own, their ids following the last
+/// scale's. One scale throughout is one weld of all positions.
+pub(crate) fn weld_scaled(
+    mesh: &Mesh,
+    face_of: &dyn Fn(usize) -> u32,
+    scale: &dyn Fn(u32) -> f64,
+    weld: f64,
+) -> (Vec<u32>, usize) {
+    let mut of_vertex = alloc::vec![1.0f64; mesh.positions.len()];
+    for (ti, t) in mesh.indices.chunks_exact(3).enumerate() {
+        let k = scale(face_of(ti));
+        for &v in t {
+            if let Some(x) = of_vertex.get_mut(v as usize) {
+                *x = k;
+            }
+        }
+    }
+    if of_vertex.iter().all(|&k| k == 1.0) {
+        return weld_positions(&mesh.positions, weld);
+    }
+    let mut scales = of_vertex.clone();
+    crate::sort::f64s(&mut scales);
+    scales.dedup();
+    let mut map = alloc::vec![0u32; mesh.positions.len()];
+    let mut count = 0usize;
+    for k in scales {
+        let members: Vec<usize> = (0..of_vertex.len()).filter(|&v| of_vertex[v] == k).collect();
+        let points: Vec<DVec3> = members.iter().map(|&v| mesh.positions[v]).collect();
+        let (sub, n) = weld_positions(&points, weld * k);
+        for (&v, &m) in members.iter().zip(&sub) {
+            map[v] = (count + m as usize) as u32;
+        }
+        count += n;
+    }
+    (map, count)
 }
 
 /// Welded vertices (`map`, `nverts` of them) split by body: one keeps its
@@ -428,12 +475,12 @@ mod tests {
         // Face a's edge, and face b's two halves of it, which run along it.
         assert_eq!(edge_counts(&m, 1e-9, 1.0).free_edges, 3);
         // The node lies on the edge: a gap of nothing between faces 0 and 1.
-        assert_eq!(edge_census(&m, &[], &[], 1e-9, 1.0).1, [Gap { faces: (0, 1), width: 0.0 }]);
+        assert_eq!(edge_census(&m, &[], &[], &[], 1e-9, 1.0).1, [Gap { faces: (0, 1), width: 0.0 }]);
         // Lifted 0.3 off it, the node is the nearest of face 1's border
         // points to the edge's middle: the faces lie 0.3 apart there.
         let mut lifted = m.clone();
         lifted.positions[3].z = 0.3;
-        let gaps = edge_census(&lifted, &[], &[], 1e-9, 1.0).1;
+        let gaps = edge_census(&lifted, &[], &[], &[], 1e-9, 1.0).1;
         assert!(gaps.len() == 1 && (gaps[0].width - 0.3).abs() < 1e-12, "{gaps:?}");
     }
 
@@ -448,7 +495,7 @@ mod tests {
         let pts = [(0.0, 0.0), (10.0, 0.0), (5.0, -3.0), (4.0, 0.05), (5.0, 3.0)];
         let m = two_faces(&pts, &[[0, 2, 1]], &[[0, 3, 4], [3, 1, 4]]);
         assert_eq!(edge_counts(&m, 1e-9, 0.2).free_edges, 3);
-        let gaps = edge_census(&m, &[], &[], 1e-9, 0.2).1;
+        let gaps = edge_census(&m, &[], &[], &[], 1e-9, 0.2).1;
         assert!(gaps.len() == 1 && gaps[0].width > 0.03 && gaps[0].width < 0.05, "{gaps:?}");
     }
 

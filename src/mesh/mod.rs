@@ -13,7 +13,7 @@ use serde::Serialize;
 pub use metrics::{
     angle_stats, edge_counts, edge_counts_around_skipped, edge_counts_in_bodies, AngleStats, EdgeCounts,
 };
-pub(crate) use metrics::{edge_census, holes_warning, min_angle};
+pub(crate) use metrics::{edge_census, holes_warning, min_angle, weld_scaled};
 pub use weld::{weld_mesh, weld_positions};
 
 /// An indexed triangle mesh. Every face owns its vertices (so normals can break

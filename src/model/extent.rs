@@ -11,12 +11,18 @@ use crate::nurbs::{Aabb, Surface};
 /// its loops' parameter box (points inside the region) and the loops themselves.
 pub(crate) fn trimmed_bbox(model: &Model) -> Aabb {
     let mut b = Aabb::EMPTY;
-    for t in &model.tessellated {
-        for &p in t.positions.iter().filter(|p| p.is_finite()) {
-            b.add_point(p);
-        }
+    for f in face_boxes(model) {
+        b.union(&f);
     }
+    b
+}
+
+/// Each face's box as [`trimmed_bbox`] samples it, indexed like the mesh's
+/// faces (exact, then tessellated): a body's size is its faces' box.
+pub(crate) fn face_boxes(model: &Model) -> Vec<Aabb> {
+    let mut boxes = Vec::with_capacity(model.face_count());
     for f in &model.faces {
+        let mut b = Aabb::EMPTY;
         let s: &dyn Surface = &f.surface;
         let region = LoopSample::of(f);
         for &q in region.polys.iter().flatten() {
@@ -32,8 +38,12 @@ pub(crate) fn trimmed_bbox(model: &Model) -> Aabb {
                 b.add_point(p);
             }
         }
+        boxes.push(b);
     }
-    b
+    for t in &model.tessellated {
+        boxes.push(Aabb::from_points(t.positions.iter().copied().filter(|p| p.is_finite())));
+    }
+    boxes
 }
 
 /// A face's trim loops sampled in (u,v), 16 points per curve, and the part

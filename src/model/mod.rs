@@ -17,9 +17,9 @@ mod extent;
 pub use assembly::{Assembly, AssemblyNode, PartInstance};
 pub(crate) use bodies::body_count;
 pub use bodies::share_of_faces;
-pub(crate) use extent::trimmed_bbox;
 #[cfg(all(feature = "std", feature = "quality"))]
 pub(crate) use extent::LoopSample;
+pub(crate) use extent::{face_boxes, trimmed_bbox};
 
 /// Everything read from one input file.
 #[derive(Debug, Clone, Default)]

@@ -28,11 +28,14 @@ const ROUNDS: usize = 4;
 /// between at least two faces of one body (`body_of(face)`), each by moving
 /// its shortest side's one end onto the other, where no vertex moves
 /// farther than `room` in all. Points within `weld` are one, as in the edge
-/// census. Returns how far the farthest vertex moved, which bounds what the
-/// moves add to the measured deviation.
+/// census. `width` and `weld` are a body at the model's sewing scale's:
+/// a face's are those times its `scale` (a small part in an assembly:
+/// `sewing_scales`). Returns how far the farthest vertex moved,
+/// which bounds what the moves add to the measured deviation.
 pub(crate) fn close_short_holes(
     mesh: &mut Mesh,
     body_of: &dyn Fn(u32) -> u32,
+    scale: &dyn Fn(u32) -> f64,
     weld: f64,
     width: f64,
     room: f64,
@@ -40,18 +43,18 @@ pub(crate) fn close_short_holes(
     if !(room > 0.0 && width > 0.0) || mesh.indices.is_empty() {
         return 0.0;
     }
-    let mut joins = Joins::new(mesh, weld, body_of);
+    let mut joins = Joins::new(mesh, weld, body_of, scale);
     let mut moved_most: f64 = 0.0;
     for _ in 0..ROUNDS {
         let mut closed = false;
-        for hole in joins.holes(body_of) {
+        for (hole, face) in joins.holes(body_of) {
             // Earlier joins of this round may have moved its corners.
             let hole = hole.map(|g| joins.find(g));
             if hole[0] == hole[1] || hole[1] == hole[2] || hole[2] == hole[0] {
                 continue;
             }
             let p = hole.map(|g| joins.pos[g as usize]);
-            if crate::math::triangle_width(p) > width {
+            if crate::math::triangle_width(p) > width * scale(face) {
                 continue;
             }
             // The shortest side first; its ends each way round.
@@ -93,9 +96,10 @@ struct Joins {
 }
 
 impl Joins {
-    /// Points within `weld` are one, those of different bodies apart (as
-    /// the edge census takes them: parts that touch are not joined).
-    fn new(mesh: &Mesh, weld: f64, body_of: &dyn Fn(u32) -> u32) -> Self {
+    /// Points within `weld` (times their face's `scale`) are one, those of
+    /// different bodies apart (as the edge census takes them: parts that
+    /// touch are not joined).
+    fn new(mesh: &Mesh, weld: f64, body_of: &dyn Fn(u32) -> u32, scale: &dyn Fn(u32) -> f64) -> Self {
         let count = mesh.indices.len() / 3;
         let mut face = alloc::vec![0u32; count];
         for (f, r) in mesh.face_ranges.iter().enumerate() {
@@ -111,7 +115,7 @@ impl Joins {
                 }
             }
         }
-        let (welded, _) = crate::mesh::weld_positions(&mesh.positions, weld);
+        let (welded, _) = crate::mesh::weld_scaled(mesh, &|t| face[t], scale, weld);
         let mut ids: HashMap<(u32, u32), u32> = HashMap::default();
         let map: Vec<u32> = welded
             .iter()
@@ -158,7 +162,7 @@ impl Joins {
 
     /// The three-sided holes: loops of three edges each used by one kept
     /// triangle, through at least two faces of one body, each once.
-    fn holes(&mut self, body_of: &dyn Fn(u32) -> u32) -> Vec<[u32; 3]> {
+    fn holes(&mut self, body_of: &dyn Fn(u32) -> u32) -> Vec<([u32; 3], u32)> {
         self.index();
         let mut uses: HashMap<(u32, u32), (u32, u32)> = HashMap::default();
         for t in 0..self.tris.len() as u32 {
@@ -195,7 +199,7 @@ impl Joins {
                     let one_face = f1 == f2 && f2 == f3;
                     let one_body = body_of(f1) == body_of(f2) && body_of(f2) == body_of(f3);
                     if !one_face && one_body {
-                        holes.push([a, b, c]);
+                        holes.push(([a, b, c], f1));
                     }
                 }
             }
@@ -355,7 +359,7 @@ mod tests {
         let mut m = bent();
         // The two long sides (the short one leaves face a's corner at 31 degrees).
         assert_eq!(edge_counts(&m, 1e-9, 1.0).free_edges, 2);
-        let moved = close_short_holes(&mut m, &|_| 0, 1e-9, 1.0, 1.0);
+        let moved = close_short_holes(&mut m, &|_| 0, &|_| 1.0, 1e-9, 1.0, 1.0);
         assert!((moved - 0.5f64.hypot(0.3)).abs() < 1e-12, "{moved}");
         let c = edge_counts(&m, 1e-9, 1.0);
         assert_eq!((c.free_edges, c.nonmanifold_edges), (0, 0));
@@ -371,14 +375,24 @@ mod tests {
     #[test]
     fn a_join_farther_than_the_room_is_not_made() {
         let mut m = bent();
-        assert_eq!(close_short_holes(&mut m, &|_| 0, 1e-9, 1.0, 0.5), 0.0);
+        assert_eq!(close_short_holes(&mut m, &|_| 0, &|_| 1.0, 1e-9, 1.0, 0.5), 0.0);
+        assert_eq!(m, bent());
+    }
+
+    /// The sliver is 0.3 wide: within a width of 1, not within a body's
+    /// share of it a quarter as large (a small part in an assembly whose
+    /// tolerance spans its features).
+    #[test]
+    fn a_hole_wider_than_its_body_s_share_of_the_width_is_left() {
+        let mut m = bent();
+        assert_eq!(close_short_holes(&mut m, &|_| 0, &|_| 0.25, 1e-9, 1.0, 1.0), 0.0);
         assert_eq!(m, bent());
     }
 
     #[test]
     fn a_hole_between_two_bodies_is_left() {
         let mut m = bent();
-        assert_eq!(close_short_holes(&mut m, &|f| f, 1e-9, 1.0, 1.0), 0.0);
+        assert_eq!(close_short_holes(&mut m, &|f| f, &|_| 1.0, 1e-9, 1.0, 1.0), 0.0);
         assert_eq!(m, bent());
     }
 }

@@ -39,7 +39,7 @@ mod variant;
 use alloc::vec::Vec;
 
 use crate::mesh::FaceRange;
-use crate::model::{body_count, trimmed_bbox};
+use crate::model::{body_count, face_boxes};
 #[cfg(feature = "std")]
 use crate::nurbs::Surface;
 use crate::options::{MeshOptions, Reparam, Tolerance};
@@ -172,6 +172,8 @@ pub(crate) struct Setup {
     tol: f64,
     /// Diagonal of the trimmed geometry's box.
     diag: f64,
+    /// Each face's box (exact faces, then tessellated).
+    boxes: Vec<crate::nurbs::Aabb>,
     /// Limits of the grid and loop discretization (the tolerance times the safety factor).
     lim: params::Limits,
     /// Limits every triangle must meet after refinement.
@@ -184,7 +186,12 @@ fn setup(model: &Model, options: &MeshOptions) -> Result<Setup, Error> {
     if model.face_count() == 0 {
         return Err(Error::Model { location: "model".into(), message: "has no faces".into() });
     }
-    let diag = trimmed_bbox(model).diagonal();
+    let boxes = face_boxes(model);
+    let diag = boxes.iter().fold(crate::nurbs::Aabb::EMPTY, |mut b, f| {
+        b.union(f);
+        b
+    });
+    let diag = diag.diagonal();
     let tol = match options.tolerance {
         Tolerance::Absolute(t) => t,
         Tolerance::Relative(r) => r * diag,
@@ -204,7 +211,7 @@ fn setup(model: &Model, options: &MeshOptions) -> Result<Setup, Error> {
         steps: options.measure_steps,
         lift: refine::Lift::NONE,
     };
-    Ok(Setup { tol, diag, lim, crit })
+    Ok(Setup { tol, diag, boxes, lim, crit })
 }
 
 /// Each face's body for sewing and for the edge counts: the file's
@@ -225,31 +232,93 @@ fn own_bodies(model: &Model, mine: &[bool], reach: f64) -> Vec<u32> {
     ids
 }
 
+/// The coarsest tolerance, as a share of a body's own size, that its
+/// sewing distances are derived from: in an assembly whose tolerance
+/// exceeds a twentieth of a small part (a bolt beside a motor), the
+/// model's distances span the part's features and sew them together.
+const BODY_SEW_SHARE: f64 = 0.05;
+
+/// Per face, the factor its body's sewing distances take of the model's:
+/// `BODY_SEW_SHARE` of the body's size (the box of its faces, `boxes`) over
+/// the tolerance `tol`, but not below the body's share of the model's size
+/// `diag` (a body as large as the model keeps the model's distances, at any
+/// tolerance), at most 1, rounded down to a power of two so that bodies of
+/// about one size are sewn together in one pass. A body of no measurable
+/// size keeps the model's distances.
+fn sewing_scales(boxes: &[crate::nurbs::Aabb], bodies: &[u32], tol: f64, diag: f64) -> Vec<f64> {
+    let mut body_box: crate::collections::HashMap<u32, crate::nurbs::Aabb> = crate::collections::HashMap::default();
+    for (f, b) in boxes.iter().enumerate() {
+        body_box.entry(crate::model::body_of(bodies, f)).or_insert(crate::nurbs::Aabb::EMPTY).union(b);
+    }
+    (0..boxes.len())
+        .map(|f| {
+            let size = body_box.get(&crate::model::body_of(bodies, f)).map_or(0.0, |b| b.diagonal());
+            let k = (BODY_SEW_SHARE * size / tol).max(size / diag);
+            if k.is_finite() && k > 0.0 && k < 1.0 {
+                // Mantissa cleared: the power of two at or below `k` (zero if subnormal).
+                let p = f64::from_bits(k.to_bits() & 0xFFF0_0000_0000_0000);
+                if p > 0.0 {
+                    p
+                } else {
+                    f64::MIN_POSITIVE
+                }
+            } else {
+                1.0
+            }
+        })
+        .collect()
+}
+
 /// Sews the outlines of the faces to be meshed (see [`sew::unify`]), after
 /// the tessellated faces' border vertices are pinned on them, and halves the
 /// sewn chords that then cross ([`sew::split_crossing_chords`]); returns the
-/// node ids given.
+/// node ids given. Faces are sewn in groups of one sewing scale (`scales`,
+/// per face: [`sewing_scales`]), each at `sew_tol` and `tight` times its
+/// scale: faces of different bodies are never sewn together, so each group
+/// is sewn on its own, its node ids following the last group's.
 fn unify_outlines(
     chosen: &mut [Option<Chosen<'_>>],
     bodies: &[u32],
+    scales: &[f64],
     facets: &tessellated::Facets<'_>,
     sew_tol: f64,
     tight: f64,
-    reach: f64,
+    chord: f64,
 ) -> u32 {
     #[cfg(feature = "std")]
     {
         // A rebuilt face's border lies up to its fit error from its neighbours'.
         let moved: Vec<f64> = chosen.iter().map(|c| c.as_ref().map_or(0.0, |c| c.fit_error)).collect();
+        let scale_of = |f: usize| scales.get(f).copied().unwrap_or(1.0);
+        let mut groups: Vec<f64> = (0..chosen.len()).map(scale_of).collect();
+        crate::sort::f64s(&mut groups);
+        groups.dedup();
+        let mut ids = 0u32;
+        for &k in groups.iter().rev() {
+            let mut faces: Vec<Option<(&dyn Surface, &mut face::Outline<'_>)>> = chosen
+                .iter_mut()
+                .enumerate()
+                .map(|(f, c)| {
+                    c.as_mut().filter(|_| scale_of(f) == k).map(|c| (&c.face.surface as &dyn Surface, &mut c.outline))
+                })
+                .collect();
+            let (sew, tight) = (sew_tol * k, tight * k);
+            tessellated::pin_outlines(&mut faces, bodies, facets, sew);
+            let given = sew::unify(&mut faces, bodies, &moved, sew, tight, chord + sew);
+            for (_, o) in faces.iter_mut().flatten() {
+                for g in o.gids.iter_mut().flatten() {
+                    *g += ids;
+                }
+            }
+            ids += given;
+        }
         let mut faces: Vec<Option<(&dyn Surface, &mut face::Outline<'_>)>> =
             chosen.iter_mut().map(|c| c.as_mut().map(|c| (&c.face.surface as &dyn Surface, &mut c.outline))).collect();
-        tessellated::pin_outlines(&mut faces, bodies, facets, sew_tol);
-        let ids = sew::unify(&mut faces, bodies, &moved, sew_tol, tight, reach);
         sew::split_crossing_chords(&mut faces, ids)
     }
     #[cfg(not(feature = "std"))]
     {
-        let _ = (chosen, bodies, facets, sew_tol, tight, reach);
+        let _ = (chosen, bodies, scales, facets, sew_tol, tight, chord);
         0
     }
 }

@@ -14,7 +14,9 @@ use super::fill;
 use super::refine::{Known, WorkMesh};
 use super::sew::{self, FaceWork, Places};
 use super::variant::Chosen;
-use super::{collapse, empty_work, own_bodies, reparameterize, setup, tessellated, unify_outlines, Setup};
+use super::{
+    collapse, empty_work, own_bodies, reparameterize, setup, sewing_scales, tessellated, unify_outlines, Setup,
+};
 use super::{face, params, refine};
 use crate::mesh::{edge_census, holes_warning, FaceRange};
 use crate::model::{body_count, share_of_faces};
@@ -52,6 +54,9 @@ pub struct Plan<'m> {
     tight: f64,
     /// Each face's body for sewing and the edge counts ([`own_bodies`]).
     body_ids: Vec<u32>,
+    /// Per face, the factor its body takes of `sew_tol`, `tight` and the
+    /// weld (1 but for bodies far smaller than the tolerance: `sewing_scales`).
+    sew_scale: Vec<f64>,
     /// The report as the stages start it (reparameterized faces listed).
     report: Report,
 }
@@ -164,7 +169,7 @@ impl<'m> Plan<'m> {
 
     /// As [`Plan::new`], for the faces `mine` (indexed by model face).
     pub(super) fn with_share(model: &'m Model, options: &'m MeshOptions, mine: Vec<bool>) -> Result<Self, Error> {
-        let Setup { tol, diag, lim, crit } = setup(model, options)?;
+        let Setup { tol, diag, boxes, lim, crit } = setup(model, options)?;
         let mut report = Report {
             units: model.units.clone(),
             tolerance: tol,
@@ -197,6 +202,12 @@ impl<'m> Plan<'m> {
         // circle within the sewing distance is a border that another face can
         // close, not a pole.
         let body_ids = own_bodies(model, &mine, 1e-9 * diag.max(tol));
+        // A sewing distance the caller sets holds for every body.
+        let sew_scale = if options.sew.is_some() {
+            alloc::vec![1.0; boxes.len()]
+        } else {
+            sewing_scales(&boxes, &body_ids, tol, diag)
+        };
         Ok(Self {
             model,
             options,
@@ -211,6 +222,7 @@ impl<'m> Plan<'m> {
             sew_tol,
             tight,
             body_ids,
+            sew_scale,
             report,
         })
     }
@@ -259,8 +271,8 @@ impl<'m> Plan<'m> {
     /// faces' border vertices are pinned on them.
     pub fn sew_outlines<'p>(&self, run: &Run<'m>, variants: Variants<'p>) -> Sewn<'p> {
         let Variants { mut faces } = variants;
-        let reach = self.crit.tol + self.sew_tol;
-        let ids = unify_outlines(&mut faces, &self.body_ids, &run.facets, self.sew_tol, self.tight, reach);
+        let (bodies, scales) = (&self.body_ids, &self.sew_scale);
+        let ids = unify_outlines(&mut faces, bodies, scales, &run.facets, self.sew_tol, self.tight, self.crit.tol);
         Sewn { faces, ids }
     }
 
@@ -334,8 +346,8 @@ impl<'m> Plan<'m> {
         works: &mut Works<'_>,
         progress: &mut dyn FnMut(usize, usize) -> bool,
     ) -> Result<Refined, Error> {
-        works.budget_hit =
-            sew::refine_all(&mut works.faces, works.ids, self.sew_tol, self.options.max_triangles, progress)?;
+        let sew = |f: usize| self.sew_tol * self.scale_of(f);
+        works.budget_hit = sew::refine_all(&mut works.faces, works.ids, &sew, self.options.max_triangles, progress)?;
         let (settled, places) = sew::settle_nodes(&mut works.faces, 1e-6 * self.tol);
         works.check("refinement", Known::SEWN);
         for (w, moved) in works.faces.iter_mut().zip(&settled) {
@@ -446,9 +458,15 @@ impl<'m> Plan<'m> {
         }
     }
 
-    /// The distance within which the edge census takes two points for one.
+    /// The distance within which the edge census takes two points for one
+    /// (of a body at the model's sewing scale).
     fn weld(&self) -> f64 {
         (self.tol * 1e-3).min(self.tight * 0.5)
+    }
+
+    /// Face `f`'s sewing scale (`sewing_scales`; 1 past the end).
+    pub(super) fn scale_of(&self, f: usize) -> f64 {
+        self.sew_scale.get(f).copied().unwrap_or(1.0)
     }
 
     /// Stage 9, paper 000 §4's last step (the triangles in model space, one
@@ -460,9 +478,9 @@ impl<'m> Plan<'m> {
     /// fold against the surface are counted; the tessellated faces follow.
     pub fn assemble(&self, run: &mut Run<'m>, works: Works<'_>) -> Mesh {
         let mut mesh = Mesh { face_ranges: Vec::with_capacity(works.faces.len()), ..Mesh::default() };
-        let weld = self.weld();
         let mut shift: f64 = 0.0;
-        for mut w in works.faces {
+        for (index, mut w) in works.faces.into_iter().enumerate() {
+            let weld = self.weld() * self.scale_of(index);
             let mut wm = core::mem::take(&mut w.mesh);
             // Folds are counted on the triangles the mesh keeps (a collapse
             // takes away folded slivers), each judged against the normal at
@@ -501,7 +519,7 @@ impl<'m> Plan<'m> {
         report.triangles = mesh.triangle_count();
         report.vertices = mesh.positions.len();
         let weld = self.weld();
-        let (mut edges, mut gaps) = edge_census(&mesh, &self.body_ids, &self.model.skipped, weld, tol);
+        let (mut edges, mut gaps) = edge_census(&mesh, &self.body_ids, &self.sew_scale, &self.model.skipped, weld, tol);
         // Three-sided holes no face took a triangle for: a short side's ends
         // joined, within what the tolerance leaves above the deviation (only
         // where the census found cracks: the pass holds the whole mesh's
@@ -509,22 +527,23 @@ impl<'m> Plan<'m> {
         if edges.free_edges > edges.hole_edges {
             let body_of = |f: u32| crate::model::body_of(&self.body_ids, f as usize);
             let room = tol - report.max_deviation;
-            let moved = super::holes::close_short_holes(&mut mesh, &body_of, weld, self.sew_tol, room);
+            let scale = |f: u32| self.scale_of(f as usize);
+            let moved = super::holes::close_short_holes(&mut mesh, &body_of, &scale, weld, self.sew_tol, room);
             if moved > 0.0 {
                 report.max_deviation += moved;
                 report.triangles = mesh.triangle_count();
-                (edges, gaps) = edge_census(&mesh, &self.body_ids, &self.model.skipped, weld, tol);
+                (edges, gaps) = edge_census(&mesh, &self.body_ids, &self.sew_scale, &self.model.skipped, weld, tol);
             }
         }
         holes_warning(&self.model.skipped, edges.hole_edges, &mut report.warnings);
         // A crack wider than sewing reaches is the file's own gap: say where.
-        let sew_tol = self.sew_tol;
-        for g in gaps.iter().filter(|g| g.width > sew_tol) {
-            let kind = WarningKind::FacesApart {
-                faces: (g.faces.0 as usize, g.faces.1 as usize),
-                width: g.width,
-                sewing: sew_tol,
-            };
+        for g in gaps.iter() {
+            let sewing = self.sew_tol * self.scale_of(g.faces.0 as usize);
+            if g.width <= sewing {
+                continue;
+            }
+            let kind =
+                WarningKind::FacesApart { faces: (g.faces.0 as usize, g.faces.1 as usize), width: g.width, sewing };
             report.warnings.push(Warning::new(kind));
         }
         report.take_edges_and_angles(&edges, &mesh);

@@ -137,10 +137,10 @@ fn border_uses(faces: &[FaceWork<'_>]) -> Uses {
 /// Where two faces share two border nodes but their borders between them
 /// carry different nodes (their gap there was wider than the nodes' reach
 /// when the outlines were sewn: T-junctions), each face takes the other's
-/// nodes in between, within the sewing distance `sew`. Paper 000 §3.3:
+/// nodes in between, within its sewing distance (`sew` of the face). Paper 000 §3.3:
 /// both sides of a shared edge carry the same nodes. Returns the border
 /// uses after it ([`border_uses`]).
-fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: f64) -> Uses {
+fn close_t_junctions(faces: &mut [FaceWork<'_>], sew: &dyn Fn(usize) -> f64) -> Uses {
     let uses = border_uses(faces);
     // Every walk starts on an edge no other face uses: where there is none
     // (a closed shell), there is nothing to close, and the tables of
@@ -254,11 +254,12 @@ fn t_junctions(faces: &[FaceWork<'_>], uses: &Uses) -> Vec<Junction> {
 }
 
 /// Each junction's face takes the other face's nodes on its border, where
-/// all of them run along it within the sewing distance `sew`; returns
+/// all of them run along it within its sewing distance (`sew` of the face); returns
 /// whether any border edge was split.
-fn take_their_nodes(faces: &mut [FaceWork<'_>], junctions: Vec<Junction>, sew: f64) -> bool {
+fn take_their_nodes(faces: &mut [FaceWork<'_>], junctions: Vec<Junction>, sew: &dyn Fn(usize) -> f64) -> bool {
     let mut split = false;
     for Junction { face, mut run, gap, nodes } in junctions {
+        let sew = sew(face);
         let f = &mut faces[face];
         // Per edge of the run from `from` on: its index, the fraction of its
         // border point nearest `p`, that point's distance and the distance
@@ -316,7 +317,7 @@ fn nearest_on_border(f: &FaceWork<'_>, a: u32, b: u32, q: DVec3) -> f64 {
 /// Refines every face until its triangles pass (or its budget or the minimum
 /// edge stops it), making each split of a shared border edge in every face
 /// that shares it and refining again what that split changed there. First
-/// closes the T-junctions the outline sewing left, within `sew`. Node ids
+/// closes the T-junctions the outline sewing left, within each face's `sew`. Node ids
 /// continue from `ids`. `progress(done, total)` is called as each face's
 /// first refinement ends; `false` cancels. Returns whether the budget
 /// stopped a face.
@@ -326,7 +327,7 @@ fn nearest_on_border(f: &FaceWork<'_>, a: u32, b: u32, q: DVec3) -> f64 {
 pub(crate) fn refine_all(
     faces: &mut [FaceWork<'_>],
     mut ids: u32,
-    sew: f64,
+    sew: &dyn Fn(usize) -> f64,
     budget: usize,
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<bool, Error> {
@@ -717,7 +718,7 @@ mod tests {
                 FaceWork { surface: &plane, curves: Vec::new(), mesh: a, crit },
                 FaceWork { surface: &plane, curves: Vec::new(), mesh: b, crit },
             ];
-            close_t_junctions(&mut faces, sew);
+            close_t_junctions(&mut faces, &|_| sew);
             let want = if closed { alloc::vec![(1, 3), (2, 3)] } else { alloc::vec![(1, 2)] };
             assert_eq!(gids(&faces[0]), want, "sew {sew}");
             assert_eq!(gids(&faces[1]), [(1, 3), (2, 3)], "sew {sew}");

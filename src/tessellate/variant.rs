@@ -209,7 +209,7 @@ impl<'m> Plan<'m> {
         report: &mut Report,
     ) {
         let original = &self.model.faces[index];
-        let (f, tight) = (v.face, self.auto_tight);
+        let (f, tight) = (v.face, self.auto_tight * self.scale_of(index));
         let budget = self.options.max_triangles;
         let auto = self.options.reparam == Reparam::Auto;
         let orig_loops = self.loops_of(index, original);
@@ -260,7 +260,7 @@ impl<'m> Plan<'m> {
         (cap, trial): (f64, usize),
         made: &mut Made<'p>,
     ) -> Option<(params::Limits, refine::Criteria)> {
-        let tight = self.auto_tight;
+        let tight = self.auto_tight * self.scale_of(index);
         let mut free_run = None;
         if cap.is_finite() {
             let l = params::Limits { max_edge: self.lim.max_edge, ..capped.1 };

@@ -285,3 +285,23 @@ fn the_yardstick_counts_edges_per_body_where_two_parts_touch() {
     let m = measure_mesh(&model, &r.mesh, &options);
     assert!(m.nonmanifold_edges >= 4, "{} non-manifold edges", m.nonmanifold_edges);
 }
+
+/// as1's parts beside a plate a thousand times their size, as another body:
+/// at a hundredth of the whole, the tolerance (about 4 m) is far wider
+/// than a nut (15 mm across). Each small body is sewn, welded and its holes
+/// closed at distances from its own size, not the plate's: the model's
+/// distances took a nut's rings for gaps and sewed them into one another
+/// (non-manifold edges and cracks, as in an assembly of a motor and bolts).
+#[test]
+fn small_parts_beside_a_large_one_are_sewn_at_their_own_scale() {
+    let mut model = read_model(&corpus_bytes("as1-oc-214.stp"), Format::Step).unwrap();
+    let plate = read_model(include_bytes!("../data/plate_far.json"), Format::Json).unwrap();
+    let next = model.bodies.iter().copied().max().unwrap() + 1;
+    assert_eq!(model.bodies.len(), model.faces.len());
+    model.faces.extend(plate.faces);
+    model.bodies.push(next);
+    let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-2)).unwrap();
+    assert!(r.report.tolerance > 1000.0, "tolerance {}", r.report.tolerance);
+    assert_eq!((r.report.free_edges, r.report.nonmanifold_edges), (0, 0), "{:?}", r.report.warnings);
+    assert!(r.report.max_deviation <= r.report.tolerance);
+}
