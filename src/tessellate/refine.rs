@@ -429,6 +429,47 @@ impl WorkMesh {
         (m, turn)
     }
 
+    /// [`Criteria::short_for_angle`] for triangle `t` of measure `m` and
+    /// normal turn `turn`, its width across the turn found only when the
+    /// longest edge alone does not settle it.
+    pub(crate) fn short_for_angle(
+        &self,
+        surface: &dyn Surface,
+        c: &Criteria,
+        t: usize,
+        m: &TriMeasure,
+        turn: f64,
+    ) -> bool {
+        let edge = self.longest_edge(t);
+        let len = edge.2;
+        if c.short_for_angle(m, turn, len, len) {
+            return true;
+        }
+        c.short_for_angle(m, turn, len, 0.0) && c.short_for_angle(m, turn, len, self.turn_width(surface, c, t, edge))
+    }
+
+    /// How wide triangle `t` is across its normal's turn: where the ends
+    /// and middle of its longest edge `edge` face alike (within the angle
+    /// limit), the normal turns across the triangle (a curl or fillet
+    /// running beside that edge), and splitting the edge, all refinement
+    /// does to a sliver, never lowers the turn: the triangle's height over
+    /// it. Elsewhere the edge's length.
+    fn turn_width(&self, surface: &dyn Surface, c: &Criteria, t: usize, edge: (u32, u32, f64)) -> f64 {
+        let (a, b, len) = edge;
+        let v = self.tris[t];
+        let uv = self.uv(t);
+        let (Some(i), Some(j)) = (v.iter().position(|&x| x == a), v.iter().position(|&x| x == b)) else { return len };
+        let (na, nb) = (self.normal_at(a as usize), self.normal_at(b as usize));
+        if na.length_squared() == 0.0 || nb.length_squared() == 0.0 {
+            return len;
+        }
+        let Some(nm) = regular_normal(&surface.derivs((uv[i] + uv[j]) * 0.5)) else { return len };
+        if [(na, nb), (na, nm), (nm, nb)].iter().any(|&(x, y)| angle_between(x, y) > c.angle) {
+            return len;
+        }
+        crate::math::triangle_width(v.map(|x| self.pos[x as usize])).min(len)
+    }
+
     /// Triangle `t`'s smallest angle in space.
     pub(crate) fn least_angle(&self, t: u32) -> f64 {
         crate::mesh::min_angle(self.tris[t as usize].map(|v| self.pos[v as usize]))
@@ -756,7 +797,8 @@ impl WorkMesh {
             let t = t as usize;
             let (m, turn) = self.cached_measure(surface, t, c);
             let (a, b, len) = self.longest_edge(t);
-            let limits = (m.max > c.tol || turn > c.angle || len > c.max_edge) && !c.short_for_angle(&m, turn, len);
+            let limits =
+                (m.max > c.tol || turn > c.angle || len > c.max_edge) && !self.short_for_angle(surface, c, t, &m, turn);
             // A folded sliver along a border is mended by splitting it, but
             // a fold splitting cannot mend (its corners off the surface
             // after sewing) would only breed more: such splits are rationed.
@@ -815,7 +857,7 @@ impl WorkMesh {
         for t in 0..self.tris.len() {
             let (m, turn) = self.cached_measure(surface, t, c);
             let (_, _, len) = self.longest_edge(t);
-            if c.short_for_angle(&m, turn, len) {
+            if self.short_for_angle(surface, c, t, &m, turn) {
                 out.creased += 1;
             } else if m.max > c.tol || turn > c.angle || len > c.max_edge {
                 out.unproven += 1;

@@ -53,12 +53,15 @@ impl Criteria {
     /// turns past a right angle within the tolerance, the surface folds back
     /// on itself (a pleat) or bends tighter than a radius of 0.64× the
     /// tolerance: within the tolerance of a sharp edge, so splitting stops
-    /// there at the tolerance's length.
-    pub fn short_for_angle(&self, m: &TriMeasure, turn: f64, len: f64) -> bool {
+    /// there at the tolerance's length. `len` is the longest edge, `width`
+    /// how wide the triangle is across its turn (at most `len`): a long
+    /// sliver turning across a curl narrower than a tenth of the tolerance
+    /// sits on a crease as much as a short triangle does.
+    pub fn short_for_angle(&self, m: &TriMeasure, turn: f64, len: f64, width: f64) -> bool {
         m.max <= self.tol
             && len <= self.max_edge
             && turn > self.angle
-            && (len <= 0.1 * self.tol || (turn > FOLD_TURN && len <= self.tol))
+            && (len.min(width) <= 0.1 * self.tol || (turn > FOLD_TURN && len <= self.tol))
     }
 }
 
@@ -138,12 +141,16 @@ mod tests {
         let c = Criteria::PLANE_TEST;
         let m = within(&c);
         let (bend, fold) = (1.0, 2.5);
-        assert!(!c.short_for_angle(&m, bend, 0.5 * c.tol));
-        assert!(c.short_for_angle(&m, bend, 0.09 * c.tol));
-        assert!(c.short_for_angle(&m, fold, 0.5 * c.tol));
-        assert!(!c.short_for_angle(&m, fold, 1.5 * c.tol));
+        let short = |m: &TriMeasure, turn: f64, len: f64| c.short_for_angle(m, turn, len, len);
+        assert!(!short(&m, bend, 0.5 * c.tol));
+        assert!(short(&m, bend, 0.09 * c.tol));
+        assert!(short(&m, fold, 0.5 * c.tol));
+        assert!(!short(&m, fold, 1.5 * c.tol));
         // Over the tolerance or within the angle limit: not a crease at all.
-        assert!(!c.short_for_angle(&TriMeasure { max: 2.0 * c.tol, sum: 0.0 }, fold, 0.5 * c.tol));
-        assert!(!c.short_for_angle(&m, 0.4, 0.05 * c.tol));
+        assert!(!short(&TriMeasure { max: 2.0 * c.tol, sum: 0.0 }, fold, 0.5 * c.tol));
+        assert!(!short(&m, 0.4, 0.05 * c.tol));
+        // A long sliver turning across a narrow width is a crease too.
+        assert!(c.short_for_angle(&m, bend, 5.0 * c.tol, 0.09 * c.tol));
+        assert!(!c.short_for_angle(&m, bend, 5.0 * c.tol, 0.2 * c.tol));
     }
 }

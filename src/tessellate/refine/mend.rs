@@ -264,7 +264,7 @@ impl WorkMesh {
         self.retriangulate(t, u, [tv, uv_], [t1, t2], [w1, w2]);
         let good = [t, u].iter().all(|&x| {
             let (m, turn) = self.measure(surface, x as usize, c);
-            !self.inverted(surface, x as usize) && m.max <= c.tol && self.turn_ok(c, &m, turn, x)
+            !self.inverted(surface, x as usize) && m.max <= c.tol && self.turn_ok(surface, c, &m, turn, x)
         });
         if !good {
             self.retriangulate(t, u, [t1, t2], [old.0, old.2], [old.1, old.3]);
@@ -483,14 +483,14 @@ impl WorkMesh {
         uv_area(self.uv(t as usize)) * sense > 0.0
             && !self.inverted(surface, t as usize)
             && m.max <= c.tol
-            && self.turn_ok(c, &m, turn, t)
+            && self.turn_ok(surface, c, &m, turn, t)
     }
 
     /// Whether triangle `t`'s normal turn passes: within the angle limit, or
     /// too short to split for it ([`Criteria::short_for_angle`]), so a repair
     /// that unfolds such a triangle is not refused for a turn refinement keeps too.
-    pub(super) fn turn_ok(&self, c: &Criteria, m: &TriMeasure, turn: f64, t: u32) -> bool {
-        turn <= c.angle || c.short_for_angle(m, turn, self.longest_edge(t as usize).2)
+    pub(super) fn turn_ok(&self, surface: &dyn Surface, c: &Criteria, m: &TriMeasure, turn: f64, t: u32) -> bool {
+        turn <= c.angle || self.short_for_angle(surface, c, t as usize, m, turn)
     }
 
     /// Replaces triangles `t` and `u` (vertices `from`) by `to` with corner (u,v)s `uvs`.
@@ -595,7 +595,7 @@ impl WorkMesh {
     #[cfg(feature = "std")]
     fn fits_placed(&mut self, surface: &dyn Surface, c: &Criteria, t: usize) -> bool {
         let (m, turn) = self.cached_measure(surface, t, c);
-        m.max <= c.tol && self.turn_ok(c, &m, turn, t as u32) && !self.inverted(surface, t)
+        m.max <= c.tol && self.turn_ok(surface, c, &m, turn, t as u32) && !self.inverted(surface, t)
     }
 
     /// Takes back the last triangle added.

@@ -311,3 +311,49 @@ fn a_triangle_across_a_fold_is_judged_by_the_sheet_it_lies_along() {
     assert_eq!(mend::count_folded(&m.pos, &m.tris[1..], &judged[1..], 1e-9, 1e-9), 1, "turned over on one sheet");
     assert_eq!(mend::count_folded(&m.pos, &m.tris, &judged, 1e-9, 1e-9), 1);
 }
+
+/// A strip 10 long whose cross-section, straight in u, curls by 60°
+/// within `r` at its v = 1 edge: a fillet far narrower than the tolerance.
+fn curled_strip(r: f64) -> crate::nurbs::NurbsSurface {
+    let section = [(0.0, 0.0), (1.0 - r, 0.0), (1.0, 0.0), (1.0 + 0.5 * r, 0.75_f64.sqrt() * r)];
+    let row = |x: f64| section.iter().map(|&(y, z)| DVec3::new(x, y, z)).collect::<Vec<_>>();
+    let points = [row(0.0), row(10.0)];
+    // The curl is the last span, from the middle of the two control points at (1 - r, 0) and (1, 0).
+    crate::nurbs::NurbsSurface::try_new(
+        [1, 2],
+        [0.0, 0.0, 1.0, 1.0].into(),
+        [0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0].into(),
+        &points,
+        None,
+    )
+    .expect("valid strip")
+}
+
+/// A long triangle across a curl narrower than a tenth of the tolerance,
+/// its longest edge along the curl, turns past the angle limit however
+/// short it is split along it: refinement leaves it as it is (creased),
+/// instead of chopping it into slivers a hundred times shorter, whose
+/// split points, off the chord by the strip's sag, fold over the next row.
+#[test]
+fn a_long_triangle_across_a_narrow_curl_is_creased() {
+    let uv = [at(0.0, 0.5), at(1.0, 0.5), at(0.5, 1.0)];
+    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: f64::INFINITY, min_edge: 0.0, steps: 2, lift: Lift::NONE };
+    let refined = |r: f64| {
+        let s = curled_strip(r);
+        let mut m = WorkMesh::default();
+        for q in uv {
+            m.add_vertex(s.point(q), s.normal(q));
+        }
+        m.add_triangle([0, 1, 2], uv);
+        let out = m.refine(&s, &[], &c, 100_000);
+        (m.tris.len(), out)
+    };
+    let (n, out) = refined(0.005);
+    assert!(out.max_turn > 1.0, "the curl turns by {}", out.max_turn);
+    assert!(out.max <= c.tol, "deviation {}", out.max);
+    assert_eq!(n, 1, "split into {n} triangles");
+    assert_eq!((out.creased, out.unproven), (1, 0));
+    // A curl as wide as the tolerance is split for its turn as before.
+    let (n, _) = refined(0.5);
+    assert!(n > 20, "{n} triangles");
+}
