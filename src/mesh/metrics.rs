@@ -81,7 +81,8 @@ pub(crate) fn edge_census(
 ) -> (EdgeCounts, Vec<Gap>) {
     let face_of = face_lookup(mesh);
     let scale_of = |f: u32| scale.get(f as usize).copied().unwrap_or(1.0);
-    let (mut map, mut nverts) = if scale.is_empty() {
+    // One scale throughout (most models): no per-vertex scales held beside the mesh.
+    let (mut map, mut nverts) = if scale.iter().all(|&k| k == 1.0) {
         weld_positions(&mesh.positions, weld_tol)
     } else {
         weld_scaled(mesh, &face_of, &scale_of, weld_tol)

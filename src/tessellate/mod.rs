@@ -290,9 +290,14 @@ fn unify_outlines(
         // A rebuilt face's border lies up to its fit error from its neighbours'.
         let moved: Vec<f64> = chosen.iter().map(|c| c.as_ref().map_or(0.0, |c| c.fit_error)).collect();
         let scale_of = |f: usize| scales.get(f).copied().unwrap_or(1.0);
-        let mut groups: Vec<f64> = (0..chosen.len()).map(scale_of).collect();
+        // The distinct scales, largest first (few: powers of two).
+        let mut groups: Vec<f64> = Vec::new();
+        for k in (0..chosen.len()).map(scale_of) {
+            if !groups.contains(&k) {
+                groups.push(k);
+            }
+        }
         crate::sort::f64s(&mut groups);
-        groups.dedup();
         let mut ids = 0u32;
         for &k in groups.iter().rev() {
             let mut faces: Vec<Option<(&dyn Surface, &mut face::Outline<'_>)>> = chosen

@@ -55,7 +55,8 @@ pub struct Plan<'m> {
     /// Each face's body for sewing and the edge counts ([`own_bodies`]).
     body_ids: Vec<u32>,
     /// Per face, the factor its body takes of `sew_tol`, `tight` and the
-    /// weld (1 but for bodies far smaller than the tolerance: `sewing_scales`).
+    /// weld (1 but for bodies far smaller than the tolerance: `sewing_scales`);
+    /// empty where all are 1.
     sew_scale: Vec<f64>,
     /// The report as the stages start it (reparameterized faces listed).
     report: Report,
@@ -202,12 +203,14 @@ impl<'m> Plan<'m> {
         // circle within the sewing distance is a border that another face can
         // close, not a pole.
         let body_ids = own_bodies(model, &mine, 1e-9 * diag.max(tol));
-        // A sewing distance the caller sets holds for every body.
-        let sew_scale = if options.sew.is_some() {
-            alloc::vec![1.0; boxes.len()]
-        } else {
-            sewing_scales(&boxes, &body_ids, tol, diag)
-        };
+        // A sewing distance the caller sets holds for every body; none kept
+        // where every body is at the model's scale (most models).
+        let mut sew_scale =
+            if options.sew.is_some() { Vec::new() } else { sewing_scales(&boxes, &body_ids, tol, diag) };
+        if sew_scale.iter().all(|&k| k == 1.0) {
+            sew_scale = Vec::new();
+        }
+        drop(boxes);
         Ok(Self {
             model,
             options,
