@@ -658,6 +658,35 @@ fn closed_surfaces_written_awkwardly_mesh_as_solids() {
     }
 }
 
+/// A face bounded along a knot line of its surface (a quarter of a
+/// rational B-spline sphere, its loop the meridians at 0 and 90 degrees,
+/// the second where two arc pieces meet), that meridian turned a rounding
+/// either way: the surface is cut on the knot line, not beside it (a sliver
+/// span whose derivatives are rounding noise turned the normals over near
+/// the poles and multiplied the triangles), so the mesh does not change
+/// with the rounding.
+#[test]
+fn a_loop_a_rounding_off_a_knot_line_meshes_the_same() {
+    let text = String::from_utf8(data("step_bspline_sphere_quarter.stp")).unwrap();
+    let mut counts = Vec::new();
+    for d in [0.0, 1e-13, -1e-13, 3e-13, 1e-12, 1e-11] {
+        // The meridian at 90 degrees, turned by `d` radians about the sphere's axis.
+        let t = text
+            .replace("#43=DIRECTION('',(1.0,0.0,0.0));", &format!("#43=DIRECTION('',(1.0,{d:e},0.0));"))
+            .replace("#44=DIRECTION('',(0.0,1.0,0.0));", &format!("#44=DIRECTION('',({:e},1.0,0.0));", -d));
+        assert!(d == 0.0 || t != text, "the meridian was turned");
+        let model = read_step(t.as_bytes()).unwrap();
+        assert_eq!(model.faces.len(), 1, "{:?}", model.warnings);
+        let r = mesh_model(&model, &MeshOptions::default().with_relative_tolerance(1e-3)).unwrap();
+        let rep = &r.report;
+        assert!(rep.max_deviation <= rep.tolerance, "{d}: deviation {} > {}", rep.max_deviation, rep.tolerance);
+        assert_eq!(rep.inverted_triangles, 0, "{d}: inverted triangles");
+        counts.push(rep.triangles);
+    }
+    let (lo, hi) = (*counts.iter().min().unwrap(), *counts.iter().max().unwrap());
+    assert!(hi as f64 <= 1.05 * lo as f64, "the triangles vary with a rounding: {counts:?}");
+}
+
 /// A trimmed curve runs from its first trim to its second, against its
 /// basis where its sense is false (ISO 10303-42): the quarter cylinder's top
 /// arc goes from 90 back to 0 degrees, not three quarters of the way round.

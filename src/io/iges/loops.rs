@@ -210,19 +210,25 @@ fn place_loops(
     if def.fixed_domain() {
         // Loops straddling the seam of a closed B-spline: move the seam,
         // or unroll the surface over more than a period where they wrap further.
-        let [lo, hi] = def.build((0.0, 1.0), (0.0, 1.0))?.0.domain();
+        let whole = def.build((0.0, 1.0), (0.0, 1.0))?.0;
+        let [lo, hi] = whole.domain();
         for k in 0..2 {
             let (Some(p), (a, b)) = (periods[k], range[k]) else { continue };
             let eps = 1e-9 * p;
             if a >= lo[k] - eps && b <= hi[k] + eps {
                 continue;
             }
+            // Cuts a rounding off a knot line are made on it (see `snap_to_knot`).
+            let knots = knot_lines(&whole, k);
             let cannot = TrimError::SeamRecut;
             if b - a > p * (1.0 + 1e-6) {
+                let (a, b) = (snap_to_knot(&knots, Some(p), a, eps), snap_to_knot(&knots, Some(p), b, eps));
                 *def = def.unroll(k == 0, a, b).ok_or(cannot)?;
                 continue;
             }
             let c = lo[k] + (a - lo[k] - p * crate::math::floor((a - lo[k]) / p));
+            let snapped = snap_to_knot(&knots, Some(p), c, eps);
+            let c = if snapped > lo[k] && snapped < hi[k] { snapped } else { c };
             *def = def.rotate_seam(k == 0, c).ok_or(cannot)?;
             for s in &mut shifts {
                 s[k] += c - a;
@@ -309,8 +315,12 @@ fn rectangle_face(def: &SurfDef, lp: &[Track]) -> Result<Option<Face>, TrimError
         }
         let FaceSurface::Nurbs(mut n) = whole else { return Ok(None) };
         let [dlo, dhi] = n.domain();
+        let (mut lo, mut hi) = (lo, hi);
         for k in 0..2 {
             let tiny = 1e-9 * (dhi[k] - dlo[k]);
+            let knots = if k == 0 { n.knots_u() } else { n.knots_v() }.breakpoints();
+            lo[k] = snap_to_knot(&knots, None, lo[k], tiny);
+            hi[k] = snap_to_knot(&knots, None, hi[k], tiny);
             if lo[k] > dlo[k] + tiny {
                 let Some((_, b)) = n.split(k == 0, lo[k]) else { return Ok(None) };
                 n = b;
@@ -325,6 +335,35 @@ fn rectangle_face(def: &SurfDef, lp: &[Track]) -> Result<Option<Face>, TrimError
         def.build((lo.x, hi.x), (lo.y, hi.y))?.0
     };
     Ok(Some(Face { name: None, surface, loops: Vec::new() }))
+}
+
+/// The knot line nearest `t` when within `tiny` of it, else `t`: one of
+/// `knots`, or one a whole number of `period`s from one. A loop's range comes
+/// from projected samples a rounding off the knot line it runs along (a
+/// sphere's quarter meridian); a cut there would leave a sliver span whose
+/// derivatives are rounding noise, and the mesh would change with the rounding.
+fn snap_to_knot(knots: &[f64], period: Option<f64>, t: f64, tiny: f64) -> f64 {
+    let (mut best, mut off) = (t, tiny);
+    for &k in knots {
+        let turns = match period {
+            Some(p) if p > 0.0 => crate::math::floor((t - k) / p + 0.5),
+            _ => 0.0,
+        };
+        let x = k + turns * period.unwrap_or(0.0);
+        if (x - t).abs() <= off {
+            (best, off) = (x, (x - t).abs());
+        }
+    }
+    best
+}
+
+/// The distinct knots along direction `k` (0: u) of a B-spline face surface
+/// (an offset's base's), empty for any other.
+fn knot_lines(s: &FaceSurface, k: usize) -> Vec<f64> {
+    match s {
+        FaceSurface::Nurbs(n) | FaceSurface::Rebuilt(n) => if k == 0 { n.knots_u() } else { n.knots_v() }.breakpoints(),
+        FaceSurface::Offset { base, .. } => knot_lines(base, k),
+    }
 }
 
 /// The native ranges the surface must cover: the loops' range plus a
