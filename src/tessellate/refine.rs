@@ -7,7 +7,7 @@ use crate::collections::{HashMap, PairMap};
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3, Vec3};
 
-use super::measure::{measure_projection, measure_triangle, sample_count, TriMeasure};
+use super::measure::{measure_projection, measure_triangle, sample_count, EdgeSamples, TriMeasure};
 use crate::math::angle_between;
 use crate::nurbs::{project_to_surface, regular_normal, NurbsCurve, Surface};
 
@@ -95,6 +95,9 @@ pub(crate) struct WorkMesh {
     /// distance) marks one changed since measured, which saves an `Option`'s
     /// tag, and the sample count follows from the grid: 12 bytes a triangle.
     measures: Vec<Packed>,
+    /// Distances at edge samples whose other triangle is still to be
+    /// measured; held only while a refinement or an outcome measures.
+    edge_samples: EdgeSamples,
 }
 
 /// One triangle of an edge being split.
@@ -257,6 +260,7 @@ impl WorkMesh {
             self.rim = EdgeList::from_unsorted(rim);
             self.resting = true;
         }
+        self.edge_samples = EdgeSamples::default();
         self.pos.shrink_to_fit();
         self.normal.shrink_to_fit();
         self.gid.shrink_to_fit();
@@ -397,10 +401,21 @@ impl WorkMesh {
     }
 
     fn measure(&self, surface: &dyn Surface, t: usize, c: &Criteria) -> (TriMeasure, f64) {
+        self.measure_sharing(surface, t, c, None)
+    }
+
+    /// As [`Self::measure`], with edge samples shared between neighbours through `shared`.
+    fn measure_sharing(
+        &self,
+        surface: &dyn Surface,
+        t: usize,
+        c: &Criteria,
+        shared: Option<&mut EdgeSamples>,
+    ) -> (TriMeasure, f64) {
         let v = self.tris[t];
         let p = [self.pos[v[0] as usize], self.pos[v[1] as usize], self.pos[v[2] as usize]];
         let uv = self.uv(t);
-        let m = measure_triangle(surface, &p, &uv, c.steps, &measure_projection());
+        let m = measure_triangle(surface, &p, &uv, c.steps, &measure_projection(), shared);
         let mut n = v.map(|x| self.normal_at(x as usize));
         let turn_of =
             |n: &[DVec3; 3]| angle_between(n[0], n[1]).max(angle_between(n[1], n[2])).max(angle_between(n[2], n[0]));
@@ -821,6 +836,7 @@ impl WorkMesh {
             self.forget(&changed);
             stack.extend_from_slice(&changed);
         }
+        self.edge_samples = EdgeSamples::default();
         budget_hit
     }
 
@@ -831,7 +847,9 @@ impl WorkMesh {
         if !x.max.is_nan() {
             return x.unpack();
         }
-        let (m, turn) = self.measure(surface, t, c);
+        let mut shared = core::mem::take(&mut self.edge_samples);
+        let (m, turn) = self.measure_sharing(surface, t, c, Some(&mut shared));
+        self.edge_samples = shared;
         let x = Packed::pack(m, turn);
         self.measures[t] = x;
         x.unpack()
@@ -867,6 +885,7 @@ impl WorkMesh {
             out.count += samples;
             out.max_turn = out.max_turn.max(turn);
         }
+        self.edge_samples = EdgeSamples::default();
         out
     }
 }
