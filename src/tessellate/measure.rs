@@ -35,7 +35,9 @@ pub(crate) fn measure_projection() -> ProjectionOptions {
 pub(crate) static MEASURE_NANOS: core::sync::atomic::AtomicU64 = core::sync::atomic::AtomicU64::new(0);
 
 /// Samples the barycentric grid with `steps` divisions per edge (corners skipped:
-/// they are surface points by construction) and measures their distance.
+/// they are surface points by construction) and measures their distance;
+/// `None` as soon as a sample lies farther than `limit` (a triangle that
+/// fails anyway need not be measured to its end; infinite: never).
 /// With `shared`, an edge's samples measured for the triangle across it are
 /// taken from there, and this triangle's are left for the next one.
 pub(crate) fn measure_triangle(
@@ -45,10 +47,11 @@ pub(crate) fn measure_triangle(
     steps: usize,
     opts: &ProjectionOptions,
     shared: Option<&mut EdgeSamples>,
-) -> TriMeasure {
+    limit: f64,
+) -> Option<TriMeasure> {
     #[cfg(feature = "timing")]
     let started = std::time::Instant::now();
-    let m = sample_triangle(surface, p, uv, steps, opts, shared);
+    let m = sample_triangle(surface, p, uv, steps, opts, shared, limit);
     #[cfg(feature = "timing")]
     MEASURE_NANOS.fetch_add(
         u64::try_from(started.elapsed().as_nanos()).unwrap_or(u64::MAX),
@@ -69,7 +72,8 @@ fn sample_triangle(
     steps: usize,
     opts: &ProjectionOptions,
     shared: Option<&mut EdgeSamples>,
-) -> TriMeasure {
+    limit: f64,
+) -> Option<TriMeasure> {
     let mut m = TriMeasure::default();
     let n = steps.max(2);
     let inv = 1.0 / n as f64;
@@ -113,6 +117,9 @@ fn sample_triangle(
                     d
                 }
             };
+            if d > limit {
+                return None;
+            }
             m.max = m.max.max(d);
             m.sum += d;
         }
@@ -122,7 +129,7 @@ fn sample_triangle(
             cache.put(p, uv, e, n, edge[e]);
         }
     }
-    m
+    Some(m)
 }
 
 /// Most samples per edge [`EdgeSamples`] holds: up to 8 measuring steps (the
@@ -443,7 +450,7 @@ mod tests {
         let uv = [DVec2::new(0.0, 0.0), DVec2::new(4.0, 0.0), DVec2::new(0.0, 3.0)];
         let p = uv.map(|q| DVec3::new(q.x, q.y, h));
         for steps in 0..7 {
-            let m = measure_triangle(&plane, &p, &uv, steps, &measure_projection(), None);
+            let m = measure_triangle(&plane, &p, &uv, steps, &measure_projection(), None, f64::INFINITY).unwrap();
             assert!((m.max - h).abs() < 1e-12);
             assert!((m.sum / h - f64::from(sample_count(steps))).abs() < 1e-9, "steps {steps}: {}", m.sum / h);
         }
@@ -485,10 +492,10 @@ mod tests {
             for t in &tris {
                 let (p, w) = (t.map(|x| x.0), t.map(|x| x.1));
                 s.reset();
-                let fresh = measure_triangle(&s, &p, &w, steps, &opts, None);
+                let fresh = measure_triangle(&s, &p, &w, steps, &opts, None, f64::INFINITY).unwrap();
                 alone += s.derivs.get();
                 s.reset();
-                let got = measure_triangle(&s, &p, &w, steps, &opts, Some(&mut shared));
+                let got = measure_triangle(&s, &p, &w, steps, &opts, Some(&mut shared), f64::INFINITY).unwrap();
                 sharing += s.derivs.get();
                 assert_eq!(got.max.to_bits(), fresh.max.to_bits(), "steps {steps}");
                 assert_eq!(got.sum.to_bits(), fresh.sum.to_bits(), "steps {steps}");
@@ -499,6 +506,23 @@ mod tests {
                 assert_eq!(sharing, alone, "steps {steps}");
             }
         }
+    }
+
+    /// A limit gives up only where a sample lies beyond it: at the largest
+    /// distance or above, the measure is the full one; below it, `None`,
+    /// and the samples measured before it are not left for a neighbour.
+    #[test]
+    fn a_limit_gives_up_only_past_a_sample() {
+        let s = Sphere::new(10.0);
+        let opts = measure_projection();
+        let w = [DVec2::new(0.5, 1.0), DVec2::new(0.9, 1.0), DVec2::new(0.7, 1.3)];
+        let p = w.map(|x| s.at(x) * 1.002);
+        let full = measure_triangle(&s, &p, &w, 4, &opts, None, f64::INFINITY).unwrap();
+        assert!(full.max > 0.0);
+        assert_eq!(measure_triangle(&s, &p, &w, 4, &opts, None, full.max), Some(full));
+        let mut shared = EdgeSamples::default();
+        assert_eq!(measure_triangle(&s, &p, &w, 4, &opts, Some(&mut shared), 0.5 * full.max), None);
+        assert!(shared.map.is_empty());
     }
 
     /// Two triangles on one seam edge, its ends at the same points but at
@@ -515,18 +539,18 @@ mod tests {
         // The second triangle's corners at the same points, another chart.
         let w2_other = [w2[0] + DVec2::new(1e-3, 0.0), w2[1] + DVec2::new(1e-3, 0.0), w2[2]];
         let mut shared = EdgeSamples::default();
-        measure_triangle(&s, &p1, &w1, 4, &opts, Some(&mut shared));
+        measure_triangle(&s, &p1, &w1, 4, &opts, Some(&mut shared), f64::INFINITY);
         s.reset();
-        let fresh = measure_triangle(&s, &p2, &w2_other, 4, &opts, None);
+        let fresh = measure_triangle(&s, &p2, &w2_other, 4, &opts, None, f64::INFINITY).unwrap();
         let alone = s.derivs.get();
         s.reset();
-        let got = measure_triangle(&s, &p2, &w2_other, 4, &opts, Some(&mut shared));
+        let got = measure_triangle(&s, &p2, &w2_other, 4, &opts, Some(&mut shared), f64::INFINITY).unwrap();
         assert_eq!(s.derivs.get(), alone);
         assert_eq!(got.max.to_bits(), fresh.max.to_bits());
         assert_eq!(got.sum.to_bits(), fresh.sum.to_bits());
         // In the same chart the edge is shared.
         s.reset();
-        measure_triangle(&s, &p2, &w2, 4, &opts, Some(&mut shared));
+        measure_triangle(&s, &p2, &w2, 4, &opts, Some(&mut shared), f64::INFINITY);
         assert!(s.derivs.get() < alone);
     }
 
@@ -547,7 +571,7 @@ mod tests {
         let a = 0.015;
         let uv = [DVec2::new(a, 0.75), DVec2::new(0.0, 0.75), DVec2::new(a, 0.5)];
         let p = uv.map(|x| s.point(x));
-        let m = measure_triangle(&s, &p, &uv, 4, &measure_projection(), None);
+        let m = measure_triangle(&s, &p, &uv, 4, &measure_projection(), None, f64::INFINITY).unwrap();
         assert!(m.max < 1e-9, "{}", m.max);
         // The hints are far off: the search had work to do.
         let hint = uv[1] * 0.25 + uv[2] * 0.75;
