@@ -398,6 +398,9 @@ pub(crate) struct SurfaceFacts {
     collapsed: [[OnceCell<bool>; 2]; 2],
     /// The coarse search's grid: its steps per direction and its points.
     grid: OnceCell<(usize, Vec<DVec3>)>,
+    /// A size of the surface its owner measures once (the diagonal of its
+    /// control points' box, for the IGES and STEP readers' inversions).
+    size: OnceCell<f64>,
 }
 
 impl SurfaceFacts {
@@ -442,6 +445,12 @@ impl SurfaceFacts {
             // Written as the negation of "apart", so that NaN counts as collapsed.
             !(a.distance(b) > eps || a.distance(c) > eps)
         })
+    }
+
+    /// The size `measure` gives, measured on first need and kept: the same
+    /// value each time, without its cost per projection.
+    pub(crate) fn size(&self, measure: impl FnOnce() -> f64) -> f64 {
+        *self.size.get_or_init(measure)
     }
 
     /// The points of the `(n+1)²` search grid ([`param`]), kept for the first `n` asked.

@@ -35,17 +35,23 @@ pub(crate) fn measure_projection() -> ProjectionOptions {
 pub(crate) static MEASURE_NANOS: core::sync::atomic::AtomicU64 = core::sync::atomic::AtomicU64::new(0);
 
 /// Samples the barycentric grid with `steps` divisions per edge (corners skipped:
-/// they are surface points by construction) and measures their distance.
+/// they are surface points by construction) and measures their distance;
+/// `None` as soon as a sample lies farther than `limit` (a triangle that
+/// fails anyway need not be measured to its end; infinite: never).
+/// With `shared`, an edge's samples measured for the triangle across it are
+/// taken from there, and this triangle's are left for the next one.
 pub(crate) fn measure_triangle(
     surface: &dyn Surface,
     p: &[DVec3; 3],
     uv: &[DVec2; 3],
     steps: usize,
     opts: &ProjectionOptions,
-) -> TriMeasure {
+    shared: Option<&mut EdgeSamples>,
+    limit: f64,
+) -> Option<TriMeasure> {
     #[cfg(feature = "timing")]
     let started = std::time::Instant::now();
-    let m = sample_triangle(surface, p, uv, steps, opts);
+    let m = sample_triangle(surface, p, uv, steps, opts, shared, limit);
     #[cfg(feature = "timing")]
     MEASURE_NANOS.fetch_add(
         u64::try_from(started.elapsed().as_nanos()).unwrap_or(u64::MAX),
@@ -54,32 +60,142 @@ pub(crate) fn measure_triangle(
     m
 }
 
-/// [`measure_triangle`]'s work.
+/// [`measure_triangle`]'s work. Each sample's distance depends only on its
+/// point and (u,v) hint, and on an edge both are the same bits in the two
+/// triangles that share it (one weight is zero, and the sum of the other two
+/// products does not depend on their order), so an edge's distances measured
+/// once serve both sides; they are summed in the grid's order as before.
 fn sample_triangle(
     surface: &dyn Surface,
     p: &[DVec3; 3],
     uv: &[DVec2; 3],
     steps: usize,
     opts: &ProjectionOptions,
-) -> TriMeasure {
+    shared: Option<&mut EdgeSamples>,
+    limit: f64,
+) -> Option<TriMeasure> {
     let mut m = TriMeasure::default();
     let n = steps.max(2);
     let inv = 1.0 / n as f64;
+    let mut shared = shared.filter(|_| n - 1 <= EDGE_MAX);
+    // Per edge `e` (corner e to corner e + 1), its samples' distances by the
+    // weight on corner e (slot weight - 1), and whether the cache had them.
+    let mut edge = [[f64::NAN; EDGE_MAX]; 3];
+    let mut known = [false; 3];
+    if let Some(cache) = shared.as_deref_mut() {
+        for e in 0..3 {
+            if let Some(d) = cache.take(p, uv, e, n) {
+                edge[e] = d;
+                known[e] = true;
+            }
+        }
+    }
     for i in 0..=n {
         for j in 0..=(n - i) {
             let k = n - i - j;
             if i == n || j == n || k == n {
                 continue;
             }
-            let (a, b, c) = (i as f64 * inv, j as f64 * inv, k as f64 * inv);
-            let q = p[0] * a + p[1] * b + p[2] * c;
-            let hint = uv[0] * a + uv[1] * b + uv[2] * c;
-            let d = distance_from_hint(surface, q, hint, opts);
+            let slot = match (i, j, k) {
+                (_, _, 0) => Some((0, i - 1)),
+                (0, _, _) => Some((1, j - 1)),
+                (_, 0, _) => Some((2, k - 1)),
+                _ => None,
+            };
+            let d = match slot {
+                Some((e, w)) if known[e] => edge[e][w],
+                _ => {
+                    let (a, b, c) = (i as f64 * inv, j as f64 * inv, k as f64 * inv);
+                    let q = p[0] * a + p[1] * b + p[2] * c;
+                    let hint = uv[0] * a + uv[1] * b + uv[2] * c;
+                    let d = distance_from_hint(surface, q, hint, opts);
+                    if let Some((e, w)) = slot {
+                        if let Some(x) = edge[e].get_mut(w) {
+                            *x = d;
+                        }
+                    }
+                    d
+                }
+            };
+            if d > limit {
+                return None;
+            }
             m.max = m.max.max(d);
             m.sum += d;
         }
     }
-    m
+    if let Some(cache) = shared {
+        for e in (0..3).filter(|&e| !known[e]) {
+            cache.put(p, uv, e, n, edge[e]);
+        }
+    }
+    Some(m)
+}
+
+/// Most samples per edge [`EdgeSamples`] holds: up to 8 measuring steps (the
+/// default is 4); with more, every edge is measured from both sides.
+const EDGE_MAX: usize = 7;
+
+/// Most edges [`EdgeSamples`] holds before it starts over: its triangles'
+/// neighbours are mostly measured soon after them (the grid's order, a
+/// split's neighbours), and the room stays bounded (about 0.6 MB).
+const EDGE_CAP: usize = 4096;
+
+/// An edge's key: the measuring steps, then its two ends' point and (u,v)
+/// bits, the lower end first.
+type EdgeKey = [u64; 11];
+
+/// Distances measured at the samples of triangle edges whose other triangle
+/// has not been measured yet, by the edge's exact ends (point and (u,v)):
+/// each is taken out when that triangle reads it, so an edge's samples are
+/// measured once instead of twice. A moved end is another key, so an entry
+/// never answers for what it was not measured on.
+#[derive(Debug, Default)]
+pub(crate) struct EdgeSamples {
+    map: crate::collections::HashMap<EdgeKey, [f64; EDGE_MAX]>,
+}
+
+impl EdgeSamples {
+    /// The key of edge `e` (corner e to corner e + 1) at `n` steps, and
+    /// whether the key's lower end is its corner e + 1 (its samples then
+    /// run the other way).
+    fn key(p: &[DVec3; 3], uv: &[DVec2; 3], e: usize, n: usize) -> (EdgeKey, bool) {
+        let end = |c: usize| {
+            let (q, w) = (p[c % 3], uv[c % 3]);
+            [q.x, q.y, q.z, w.x, w.y].map(f64::to_bits)
+        };
+        let (a, b) = (end(e), end(e + 1));
+        let flip = b < a;
+        let (lo, hi) = if flip { (b, a) } else { (a, b) };
+        let mut k = [0u64; 11];
+        k[0] = n as u64;
+        k[1..6].copy_from_slice(&lo);
+        k[6..].copy_from_slice(&hi);
+        (k, flip)
+    }
+
+    /// Edge `e`'s distances by the weight on corner e, if the triangle
+    /// across it left them; they are taken out.
+    fn take(&mut self, p: &[DVec3; 3], uv: &[DVec2; 3], e: usize, n: usize) -> Option<[f64; EDGE_MAX]> {
+        let (k, flip) = Self::key(p, uv, e, n);
+        let mut d = self.map.remove(&k)?;
+        if flip {
+            d[..n - 1].reverse();
+        }
+        Some(d)
+    }
+
+    /// Leaves edge `e`'s distances `d` (by the weight on corner e) for the triangle across it.
+    fn put(&mut self, p: &[DVec3; 3], uv: &[DVec2; 3], e: usize, n: usize, mut d: [f64; EDGE_MAX]) {
+        let (k, flip) = Self::key(p, uv, e, n);
+        if flip {
+            d[..n - 1].reverse();
+        }
+        if self.map.len() >= EDGE_CAP {
+            self.map.clear();
+        }
+        self.map.insert(k, d);
+    }
 }
 
 /// Distance from `q` to the surface, starting at `hint` (the triangle's own
@@ -334,10 +450,108 @@ mod tests {
         let uv = [DVec2::new(0.0, 0.0), DVec2::new(4.0, 0.0), DVec2::new(0.0, 3.0)];
         let p = uv.map(|q| DVec3::new(q.x, q.y, h));
         for steps in 0..7 {
-            let m = measure_triangle(&plane, &p, &uv, steps, &measure_projection());
+            let m = measure_triangle(&plane, &p, &uv, steps, &measure_projection(), None, f64::INFINITY).unwrap();
             assert!((m.max - h).abs() < 1e-12);
             assert!((m.sum / h - f64::from(sample_count(steps))).abs() < 1e-9, "steps {steps}: {}", m.sum / h);
         }
+    }
+
+    /// Edge samples shared between neighbours give each triangle the very
+    /// measure it gets alone (bit for bit: the sum's order is the grid's),
+    /// whichever corners the shared edge joins in each triangle and which
+    /// way it runs, for every step count; where steps allow, the second
+    /// triangle on an edge measures its samples no more (fewer evaluations).
+    /// Corners lie off the sphere by different amounts, so every sample's
+    /// distance differs.
+    #[test]
+    fn shared_edge_samples_equal_fresh_ones() {
+        let s = Sphere::new(10.0);
+        let opts = measure_projection();
+        let uv = |i: usize, j: usize| DVec2::new(0.5 + 0.3 * i as f64, 0.6 + 0.25 * j as f64);
+        let node = |i: usize, j: usize| {
+            let off = 0.01 * ((3 * i + 5 * j) % 7) as f64 - 0.02;
+            (s.at(uv(i, j)) * (1.0 + off / s.r), uv(i, j))
+        };
+        // A 4 × 4 grid of cells, two triangles each, their corners rotated
+        // by the cell so that shared edges fall at every corner pair.
+        let mut tris = Vec::new();
+        for i in 0..4 {
+            for j in 0..4 {
+                let (a, b, c, d) = (node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1));
+                let mut t1 = [a, b, c];
+                let mut t2 = [a, c, d];
+                t1.rotate_left((i + j) % 3);
+                t2.rotate_left((2 * i + j) % 3);
+                tris.push(t1);
+                tris.push(t2);
+            }
+        }
+        for steps in [2, 3, 4, 8, 9] {
+            let mut shared = EdgeSamples::default();
+            let (mut alone, mut sharing) = (0usize, 0usize);
+            for t in &tris {
+                let (p, w) = (t.map(|x| x.0), t.map(|x| x.1));
+                s.reset();
+                let fresh = measure_triangle(&s, &p, &w, steps, &opts, None, f64::INFINITY).unwrap();
+                alone += s.derivs.get();
+                s.reset();
+                let got = measure_triangle(&s, &p, &w, steps, &opts, Some(&mut shared), f64::INFINITY).unwrap();
+                sharing += s.derivs.get();
+                assert_eq!(got.max.to_bits(), fresh.max.to_bits(), "steps {steps}");
+                assert_eq!(got.sum.to_bits(), fresh.sum.to_bits(), "steps {steps}");
+            }
+            if steps - 1 <= EDGE_MAX {
+                assert!(sharing < alone * 4 / 5, "steps {steps}: {sharing} against {alone}");
+            } else {
+                assert_eq!(sharing, alone, "steps {steps}");
+            }
+        }
+    }
+
+    /// A limit gives up only where a sample lies beyond it: at the largest
+    /// distance or above, the measure is the full one; below it, `None`,
+    /// and the samples measured before it are not left for a neighbour.
+    #[test]
+    fn a_limit_gives_up_only_past_a_sample() {
+        let s = Sphere::new(10.0);
+        let opts = measure_projection();
+        let w = [DVec2::new(0.5, 1.0), DVec2::new(0.9, 1.0), DVec2::new(0.7, 1.3)];
+        let p = w.map(|x| s.at(x) * 1.002);
+        let full = measure_triangle(&s, &p, &w, 4, &opts, None, f64::INFINITY).unwrap();
+        assert!(full.max > 0.0);
+        assert_eq!(measure_triangle(&s, &p, &w, 4, &opts, None, full.max), Some(full));
+        let mut shared = EdgeSamples::default();
+        assert_eq!(measure_triangle(&s, &p, &w, 4, &opts, Some(&mut shared), 0.5 * full.max), None);
+        assert!(shared.map.is_empty());
+    }
+
+    /// Two triangles on one seam edge, its ends at the same points but at
+    /// other (u,v) in each (one chart each side): the second measures its own
+    /// samples, from its own hints.
+    #[test]
+    fn a_seam_edge_is_not_shared_across_charts() {
+        let s = Sphere::new(10.0);
+        let opts = measure_projection();
+        let w1 = [DVec2::new(0.5, 1.0), DVec2::new(0.5, 1.4), DVec2::new(0.2, 1.2)];
+        let w2 = [DVec2::new(0.5, 1.4), DVec2::new(0.5, 1.0), DVec2::new(0.8, 1.2)];
+        let p1 = w1.map(|x| s.at(x) * 1.001);
+        let p2 = [p1[1], p1[0], s.at(w2[2])];
+        // The second triangle's corners at the same points, another chart.
+        let w2_other = [w2[0] + DVec2::new(1e-3, 0.0), w2[1] + DVec2::new(1e-3, 0.0), w2[2]];
+        let mut shared = EdgeSamples::default();
+        measure_triangle(&s, &p1, &w1, 4, &opts, Some(&mut shared), f64::INFINITY);
+        s.reset();
+        let fresh = measure_triangle(&s, &p2, &w2_other, 4, &opts, None, f64::INFINITY).unwrap();
+        let alone = s.derivs.get();
+        s.reset();
+        let got = measure_triangle(&s, &p2, &w2_other, 4, &opts, Some(&mut shared), f64::INFINITY).unwrap();
+        assert_eq!(s.derivs.get(), alone);
+        assert_eq!(got.max.to_bits(), fresh.max.to_bits());
+        assert_eq!(got.sum.to_bits(), fresh.sum.to_bits());
+        // In the same chart the edge is shared.
+        s.reset();
+        measure_triangle(&s, &p2, &w2, 4, &opts, Some(&mut shared), f64::INFINITY);
+        assert!(s.derivs.get() < alone);
     }
 
     /// A flat cap about a pole (the end of a tube of rectangular section,
@@ -357,7 +571,7 @@ mod tests {
         let a = 0.015;
         let uv = [DVec2::new(a, 0.75), DVec2::new(0.0, 0.75), DVec2::new(a, 0.5)];
         let p = uv.map(|x| s.point(x));
-        let m = measure_triangle(&s, &p, &uv, 4, &measure_projection());
+        let m = measure_triangle(&s, &p, &uv, 4, &measure_projection(), None, f64::INFINITY).unwrap();
         assert!(m.max < 1e-9, "{}", m.max);
         // The hints are far off: the search had work to do.
         let hint = uv[1] * 0.25 + uv[2] * 0.75;

@@ -12,9 +12,11 @@
 //! equalization (§3.1.2) for free.
 
 use alloc::vec::Vec;
+use core::cell::RefCell;
 use glam::{DVec2, DVec3};
 
 use super::refine::FOLD_TURN;
+use crate::collections::HashMap;
 use crate::math::{ceil, sqrt};
 use crate::nurbs::Surface;
 
@@ -494,7 +496,10 @@ fn fine_demand(probes: &[Probe<'_>], xs: &[f64], lim: &Limits) -> Vec<f64> {
 }
 
 /// The iso-curves one direction is tested on: at `lines + 1` even steps of
-/// the other parameter, each with its point-and-normal evaluator.
+/// the other parameter, each with its point-and-normal evaluator. Each keeps
+/// what it evaluated (by the parameter's bits): neighbouring intervals share
+/// their ends, and a part of a split interval is tested again as it is
+/// split in turn.
 #[allow(clippy::type_complexity)]
 fn iso_curves<'s>(
     surface: &'s dyn Surface,
@@ -505,9 +510,15 @@ fn iso_curves<'s>(
 ) -> Vec<(f64, impl Fn(f64) -> (DVec3, DVec3) + 's)> {
     let (s0, s1) = if along_u { (lo.y, hi.y) } else { (lo.x, hi.x) };
     let make = move |s: f64| {
+        let seen: RefCell<HashMap<u64, (DVec3, DVec3)>> = RefCell::new(HashMap::default());
         move |t: f64| {
+            if let Some(&x) = seen.borrow().get(&t.to_bits()) {
+                return x;
+            }
             let uv = if along_u { DVec2::new(t, s) } else { DVec2::new(s, t) };
-            surface.point_normal(uv)
+            let x = surface.point_normal(uv);
+            seen.borrow_mut().insert(t.to_bits(), x);
+            x
         }
     };
     (0..=lines).map(|k| s0 + (s1 - s0) * k as f64 / lines as f64).map(|s| (s, make(s))).collect()

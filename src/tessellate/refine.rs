@@ -7,7 +7,7 @@ use crate::collections::{HashMap, PairMap};
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3, Vec3};
 
-use super::measure::{measure_projection, measure_triangle, sample_count, TriMeasure};
+use super::measure::{measure_projection, measure_triangle, sample_count, EdgeSamples, TriMeasure};
 use crate::math::angle_between;
 use crate::nurbs::{project_to_surface, regular_normal, NurbsCurve, Surface};
 
@@ -95,6 +95,9 @@ pub(crate) struct WorkMesh {
     /// distance) marks one changed since measured, which saves an `Option`'s
     /// tag, and the sample count follows from the grid: 12 bytes a triangle.
     measures: Vec<Packed>,
+    /// Distances at edge samples whose other triangle is still to be
+    /// measured; held only while a refinement or an outcome measures.
+    edge_samples: EdgeSamples,
 }
 
 /// One triangle of an edge being split.
@@ -257,6 +260,7 @@ impl WorkMesh {
             self.rim = EdgeList::from_unsorted(rim);
             self.resting = true;
         }
+        self.edge_samples = EdgeSamples::default();
         self.pos.shrink_to_fit();
         self.normal.shrink_to_fit();
         self.gid.shrink_to_fit();
@@ -397,10 +401,23 @@ impl WorkMesh {
     }
 
     fn measure(&self, surface: &dyn Surface, t: usize, c: &Criteria) -> (TriMeasure, f64) {
+        self.measure_sharing(surface, t, c, None, f64::INFINITY).unwrap_or_default()
+    }
+
+    /// As [`Self::measure`], with edge samples shared between neighbours
+    /// through `shared`; `None` as soon as a sample lies farther than `limit`.
+    fn measure_sharing(
+        &self,
+        surface: &dyn Surface,
+        t: usize,
+        c: &Criteria,
+        shared: Option<&mut EdgeSamples>,
+        limit: f64,
+    ) -> Option<(TriMeasure, f64)> {
         let v = self.tris[t];
         let p = [self.pos[v[0] as usize], self.pos[v[1] as usize], self.pos[v[2] as usize]];
         let uv = self.uv(t);
-        let m = measure_triangle(surface, &p, &uv, c.steps, &measure_projection());
+        let m = measure_triangle(surface, &p, &uv, c.steps, &measure_projection(), shared, limit)?;
         let mut n = v.map(|x| self.normal_at(x as usize));
         let turn_of =
             |n: &[DVec3; 3]| angle_between(n[0], n[1]).max(angle_between(n[1], n[2])).max(angle_between(n[2], n[0]));
@@ -426,7 +443,7 @@ impl WorkMesh {
             }
             turn = turn_of(&n);
         }
-        (m, turn)
+        Some((m, turn))
     }
 
     /// [`Criteria::short_for_angle`] for triangle `t` of measure `m` and
@@ -795,10 +812,13 @@ impl WorkMesh {
         let fold_limit = 2 * stack.iter().filter(|&&t| self.inverted(surface, t as usize)).count() + 16;
         while let Some(t) = stack.pop() {
             let t = t as usize;
-            let (m, turn) = self.cached_measure(surface, t, c);
+            // A sample over the tolerance fails the triangle whatever the
+            // others measure (one over it is never short for its angle).
+            let measured = self.measure_unless_over(surface, t, c, c.tol);
             let (a, b, len) = self.longest_edge(t);
-            let limits =
-                (m.max > c.tol || turn > c.angle || len > c.max_edge) && !self.short_for_angle(surface, c, t, &m, turn);
+            let limits = measured.is_none_or(|(m, turn)| {
+                (m.max > c.tol || turn > c.angle || len > c.max_edge) && !self.short_for_angle(surface, c, t, &m, turn)
+            });
             // A folded sliver along a border is mended by splitting it, but
             // a fold splitting cannot mend (its corners off the surface
             // after sewing) would only breed more: such splits are rationed.
@@ -821,20 +841,37 @@ impl WorkMesh {
             self.forget(&changed);
             stack.extend_from_slice(&changed);
         }
+        self.edge_samples = EdgeSamples::default();
         budget_hit
     }
 
     /// Triangle `t`'s measure, from the cache while it is valid (the cache
     /// must already hold a slot per triangle).
     fn cached_measure(&mut self, surface: &dyn Surface, t: usize, c: &Criteria) -> (TriMeasure, f64) {
+        self.measure_unless_over(surface, t, c, f64::INFINITY).unwrap_or_default()
+    }
+
+    /// [`Self::cached_measure`], or `None` when triangle `t` is not cached
+    /// and one of its samples lies farther than `limit`: it is then left
+    /// stale, to be measured in full by whatever asks next.
+    fn measure_unless_over(
+        &mut self,
+        surface: &dyn Surface,
+        t: usize,
+        c: &Criteria,
+        limit: f64,
+    ) -> Option<(TriMeasure, f64)> {
         let x = self.measures[t];
         if !x.max.is_nan() {
-            return x.unpack();
+            return Some(x.unpack());
         }
-        let (m, turn) = self.measure(surface, t, c);
+        let mut shared = core::mem::take(&mut self.edge_samples);
+        let measured = self.measure_sharing(surface, t, c, Some(&mut shared), limit);
+        self.edge_samples = shared;
+        let (m, turn) = measured?;
         let x = Packed::pack(m, turn);
         self.measures[t] = x;
-        x.unpack()
+        Some(x.unpack())
     }
 
     /// Drops the cached measures of triangles `ts` (they changed).
@@ -867,6 +904,7 @@ impl WorkMesh {
             out.count += samples;
             out.max_turn = out.max_turn.max(turn);
         }
+        self.edge_samples = EdgeSamples::default();
         out
     }
 }

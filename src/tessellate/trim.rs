@@ -1,9 +1,11 @@
 //! Trim loops: discretization by the chord test, outer/hole classification,
 //! crossing checks and inside tests (paper 000 §3.2).
 
+use crate::collections::HashMap;
 use crate::numeric::TINY;
 use alloc::format;
 use alloc::vec::Vec;
+use core::cell::RefCell;
 use glam::{DVec2, DVec3};
 
 use super::mend_loops::Mended;
@@ -237,13 +239,24 @@ fn discretize_loop<'a>(
 /// until each piece's image on the surface is within the tolerance of its
 /// chord and turns less than the angle limit (by normal and by tangent),
 /// then coarsened where a longer (u,v) segment still stays that close.
+///
+/// Both tests (by normal, by tangent) sample the same parameters, and
+/// neighbouring intervals share their ends, so each parameter's point,
+/// normal and tangent are evaluated once and kept (by the parameter's bits)
+/// while the curve is discretized.
 fn curve_parameters(c: &crate::NurbsCurve, surface: &dyn Surface, lim: &Limits) -> Vec<f64> {
+    let seen: RefCell<HashMap<u64, (DVec3, DVec3, DVec3)>> = RefCell::new(HashMap::default());
     let on_surface = |t: f64| {
+        if let Some(&x) = seen.borrow().get(&t.to_bits()) {
+            return x;
+        }
         let d = c.derivs(t);
         let uv = d.point.truncate();
         let s = surface.derivs(uv);
         let tangent = s.su * d.d1.x + s.sv * d.d1.y;
-        (s.point, surface.normal_from_tangents(uv, s.su, s.sv), tangent)
+        let x = (s.point, surface.normal_from_tangents(uv, s.su, s.sv), tangent);
+        seen.borrow_mut().insert(t.to_bits(), x);
+        x
     };
     let by_normal = |t: f64| {
         let (p, n, _) = on_surface(t);

@@ -193,7 +193,7 @@ impl SurfDef {
                 let mut pr = project_with(surface, facts, p, hint, &opts, f64::NEG_INFINITY);
                 // Newton from a hint can stall (next to the domain's edge);
                 // a result far off the surface is retried by the global search.
-                let far = 1e-4 * surface.bbox().diagonal();
+                let far = 1e-4 * facts.size(|| surface.bbox().diagonal());
                 if *retry && hint.is_some() && pr.distance > far {
                     let g = project_with(surface, facts, p, None, &opts, f64::NEG_INFINITY);
                     if g.distance < pr.distance {

@@ -1,6 +1,7 @@
 //! Insertions that would sew a border across a face (see [`across_faces`]).
 
 use alloc::vec::Vec;
+use core::cell::RefCell;
 use glam::DVec3;
 
 use super::nearest_fraction;
@@ -141,6 +142,10 @@ pub(super) fn between(
                 };
                 let sag = [0.25, 0.5, 0.75].map(|s| off_chord(on_curve(s))).into_iter().fold(0.0, f64::max);
                 let room = (2.0 * sag + 1e-9 * (a.abs().max_element() + b.abs().max_element())).min(half);
+                // The piece's nearest points found so far, by the point
+                // they are nearest to: a point is asked about at two radii,
+                // and a node `q` for each border point it is to join.
+                let nearest: RefCell<Vec<([u64; 3], f64)>> = RefCell::new(Vec::new());
                 // Whether the piece passes within `r` of `x`: by its chord
                 // where the room decides, else by the nearest point.
                 let within = |x: DVec3, r: f64| {
@@ -152,7 +157,14 @@ pub(super) fn between(
                     if to_chord + room < r {
                         return true;
                     }
-                    nearest_fraction(&|s: f64| on_curve(s).distance(x), s0).1 < r
+                    let bits = x.to_array().map(f64::to_bits);
+                    let known = nearest.borrow().iter().find(|(b, _)| *b == bits).map(|&(_, d)| d);
+                    let d = known.unwrap_or_else(|| {
+                        let d = nearest_fraction(&|s: f64| on_curve(s).distance(x), s0).1;
+                        nearest.borrow_mut().push((bits, d));
+                        d
+                    });
+                    d < r
                 };
                 for &pi in probes_near {
                     let (ci, p) = probes[pi as usize];
