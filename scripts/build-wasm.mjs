@@ -9,7 +9,8 @@
 // codegen options (`-C NAME`) from [build] codegen. Ends with a
 // size report: every .wasm raw, gzip -9 and brotli, and per build the 20 largest
 // functions and sections (`twiggy top`, on a copy optimized with its names
-// kept; scripts/setup.sh installs twiggy), also written to pkg/SIZES.md.
+// kept; scripts/setup.sh installs twiggy) and the bytes per crate or module,
+// also written to pkg/SIZES.md.
 // The plain-JS helpers in js/ (the three.js adapter and loader, and its
 // worker) are copied beside the targets and exported as subpaths.
 //
@@ -172,6 +173,64 @@ function twiggyTop(wasm) {
   return r.stdout.trimEnd();
 }
 
+/** One line of twiggy's CSV: fields split on commas outside quotes, `""` as a quote. */
+function csvFields(line) {
+  const out = [];
+  let field = '';
+  let quoted = false;
+  for (let i = 0; i < line.length; i++) {
+    const c = line[i];
+    if (quoted && c === '"' && line[i + 1] === '"') field += line[++i];
+    else if (c === '"') quoted = !quoted;
+    else if (c === ',' && !quoted) {
+      out.push(field);
+      field = '';
+    } else field += c;
+  }
+  out.push(field);
+  return out;
+}
+
+/**
+ * Where an item's bytes belong: the crate for dependencies and the standard
+ * library (a generic's copy counts for the crate that defines it), the
+ * module up to two levels down for this crate (`surfmesh::io::step`).
+ */
+function sizeGroup(name) {
+  if (name.startsWith('data segment')) return '(data segments)';
+  if (name.includes('subsection') || name.startsWith('custom section')) return '(names and custom sections)';
+  // Leading `<` / `&` of trait impls and references, and crate disambiguators (`core[abc123]`).
+  const segments = name.replace(/^[<&]+(mut )?/, '').replace(/\[[0-9a-f]+\]/g, '').split('::');
+  if (/^h[0-9a-f]{16}$/.test(segments.at(-1))) segments.pop();
+  segments.pop();
+  const modules = [];
+  for (const seg of segments.slice(0, segments[0] === 'surfmesh' ? 3 : 1)) {
+    if (!/^[a-z_][a-z0-9_]*$/.test(seg)) break;
+    modules.push(seg);
+  }
+  return modules.length ? modules.join('::') : '(other)';
+}
+
+/** Shallow bytes per module (see `sizeGroup`), the 20 largest, from `twiggy top` of `wasm`. */
+function twiggyModules(wasm) {
+  const r = spawnSync('twiggy', ['top', '-n', '1000000', '-f', 'csv', wasm], { cwd: root, encoding: 'utf8', maxBuffer: 1 << 28 });
+  if (r.error || r.status !== 0) return '(twiggy failed)';
+  const groups = new Map();
+  let total = 0;
+  for (const line of r.stdout.split('\n').slice(1)) {
+    if (!line) continue;
+    const [name, bytes] = csvFields(line);
+    const n = Number(bytes);
+    if (!Number.isFinite(n)) continue;
+    total += n;
+    const g = sizeGroup(name);
+    groups.set(g, (groups.get(g) ?? 0) + n);
+  }
+  const rows = [...groups].sort((a, b) => b[1] - a[1]).slice(0, 20);
+  const width = Math.max(...rows.map(([g]) => g.length));
+  return rows.map(([g, n]) => `${g.padEnd(width)} ${String(n).padStart(8)} ${((100 * n) / total).toFixed(1).padStart(5)}%`).join('\n');
+}
+
 function main() {
   const args = parseArgs(process.argv.slice(2));
   const config = readConfig();
@@ -229,7 +288,7 @@ function main() {
         // The names survive into a copy for twiggy; the shipped module drops them.
         const named = join(config.packageDir, `${buildName}.names.wasm`);
         run(wasmOpt, [...optArgs, '--debuginfo', wasm, '-o', named]);
-        tops.push({ build: buildName, top: twiggyTop(named) });
+        tops.push({ build: buildName, top: twiggyTop(named), modules: twiggyModules(named) });
         rmSync(named, { force: true });
       }
       if (optimize) {
@@ -257,7 +316,10 @@ function main() {
   const lines = [`# Sizes of the npm package's wasm modules (wasm-opt ${optimize ? 'on' : 'off'})`, ''];
   lines.push('| build | target | file | bytes | gzip -9 | brotli |', '|---|---|---|---:|---:|---:|');
   for (const s of sizes) lines.push(`| ${s.build} | ${s.name} | ${s.path} | ${s.raw} (${kb(s.raw)}) | ${s.gzip} (${kb(s.gzip)}) | ${s.brotli} (${kb(s.brotli)}) |`);
-  for (const { build, top } of tops) lines.push('', `## ${build}: the 20 largest items (twiggy top, after wasm-opt)`, '', '```', top, '```');
+  for (const { build, top, modules } of tops) {
+    lines.push('', `## ${build}: the 20 largest items (twiggy top, after wasm-opt)`, '', '```', top, '```');
+    lines.push('', `## ${build}: bytes per module (crate, or this crate's module two levels down; before gzip)`, '', '```', modules, '```');
+  }
   const report = `${lines.join('\n')}\n`;
   writeFileSync(join(config.packageDir, 'SIZES.md'), report);
   console.log(`\npackage written to ${relative(root, config.packageDir)}/\n`);
