@@ -10,11 +10,15 @@ use crate::nurbs::{Aabb, Surface};
 /// Box of the trimmed geometry, from a 17×17 sample of each face's surface over
 /// its loops' parameter box (points inside the region) and the loops themselves.
 pub(crate) fn trimmed_bbox(model: &Model) -> Aabb {
-    let mut b = Aabb::EMPTY;
-    for f in face_boxes(model) {
-        b.union(&f);
-    }
-    b
+    union_of(&face_boxes(model))
+}
+
+/// The box holding every box of `boxes` (the model's, from its faces').
+pub(crate) fn union_of(boxes: &[Aabb]) -> Aabb {
+    boxes.iter().fold(Aabb::EMPTY, |mut b, f| {
+        b.union(f);
+        b
+    })
 }
 
 /// Each face's box as [`trimmed_bbox`] samples it, indexed like the mesh's

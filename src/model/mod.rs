@@ -19,7 +19,7 @@ pub(crate) use bodies::body_count;
 pub use bodies::share_of_faces;
 #[cfg(all(feature = "std", feature = "quality"))]
 pub(crate) use extent::LoopSample;
-pub(crate) use extent::{face_boxes, trimmed_bbox};
+pub(crate) use extent::{face_boxes, trimmed_bbox, union_of};
 
 /// Everything read from one input file.
 #[derive(Debug, Clone, Default)]

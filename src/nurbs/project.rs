@@ -429,14 +429,16 @@ impl SurfaceFacts {
     /// Whether the domain edge where coordinate `axis` equals `bound` (the
     /// domain's low or high end) is one point: three points along it agree.
     fn is_collapsed(&self, surface: &dyn Surface, axis: usize, bound: f64) -> bool {
+        // u (0) or v (anything else): one index for every table below.
+        let axis = usize::from(axis != 0);
         let [lo, hi] = surface.domain();
         let side = usize::from(bound != lo[axis]);
-        *self.collapsed[axis & 1][side].get_or_init(|| {
-            let along = 1 - (axis & 1);
+        *self.collapsed[axis][side].get_or_init(|| {
+            let along = 1 - axis;
             let size = hi - lo;
             let at = |f: f64| {
                 let mut q = DVec2::ZERO;
-                q[axis & 1] = bound;
+                q[axis] = bound;
                 q[along] = lo[along] + size[along] * f;
                 surface.point(q)
             };

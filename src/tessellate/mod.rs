@@ -39,7 +39,7 @@ mod variant;
 use alloc::vec::Vec;
 
 use crate::mesh::FaceRange;
-use crate::model::{body_count, face_boxes};
+use crate::model::{body_count, face_boxes, union_of};
 #[cfg(feature = "std")]
 use crate::nurbs::Surface;
 use crate::options::{MeshOptions, Reparam, Tolerance};
@@ -187,11 +187,7 @@ fn setup(model: &Model, options: &MeshOptions) -> Result<Setup, Error> {
         return Err(Error::Model { location: "model".into(), message: "has no faces".into() });
     }
     let boxes = face_boxes(model);
-    let diag = boxes.iter().fold(crate::nurbs::Aabb::EMPTY, |mut b, f| {
-        b.union(f);
-        b
-    });
-    let diag = diag.diagonal();
+    let diag = union_of(&boxes).diagonal();
     let tol = match options.tolerance {
         Tolerance::Absolute(t) => t,
         Tolerance::Relative(r) => r * diag,
