@@ -179,7 +179,9 @@ pub(crate) fn mend(loops: &mut Loops<'_>, file_ccw: &[bool]) -> Option<Mended> {
 /// `polys[0]`, islands in holes) run counter-clockwise, the others
 /// clockwise, and a loop beside the outer one keeps the file's direction
 /// (a second region, or a hole of nothing). A loop with any node inside the
-/// outer loop is nested in it (a hole that pokes out is still its hole);
+/// outer loop, farther than `g` from its border, is nested in it (a hole
+/// that pokes out is still its hole; a copy of a shared edge a rounding
+/// inside is on the border, so a region beside stays one);
 /// among the other loops, one is nested in another only if it lies wholly
 /// inside it, so holes that cross each other stay holes and are joined.
 fn nesting_signs(polys: &[Polyline], file_ccw: &[bool], g: f64) -> Vec<bool> {
@@ -202,7 +204,8 @@ fn nesting_signs(polys: &[Polyline], file_ccw: &[bool], g: f64) -> Vec<bool> {
             let depth = if k == 0 {
                 0
             } else {
-                let in_outer = polys[k].uv.iter().any(|&q| contains(&polys[0].uv, q));
+                let outer = &polys[0].uv;
+                let in_outer = polys[k].uv.iter().any(|&q| contains(outer, q) && !near_boundary(outer, q, g));
                 usize::from(in_outer) + (1..polys.len()).filter(|&j| j != k && within(k, j)).count()
             };
             let ccw = if k > 0 && depth == 0 { file_ccw.get(k).copied().unwrap_or(false) } else { depth % 2 == 0 };
@@ -630,6 +633,24 @@ mod tests {
         mend(&mut l, &[true, false, false]).expect("mended");
         let total: f64 = areas(&l).iter().sum();
         assert!((total - (100.0 - 17.0)).abs() < 1e-6, "{:?}", areas(&l));
+        on_curves(&l);
+    }
+
+    /// A region beside the outer loop sharing an edge whose copy bulges a
+    /// rounding into the outer loop: still beside it, so the two regions
+    /// are joined along the edge rather than the second taken for a hole.
+    #[test]
+    fn a_region_sharing_an_edge_a_rounding_inside_is_joined() {
+        let a = [(1.0, 0.0), (3.0, 0.0), (3.0, 1.0), (1.0, 1.0)];
+        let b = [(0.0, 0.0), (1.0, 0.0), (1.0 + 1e-14, 0.5), (1.0, 1.0), (0.0, 1.0)];
+        let mut curves = lines(&a);
+        curves.extend(lines(&b));
+        let mut l =
+            Loops { polys: alloc::vec![poly(&a, 0), poly(&b, 4)], curves: curves.iter().collect(), mended: None };
+        mend(&mut l, &[true, true]).expect("mended");
+        let ar = areas(&l);
+        assert_eq!(ar.len(), 1, "{ar:?}");
+        assert!((ar[0] - 3.0).abs() < 1e-6, "both regions: {ar:?}");
         on_curves(&l);
     }
 
