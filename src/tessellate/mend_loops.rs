@@ -541,6 +541,22 @@ mod tests {
 
     /// Every node of the mended loops on its curve, and every segment's
     /// ends where its curve has them.
+    /// Loops on the straight sides of `a` and of `b`, both kept open to
+    /// mending; `inspect` sees them mended, and their areas come back.
+    fn mend_pair(a: &[(f64, f64)], b: &[(f64, f64)], inspect: impl FnOnce(&Loops<'_>)) -> Vec<f64> {
+        let mut curves = lines(a);
+        curves.extend(lines(b));
+        let first_of_b = u32::try_from(a.len()).expect("a few corners");
+        let mut l = Loops {
+            polys: alloc::vec![poly(a, 0), poly(b, first_of_b)],
+            curves: curves.iter().collect(),
+            mended: None,
+        };
+        mend(&mut l, &[true, true]).expect("mended");
+        inspect(&l);
+        areas(&l)
+    }
+
     fn on_curves(l: &Loops<'_>) {
         for p in &l.polys {
             for (q, at) in p.uv.iter().zip(&p.at) {
@@ -643,15 +659,9 @@ mod tests {
     fn a_region_sharing_an_edge_a_rounding_inside_is_joined() {
         let a = [(1.0, 0.0), (3.0, 0.0), (3.0, 1.0), (1.0, 1.0)];
         let b = [(0.0, 0.0), (1.0, 0.0), (1.0 + 1e-14, 0.5), (1.0, 1.0), (0.0, 1.0)];
-        let mut curves = lines(&a);
-        curves.extend(lines(&b));
-        let mut l =
-            Loops { polys: alloc::vec![poly(&a, 0), poly(&b, 4)], curves: curves.iter().collect(), mended: None };
-        mend(&mut l, &[true, true]).expect("mended");
-        let ar = areas(&l);
+        let ar = mend_pair(&a, &b, on_curves);
         assert_eq!(ar.len(), 1, "{ar:?}");
         assert!((ar[0] - 3.0).abs() < 1e-6, "both regions: {ar:?}");
-        on_curves(&l);
     }
 
     /// Nodes a rounding apart and two loops touching at a corner: the
@@ -660,12 +670,7 @@ mod tests {
     fn squares_touching_at_a_corner_stay_two_loops() {
         let a = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
         let b = [(1.0, 1.0 + 1e-15), (2.0, 1.0), (2.0, 2.0), (1.0, 2.0)];
-        let mut curves = lines(&a);
-        curves.extend(lines(&b));
-        let mut l =
-            Loops { polys: alloc::vec![poly(&a, 0), poly(&b, 4)], curves: curves.iter().collect(), mended: None };
-        mend(&mut l, &[true, true]).expect("mended");
-        let ar = areas(&l);
+        let ar = mend_pair(&a, &b, |_| ());
         assert_eq!(ar.len(), 2, "{ar:?}");
         assert!(ar.iter().all(|&x| (x - 1.0).abs() < 1e-6), "{ar:?}");
     }
