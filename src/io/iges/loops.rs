@@ -318,7 +318,7 @@ fn rectangle_face(def: &SurfDef, lp: &[Track]) -> Result<Option<Face>, TrimError
         let (mut lo, mut hi) = (lo, hi);
         for k in 0..2 {
             let tiny = 1e-9 * (dhi[k] - dlo[k]);
-            let knots = if k == 0 { n.knots_u() } else { n.knots_v() }.breakpoints();
+            let knots = n.breaks(k == 0);
             lo[k] = snap_to_knot(&knots, None, lo[k], tiny);
             hi[k] = snap_to_knot(&knots, None, hi[k], tiny);
             if lo[k] > dlo[k] + tiny {
@@ -361,7 +361,7 @@ fn snap_to_knot(knots: &[f64], period: Option<f64>, t: f64, tiny: f64) -> f64 {
 /// (an offset's base's), empty for any other.
 fn knot_lines(s: &FaceSurface, k: usize) -> Vec<f64> {
     match s {
-        FaceSurface::Nurbs(n) | FaceSurface::Rebuilt(n) => if k == 0 { n.knots_u() } else { n.knots_v() }.breakpoints(),
+        FaceSurface::Nurbs(n) | FaceSurface::Rebuilt(n) => n.breaks(k == 0),
         FaceSurface::Offset { base, .. } => knot_lines(base, k),
     }
 }
