@@ -8,6 +8,21 @@ pub(crate) type HashMap<K, V> = hashbrown::HashMap<K, V, foldhash::fast::FixedSt
 /// [`hashbrown::HashSet`] with a fixed seed.
 pub(crate) type HashSet<K> = hashbrown::HashSet<K, foldhash::fast::FixedState>;
 
+/// `f`, each value kept by its argument's bits: a parameter asked for again
+/// (an interval's end its neighbour shares, a part of a split interval) is
+/// not evaluated again, and gives the same bits as the first time.
+pub(crate) fn memo_by_bits<T: Copy>(f: impl Fn(f64) -> T) -> impl Fn(f64) -> T {
+    let seen: core::cell::RefCell<HashMap<u64, T>> = core::cell::RefCell::new(HashMap::default());
+    move |t| {
+        if let Some(&x) = seen.borrow().get(&t.to_bits()) {
+            return x;
+        }
+        let x = f(t);
+        seen.borrow_mut().insert(t.to_bits(), x);
+        x
+    }
+}
+
 /// Items hashed by position on a uniform grid of cubes, for "what lies near
 /// this point" queries (welding, crack counting, sewing). Each cube holds
 /// its first and last item and each item the next of its cube: a list per

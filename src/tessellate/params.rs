@@ -12,11 +12,10 @@
 //! equalization (§3.1.2) for free.
 
 use alloc::vec::Vec;
-use core::cell::RefCell;
 use glam::{DVec2, DVec3};
 
 use super::refine::FOLD_TURN;
-use crate::collections::HashMap;
+use crate::collections::memo_by_bits;
 use crate::math::{ceil, sqrt};
 use crate::nurbs::Surface;
 
@@ -510,16 +509,10 @@ fn iso_curves<'s>(
 ) -> Vec<(f64, impl Fn(f64) -> (DVec3, DVec3) + 's)> {
     let (s0, s1) = if along_u { (lo.y, hi.y) } else { (lo.x, hi.x) };
     let make = move |s: f64| {
-        let seen: RefCell<HashMap<u64, (DVec3, DVec3)>> = RefCell::new(HashMap::default());
-        move |t: f64| {
-            if let Some(&x) = seen.borrow().get(&t.to_bits()) {
-                return x;
-            }
+        memo_by_bits(move |t: f64| {
             let uv = if along_u { DVec2::new(t, s) } else { DVec2::new(s, t) };
-            let x = surface.point_normal(uv);
-            seen.borrow_mut().insert(t.to_bits(), x);
-            x
-        }
+            surface.point_normal(uv)
+        })
     };
     (0..=lines).map(|k| s0 + (s1 - s0) * k as f64 / lines as f64).map(|s| (s, make(s))).collect()
 }

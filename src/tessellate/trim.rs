@@ -1,11 +1,10 @@
 //! Trim loops: discretization by the chord test, outer/hole classification,
 //! crossing checks and inside tests (paper 000 §3.2).
 
-use crate::collections::HashMap;
+use crate::collections::memo_by_bits;
 use crate::numeric::TINY;
 use alloc::format;
 use alloc::vec::Vec;
-use core::cell::RefCell;
 use glam::{DVec2, DVec3};
 
 use super::mend_loops::Mended;
@@ -245,19 +244,13 @@ fn discretize_loop<'a>(
 /// normal and tangent are evaluated once and kept (by the parameter's bits)
 /// while the curve is discretized.
 fn curve_parameters(c: &crate::NurbsCurve, surface: &dyn Surface, lim: &Limits) -> Vec<f64> {
-    let seen: RefCell<HashMap<u64, (DVec3, DVec3, DVec3)>> = RefCell::new(HashMap::default());
-    let on_surface = |t: f64| {
-        if let Some(&x) = seen.borrow().get(&t.to_bits()) {
-            return x;
-        }
+    let on_surface = memo_by_bits(|t: f64| {
         let d = c.derivs(t);
         let uv = d.point.truncate();
         let s = surface.derivs(uv);
         let tangent = s.su * d.d1.x + s.sv * d.d1.y;
-        let x = (s.point, surface.normal_from_tangents(uv, s.su, s.sv), tangent);
-        seen.borrow_mut().insert(t.to_bits(), x);
-        x
-    };
+        (s.point, surface.normal_from_tangents(uv, s.su, s.sv), tangent)
+    });
     let by_normal = |t: f64| {
         let (p, n, _) = on_surface(t);
         (p, n)
