@@ -383,6 +383,29 @@ function wasmMemory(run) {
   return run?.heap_bytes ? fmb(run.heap_bytes / 1024) : '–';
 }
 
+/** Reading speed of the CAD files in wasm: bytes over the reader's median time (each file once, at its first tolerance). */
+function readingSpeed(rows) {
+  const seen = new Set();
+  const lines = [];
+  for (const r of rows) {
+    const ms = median(r.surfmesh_wasm?.run?.parse_ms ?? []);
+    if (r.kind === 'json' || !r.bytes || !ms || seen.has(r.file)) continue;
+    seen.add(r.file);
+    lines.push(`| ${r.file} | ${(r.bytes / 1e6).toFixed(2)} | ${fms(ms)} | ${(r.bytes / 1e3 / ms).toFixed(1)} |`);
+  }
+  if (!lines.length) return [];
+  return [
+    '',
+    '## Reading speed (surfmesh wasm)',
+    '',
+    "The reader's whole time: parsing the text and building every face with its trim loops (edges without pcurves are inverted onto their surfaces, which takes most of it). `cargo bench --bench readers` times the STEP text parsing alone, natively.",
+    '',
+    '| file | MB | read ms | MB/s |',
+    '|---|---:|---:|---:|',
+    ...lines,
+  ];
+}
+
 function markdown(rows, meta) {
   const out = [];
   out.push(`# surfmesh side-by-side benchmark`);
@@ -407,6 +430,7 @@ function markdown(rows, meta) {
       out.push(`| ${peer.label} | ${rel} | ${cs.length} | ${f3(gt)} (${verdict(gt)}) | ${f3(gtime)} (${verdict(gtime)}) | ${f3(gm)} (${verdict(gm)}) | ${n('ahead')} / ${n('even')} / ${n('behind')} |`);
     }
   }
+  out.push(...readingSpeed(rows));
   out.push('');
   out.push('## Edges per file (the yardstick\'s counts; OCCT at surfmesh\'s deflection)');
   out.push('');
@@ -505,6 +529,7 @@ try {
         continue;
       }
       const row = benchOne(input, rel, info);
+      row.bytes = statSync(input.path).size;
       rows.push(row);
       if (row.surfmesh_wasm?.run?.error) failed = `${row.surfmesh_wasm.run.error} (at ${rel}; not tried finer)`;
     }

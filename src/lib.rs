@@ -52,6 +52,9 @@ pub use fit::{
     TriPatch, MAX_FILE_POINTS,
 };
 pub use instances::{flatten, mesh_instanced, InstancedResult, PartMesh};
+/// The STEP reader's text parsing alone, for the readers' bench; not a stable API.
+#[doc(hidden)]
+pub use io::count_step_instances;
 pub use io::{
     read_iges, read_json, read_model, read_step, read_step_parts, read_step_with_shells, Format, StepModel, StepShell,
 };

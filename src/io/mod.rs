@@ -39,7 +39,7 @@ pub use meshfile::{read_mesh, MeshFormat};
 pub use msh::{read_msh, write_msh};
 #[cfg(feature = "writers")]
 pub use obj::write_obj;
-pub use step::{read_step, read_step_parts, read_step_with_shells, StepModel, StepShell};
+pub use step::{count_step_instances, read_step, read_step_parts, read_step_with_shells, StepModel, StepShell};
 #[cfg(feature = "writers")]
 pub use stl::write_stl;
 #[cfg(feature = "writers")]
