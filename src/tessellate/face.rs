@@ -676,6 +676,26 @@ mod tests {
         FaceSurface::Rebuilt(NurbsSurface::try_new([3, 3], ku, kv, &pts, None).unwrap())
     }
 
+    /// Samples kept by one grid serve the next with other limits (a
+    /// rebuild's trials differ in the edge limit and the tolerance share):
+    /// each grid is the one fresh samples give, and a second grid of the
+    /// same limits evaluates nothing new.
+    #[test]
+    fn kept_samples_give_the_grids_fresh_ones_give() {
+        let s = wavy();
+        let [lo, hi] = s.domain();
+        let kept = Samples::default();
+        let lim = |tol: f64, max_edge: f64| Limits { tol, angle: 0.5, max_edge, min_edge: 1e-6 };
+        for l in [lim(1e-3, f64::INFINITY), lim(1e-3, 0.7), lim(8e-4, 0.3), lim(1e-2, f64::INFINITY)] {
+            let fresh = grid((&s, &Samples::default()), lo, hi, &l, None, usize::MAX);
+            assert_eq!(grid((&s, &kept), lo, hi, &l, None, usize::MAX), fresh, "{l:?}");
+            let n = kept.len();
+            assert!(n > 0);
+            assert_eq!(grid((&s, &kept), lo, hi, &l, None, usize::MAX), fresh, "{l:?} again");
+            assert_eq!(kept.len(), n, "{l:?}: evaluated again");
+        }
+    }
+
     /// A trial's cell limit (see [`grid`]): a grid within it is the grid
     /// without one, line for line; one far over it is cut short, still
     /// with more cells than the limit, so the caller's budget refuses it.

@@ -45,6 +45,12 @@ impl Samples {
         }
         x
     }
+
+    /// How many values are kept.
+    #[cfg(test)]
+    pub(crate) fn len(&self) -> usize {
+        self.0.borrow().len()
+    }
 }
 
 /// Limits one interval must satisfy.
