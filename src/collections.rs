@@ -10,7 +10,9 @@ pub(crate) type HashSet<K> = hashbrown::HashSet<K, foldhash::fast::FixedState>;
 
 /// `f`, each value kept by its argument's bits: a parameter asked for again
 /// (an interval's end its neighbour shares, a part of a split interval) is
-/// not evaluated again, and gives the same bits as the first time.
+/// not evaluated again, and gives the same bits as the first time. Trim
+/// curves use it, so only the trimmed mesher (`std`) does.
+#[cfg(feature = "std")]
 pub(crate) fn memo_by_bits<T: Copy>(f: impl Fn(f64) -> T) -> impl Fn(f64) -> T {
     let seen: core::cell::RefCell<HashMap<u64, T>> = core::cell::RefCell::new(HashMap::default());
     move |t| {

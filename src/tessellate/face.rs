@@ -6,7 +6,7 @@ use alloc::format;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
-use super::params::{even_demand, grid_params, Limits, Region, MAX_PARAMS};
+use super::params::{even_demand, grid_params, Limits, Region, Samples, MAX_PARAMS};
 use super::refine::{Criteria, Outcome, WorkMesh};
 use crate::model::Face;
 use crate::nurbs::Surface;
@@ -38,13 +38,14 @@ pub(crate) struct Outline<'a>(core::marker::PhantomData<&'a ()>);
 /// share of lines stops there. A grid that is not cut short is the one
 /// without `cells`.
 pub(super) fn grid(
-    surface: &dyn Surface,
+    (surface, samples): (&dyn Surface, &Samples),
     lo: DVec2,
     hi: DVec2,
     lim: &Limits,
     loops: Option<&TrimRegion<'_>>,
     cells: usize,
 ) -> (Vec<f64>, Vec<f64>) {
+    let kept = (surface, samples);
     #[cfg(feature = "std")]
     let pieces = |along_u: bool, s: f64| loops.map_or_else(Vec::new, |l| l.line_pieces(along_u, s));
     #[cfg(feature = "std")]
@@ -56,7 +57,7 @@ pub(super) fn grid(
     // (at most √2 of the lines, with twice the tolerance) cannot bring the grid back.
     let over = cells.saturating_mul(2);
     let limited = over < MAX_PARAMS;
-    let even = |along_u: bool| if limited { even_demand(surface, lo, hi, along_u, &half, region) } else { None };
+    let even = |along_u: bool| if limited { even_demand(kept, lo, hi, along_u, &half, region) } else { None };
     let (du, dv) = (even(true), even(false));
     if let (Some(du), Some(dv)) = (&du, &dv) {
         let n = |d: &[f64]| crate::math::ceil(d.iter().sum::<f64>());
@@ -73,23 +74,23 @@ pub(super) fn grid(
     let cap = |other: usize| if limited { over / other.saturating_sub(1).max(1) + 2 } else { MAX_PARAMS };
     let capped = |p: &[f64], c: usize| limited && p.len() >= c;
     let ends_v = alloc::vec![lo.y, hi.y];
-    let (mut pu, mut su) = grid_params(surface, lo, hi, true, &half, region, cap(2), du);
+    let (mut pu, mut su) = grid_params(kept, lo, hi, true, &half, region, cap(2), du);
     if capped(&pu, cap(2)) {
         return (pu, ends_v);
     }
-    let (mut pv, mut sv) = grid_params(surface, lo, hi, false, &half, region, cap(pu.len()), dv);
+    let (mut pv, mut sv) = grid_params(kept, lo, hi, false, &half, region, cap(pu.len()), dv);
     if capped(&pv, cap(pu.len())) {
         return (pu, pv);
     }
     if sv < 0.5 * half.tol && su > sv {
         let rest = Limits { tol: (lim.tol - sv).max(half.tol), ..*lim };
-        (pu, su) = grid_params(surface, lo, hi, true, &rest, region, cap(pv.len()), None);
+        (pu, su) = grid_params(kept, lo, hi, true, &rest, region, cap(pv.len()), None);
         if capped(&pu, cap(pv.len())) {
             return (pu, pv);
         }
     } else if su < 0.5 * half.tol && sv > su {
         let rest = Limits { tol: (lim.tol - su).max(half.tol), ..*lim };
-        (pv, sv) = grid_params(surface, lo, hi, false, &rest, region, cap(pu.len()), None);
+        (pv, sv) = grid_params(kept, lo, hi, false, &rest, region, cap(pu.len()), None);
         if capped(&pv, cap(pu.len())) {
             return (pu, pv);
         }
@@ -188,15 +189,16 @@ fn split_by(p: &[f64], need: &[usize]) -> Vec<f64> {
 /// Meshes face `index` (its `loops`: its own, or [`domain_loops`]' when it
 /// has none) on its own within `crit`, using at most `budget` triangles,
 /// as `mesh_model` meshes it in a model (its seams within `tight`), so the
-/// two can be compared.
+/// two can be compared. `samples`: the face surface's grid samples, shared
+/// by its trials.
 pub(crate) fn mesh_face<'a>(
     index: usize,
-    face: &'a Face,
-    loops: &'a [crate::TrimLoop],
+    (face, loops): (&'a Face, &'a [crate::TrimLoop]),
     lim: &Limits,
     crit: &Criteria,
     budget: usize,
     tight: f64,
+    samples: &Samples,
 ) -> Result<FaceResult<'a>, Error> {
     #[cfg(feature = "std")]
     {
@@ -204,7 +206,7 @@ pub(crate) fn mesh_face<'a>(
         // not be placed line by line (a trial on a capped rebuild can ask
         // for millions).
         let cells = budget.saturating_mul(2).min(MAX_BAND_CELLS).max(budget / 2);
-        let mut o = outline(index, &face.surface, loops, face.loops.is_empty(), lim, cells)?;
+        let mut o = outline(index, (&face.surface, samples), loops, face.loops.is_empty(), lim, cells)?;
         // A grid [`initial_from_outline`] refuses anyway is refused before
         // sewing its many border nodes (a rebuild's trial on a folded face).
         check_band_cells(index, &o, budget)?;
@@ -236,7 +238,7 @@ pub(crate) fn mesh_face<'a>(
     }
     #[cfg(not(feature = "std"))]
     {
-        let _ = (tight, loops);
+        let _ = (tight, loops, samples);
         let (mut wm, curves) = initial_face(index, face, lim, budget)?;
         let outcome = wm.refine(&face.surface, &curves, crit, budget);
         Ok(FaceResult { mesh: wm, outcome, outline: None })
@@ -258,7 +260,7 @@ pub(crate) fn initial_face<'a>(
     if face.loops.is_empty() {
         curves = Vec::new();
         let [lo, hi] = surface.domain();
-        let (pu, pv) = grid(surface, lo, hi, lim, None, usize::MAX);
+        let (pu, pv) = grid((surface, &Samples::default()), lo, hi, lim, None, usize::MAX);
         check_grid(index, &pu, &pv, budget)?;
         build_full_grid(surface, &pu, &pv, &mut wm);
     } else {
@@ -294,14 +296,14 @@ pub(crate) struct Outline<'a> {
 #[cfg(feature = "std")]
 pub(crate) fn outline<'a>(
     index: usize,
-    surface: &dyn Surface,
+    (surface, samples): (&dyn Surface, &Samples),
     loops: &'a [crate::TrimLoop],
     whole: bool,
     lim: &Limits,
     cells: usize,
 ) -> Result<Outline<'a>, Error> {
     if whole {
-        if let Some(o) = domain_outline(surface, loops, lim, cells) {
+        if let Some(o) = domain_outline((surface, samples), loops, lim, cells) {
             return Ok(o);
         }
     }
@@ -316,7 +318,7 @@ pub(crate) fn outline<'a>(
             message: "trim loops lie outside the surface's parameter domain".into(),
         });
     }
-    let (pu, pv) = grid(surface, lo, hi, lim, Some(&loops), cells);
+    let (pu, pv) = grid((surface, samples), lo, hi, lim, Some(&loops), cells);
     align_to_grid(surface, &mut loops, &pu, &pv, whole);
     let gids = loops.polys.iter().map(|p| alloc::vec![u32::MAX; p.uv.len()]).collect();
     Ok(Outline { loops, pu, pv, gids })
@@ -328,7 +330,7 @@ pub(crate) fn outline<'a>(
 /// their own). `None` when `loops` is not such a loop.
 #[cfg(feature = "std")]
 fn domain_outline<'a>(
-    surface: &dyn Surface,
+    (surface, samples): (&dyn Surface, &Samples),
     loops: &'a [crate::TrimLoop],
     lim: &Limits,
     cells: usize,
@@ -336,7 +338,7 @@ fn domain_outline<'a>(
     use super::trim::{CurveRef, Loops, Polyline};
     let [lp] = loops else { return None };
     let [lo, hi] = surface.domain();
-    let (pu, pv) = grid(surface, lo, hi, lim, None, cells);
+    let (pu, pv) = grid((surface, samples), lo, hi, lim, None, cells);
     // Border nodes as the loop runs.
     let uv = rect_border(lo, hi, &pu, &pv);
     // Each node on the loop's straight pieces: curve and parameter.
@@ -674,6 +676,26 @@ mod tests {
         FaceSurface::Rebuilt(NurbsSurface::try_new([3, 3], ku, kv, &pts, None).unwrap())
     }
 
+    /// Samples kept by one grid serve the next with other limits (a
+    /// rebuild's trials differ in the edge limit and the tolerance share):
+    /// each grid is the one fresh samples give, and a second grid of the
+    /// same limits evaluates nothing new.
+    #[test]
+    fn kept_samples_give_the_grids_fresh_ones_give() {
+        let s = wavy();
+        let [lo, hi] = s.domain();
+        let kept = Samples::default();
+        let lim = |tol: f64, max_edge: f64| Limits { tol, angle: 0.5, max_edge, min_edge: 1e-6 };
+        for l in [lim(1e-3, f64::INFINITY), lim(1e-3, 0.7), lim(8e-4, 0.3), lim(1e-2, f64::INFINITY)] {
+            let fresh = grid((&s, &Samples::default()), lo, hi, &l, None, usize::MAX);
+            assert_eq!(grid((&s, &kept), lo, hi, &l, None, usize::MAX), fresh, "{l:?}");
+            let n = kept.len();
+            assert!(n > 0);
+            assert_eq!(grid((&s, &kept), lo, hi, &l, None, usize::MAX), fresh, "{l:?} again");
+            assert_eq!(kept.len(), n, "{l:?}: evaluated again");
+        }
+    }
+
     /// A trial's cell limit (see [`grid`]): a grid within it is the grid
     /// without one, line for line; one far over it is cut short, still
     /// with more cells than the limit, so the caller's budget refuses it.
@@ -682,12 +704,13 @@ mod tests {
         let s = wavy();
         let [lo, hi] = s.domain();
         let lim = Limits { tol: 1e-3, angle: 0.5, max_edge: f64::INFINITY, min_edge: 1e-6 };
-        let (pu, pv) = grid(&s, lo, hi, &lim, None, usize::MAX);
+        let fresh = || Samples::default();
+        let (pu, pv) = grid((&s, &fresh()), lo, hi, &lim, None, usize::MAX);
         let cells = (pu.len() - 1) * (pv.len() - 1);
         assert!(cells > 400, "{} x {}", pu.len(), pv.len());
-        assert_eq!(grid(&s, lo, hi, &lim, None, cells), (pu.clone(), pv.clone()));
+        assert_eq!(grid((&s, &fresh()), lo, hi, &lim, None, cells), (pu.clone(), pv.clone()));
         for limit in [cells / 3, cells / 20, 1] {
-            let (a, b) = grid(&s, lo, hi, &lim, None, limit);
+            let (a, b) = grid((&s, &fresh()), lo, hi, &lim, None, limit);
             assert!((a.len() - 1) * (b.len() - 1) > limit, "{limit}: {} x {}", a.len(), b.len());
             assert!((&a, &b) != (&pu, &pv), "{limit}: not cut short");
         }

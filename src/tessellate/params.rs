@@ -15,9 +15,43 @@ use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
 use super::refine::FOLD_TURN;
-use crate::collections::memo_by_bits;
+use crate::collections::HashMap;
 use crate::math::{ceil, sqrt};
 use crate::nurbs::Surface;
+
+/// One surface's points and normals as the grid's iso-curve tests evaluate
+/// them, kept by the parameters' bits: the two passes of one grid, and the
+/// trials of one face with other edge limits (`auto`'s rebuild trials),
+/// test the same fine intervals of the same lines, and a value asked for
+/// again gives the same bits without the evaluation. Kept for one surface
+/// only; past [`Samples::MOST`] values new ones are evaluated, not kept.
+#[derive(Default)]
+pub(crate) struct Samples(core::cell::RefCell<HashMap<[u64; 2], (DVec3, DVec3)>>);
+
+impl Samples {
+    /// Most values kept (about 70 bytes each).
+    const MOST: usize = 1 << 20;
+
+    /// `surface`'s point and unit normal at `uv`, evaluated once.
+    fn point_normal(&self, surface: &dyn Surface, uv: DVec2) -> (DVec3, DVec3) {
+        let key = [uv.x.to_bits(), uv.y.to_bits()];
+        if let Some(&x) = self.0.borrow().get(&key) {
+            return x;
+        }
+        let x = surface.point_normal(uv);
+        let mut kept = self.0.borrow_mut();
+        if kept.len() < Self::MOST {
+            kept.insert(key, x);
+        }
+        x
+    }
+
+    /// How many values are kept.
+    #[cfg(test)]
+    pub(crate) fn len(&self) -> usize {
+        self.0.borrow().len()
+    }
+}
 
 /// Limits one interval must satisfy.
 #[derive(Debug, Clone, Copy)]
@@ -501,7 +535,7 @@ fn fine_demand(probes: &[Probe<'_>], xs: &[f64], lim: &Limits) -> Vec<f64> {
 /// split in turn.
 #[allow(clippy::type_complexity)]
 fn iso_curves<'s>(
-    surface: &'s dyn Surface,
+    (surface, samples): (&'s dyn Surface, &'s Samples),
     lo: DVec2,
     hi: DVec2,
     along_u: bool,
@@ -509,10 +543,10 @@ fn iso_curves<'s>(
 ) -> Vec<(f64, impl Fn(f64) -> (DVec3, DVec3) + 's)> {
     let (s0, s1) = if along_u { (lo.y, hi.y) } else { (lo.x, hi.x) };
     let make = move |s: f64| {
-        memo_by_bits(move |t: f64| {
+        move |t: f64| {
             let uv = if along_u { DVec2::new(t, s) } else { DVec2::new(s, t) };
-            surface.point_normal(uv)
-        })
+            samples.point_normal(surface, uv)
+        }
     };
     (0..=lines).map(|k| s0 + (s1 - s0) * k as f64 / lines as f64).map(|s| (s, make(s))).collect()
 }
@@ -521,7 +555,7 @@ fn iso_curves<'s>(
 /// iso-curves at every quarter of the rectangle, or every eighth on a
 /// trimmed face, each limited to where it runs inside `region`.
 fn with_probes<R>(
-    surface: &dyn Surface,
+    surface: (&dyn Surface, &Samples),
     lo: DVec2,
     hi: DVec2,
     along_u: bool,
@@ -541,7 +575,7 @@ fn with_probes<R>(
 /// sum is about the lines that direction takes, known before any is placed.
 /// `None` for other surfaces.
 pub(crate) fn even_demand(
-    surface: &dyn Surface,
+    surface: (&dyn Surface, &Samples),
     lo: DVec2,
     hi: DVec2,
     along_u: bool,
@@ -549,7 +583,7 @@ pub(crate) fn even_demand(
     region: Option<Region<'_>>,
 ) -> Option<Vec<f64>> {
     let (t0, t1) = if along_u { (lo.x, hi.x) } else { (lo.y, hi.y) };
-    if !(surface.even_parameters() && t1 > t0) {
+    if !(surface.0.even_parameters() && t1 > t0) {
         return None;
     }
     Some(with_probes(surface, lo, hi, along_u, region, |probes| fine_demand(probes, &fine_params(t0, t1), lim)))
@@ -604,7 +638,7 @@ pub(crate) type Region<'r> = &'r dyn Fn(bool, f64) -> Vec<(f64, f64)>;
 /// [`even_demand`]'s for these limits when the caller measured it.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn grid_params(
-    surface: &dyn Surface,
+    (surface, samples): (&dyn Surface, &Samples),
     lo: DVec2,
     hi: DVec2,
     along_u: bool,
@@ -615,7 +649,7 @@ pub(crate) fn grid_params(
 ) -> (Vec<f64>, f64) {
     let cap = cap.min(MAX_PARAMS);
     let (t0, t1) = if along_u { (lo.x, hi.x) } else { (lo.y, hi.y) };
-    with_probes(surface, lo, hi, along_u, region, |probes| {
+    with_probes((surface, samples), lo, hi, along_u, region, |probes| {
         if surface.even_parameters() && t1 > t0 {
             return equidistribute(probes, t0, t1, lim, cap, demand);
         }

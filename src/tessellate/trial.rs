@@ -32,7 +32,7 @@ pub(super) const SHORTER_TRIES: usize = 6;
 /// at the shortest edge) is not tried: more triangles cannot win it back.
 pub(super) fn shorter_edges<'x>(
     index: usize,
-    (face, loops): (&'x crate::Face, &'x [crate::TrimLoop]),
+    (face, loops, samples): (&'x crate::Face, &'x [crate::TrimLoop], &params::Samples),
     rebuilt: &Result<face::FaceResult<'_>, Error>,
     original: &Result<face::FaceResult<'_>, Error>,
     (lim, crit, first, tries): (&params::Limits, &refine::Criteria, f64, usize),
@@ -58,7 +58,7 @@ pub(super) fn shorter_edges<'x>(
         }
         let l = params::Limits { max_edge: lim.max_edge.min(edge), ..*lim };
         let c = refine::Criteria { max_edge: crit.max_edge.min(edge), ..*crit };
-        let mut r = face::mesh_face(index, face, loops, &l, &c, budget, tight);
+        let mut r = face::mesh_face(index, (face, loops), &l, &c, budget, tight, samples);
         match &r {
             Ok(m) if !m.mesh.tris.is_empty() && m.mesh.tris.len() <= old.mesh.tris.len() => {}
             _ => return None,
@@ -80,7 +80,7 @@ pub(super) fn shorter_edges<'x>(
 /// shape alone is lifted.
 pub(super) fn lift_needles<'x>(
     index: usize,
-    (face, loops): (&'x crate::Face, &'x [crate::TrimLoop]),
+    (face, loops, samples): (&'x crate::Face, &'x [crate::TrimLoop], &params::Samples),
     (rebuilt, lim, crit): &(Result<face::FaceResult<'_>, Error>, params::Limits, refine::Criteria),
     original: &Result<face::FaceResult<'_>, Error>,
     budget: usize,
@@ -93,7 +93,7 @@ pub(super) fn lift_needles<'x>(
     }
     let goal = (p1(&old.mesh) + 1.0).to_radians();
     let c = refine::Criteria { lift: refine::Lift { goal, most }, ..*crit };
-    let mut r = face::mesh_face(index, face, loops, lim, &c, budget, tight);
+    let mut r = face::mesh_face(index, (face, loops), lim, &c, budget, tight, samples);
     rebuild_loses(&r, original).is_none().then(|| (c, outline_of(&mut r)))
 }
 

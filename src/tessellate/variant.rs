@@ -6,6 +6,7 @@ use alloc::vec::Vec;
 
 #[cfg(feature = "std")]
 use super::mend_loops;
+use super::params::Samples;
 use super::pipeline::Plan;
 use super::trial::{lift_needles, outline_of, rebuild_loses, shorter_edges, tris_of, SHORTER_TRIES};
 use super::{face, face_loops, params, refine};
@@ -45,11 +46,11 @@ struct Variant<'a> {
 
 impl<'a> Chosen<'a> {
     /// `loops`: the face's own, or its domain's border when it has none;
-    /// `ready`: its outline for `lim` when a trial already made it.
+    /// `ready`: its outline for `lim` when a trial already made it, else
+    /// made with the grid samples its trials kept.
     fn new(
         index: usize,
-        face: &'a Face,
-        loops: &'a [crate::TrimLoop],
+        (face, loops, samples): (&'a Face, &'a [crate::TrimLoop], &params::Samples),
         (lim, crit): (params::Limits, refine::Criteria),
         fit_error: f64,
         ready: Option<face::Outline<'a>>,
@@ -57,10 +58,10 @@ impl<'a> Chosen<'a> {
         #[cfg(feature = "std")]
         let outline = match ready {
             Some(o) => o,
-            None => face::outline(index, &face.surface, loops, face.loops.is_empty(), &lim, usize::MAX)?,
+            None => face::outline(index, (&face.surface, samples), loops, face.loops.is_empty(), &lim, usize::MAX)?,
         };
         #[cfg(not(feature = "std"))]
-        let _ = (index, loops, ready);
+        let _ = (index, loops, ready, samples);
         Ok(Self {
             face,
             #[cfg(feature = "std")]
@@ -170,14 +171,19 @@ impl<'m> Plan<'m> {
             return Ok(None);
         }
         let mut made: Made<'p> = Vec::new();
+        // Grid samples of the original's surface and of the rebuild's, each
+        // shared by its trials.
+        let samples = Samples::default();
+        let rebuild_samples = Samples::default();
         if v.fit_error > 0.0 {
             let cap = self.rebuilt.get(index).and_then(Option::as_ref).map_or(f64::INFINITY, |r| r.max_edge);
-            self.judge_rebuild(index, cap, &mut v, &mut made, report);
+            self.judge_rebuild(index, (cap, [&samples, &rebuild_samples]), &mut v, &mut made, report);
         }
         let loops = self.loops_of(index, v.face);
         let ready =
             made.into_iter().find(|(g, l, _)| core::ptr::eq(*g, v.face) && l.same_as(&v.lim)).map(|(_, _, o)| o);
-        let c = Chosen::new(index, v.face, loops, (v.lim, v.crit), v.fit_error, ready)?;
+        let kept = if core::ptr::eq(v.face, original) { &samples } else { &rebuild_samples };
+        let c = Chosen::new(index, (v.face, loops, kept), (v.lim, v.crit), v.fit_error, ready)?;
         if let Some(m) = c.mended() {
             report.warnings.push(Warning::face(index, WarningKind::LoopsMended(m)));
         }
@@ -203,7 +209,7 @@ impl<'m> Plan<'m> {
     fn judge_rebuild<'p>(
         &'p self,
         index: usize,
-        cap: f64,
+        (cap, [orig_samples, samples]): (f64, [&Samples; 2]),
         v: &mut Variant<'p>,
         made: &mut Made<'p>,
         report: &mut Report,
@@ -213,14 +219,15 @@ impl<'m> Plan<'m> {
         let budget = self.options.max_triangles;
         let auto = self.options.reparam == Reparam::Auto;
         let orig_loops = self.loops_of(index, original);
-        let mesh_original = || face::mesh_face(index, original, orig_loops, &self.lim, &self.crit, budget, tight);
+        let mesh_original =
+            || face::mesh_face(index, (original, orig_loops), &self.lim, &self.crit, budget, tight, orig_samples);
         let mut orig = auto.then(mesh_original);
         let trial = match &orig {
             Some(Ok(o)) => budget.min(o.mesh.tris.len().saturating_add(1)),
             _ => budget,
         };
         let f_loops = self.loops_of(index, f);
-        let mut fr = face::mesh_face(index, f, f_loops, &v.lim, &v.crit, trial, tight);
+        let mut fr = face::mesh_face(index, (f, f_loops), &v.lim, &v.crit, trial, tight, samples);
         let failed = !matches!(&fr, Ok(r) if !r.mesh.tris.is_empty());
         if !(failed || auto) {
             made.extend(outline_of(&mut fr).map(|o| (f, v.lim, o)));
@@ -231,7 +238,7 @@ impl<'m> Plan<'m> {
         made.extend(outline_of(&mut fr).map(|o| (f, v.lim, o)));
         if why.is_some() && auto {
             let capped = (fr, v.lim, v.crit);
-            if let Some((l, c)) = self.rescue(index, (f, f_loops), &capped, &orig, (cap, trial), made) {
+            if let Some((l, c)) = self.rescue(index, (f, f_loops, samples), &capped, &orig, (cap, trial), made) {
                 (why, v.lim, v.crit) = (None, l, c);
             }
         }
@@ -254,7 +261,7 @@ impl<'m> Plan<'m> {
     fn rescue<'p>(
         &'p self,
         index: usize,
-        (f, f_loops): (&'p Face, &'p [crate::TrimLoop]),
+        (f, f_loops, samples): (&'p Face, &'p [crate::TrimLoop], &Samples),
         capped: &(TrialMesh<'p>, params::Limits, refine::Criteria),
         orig: &TrialMesh<'p>,
         (cap, trial): (f64, usize),
@@ -265,7 +272,7 @@ impl<'m> Plan<'m> {
         if cap.is_finite() {
             let l = params::Limits { max_edge: self.lim.max_edge, ..capped.1 };
             let c = refine::Criteria { max_edge: self.crit.max_edge, ..capped.2 };
-            let mut free = face::mesh_face(index, f, f_loops, &l, &c, trial, tight);
+            let mut free = face::mesh_face(index, (f, f_loops), &l, &c, trial, tight, samples);
             made.extend(outline_of(&mut free).map(|o| (f, l, o)));
             if rebuild_loses(&free, orig).is_none() {
                 return Some((l, c));
@@ -286,13 +293,14 @@ impl<'m> Plan<'m> {
         let again = if core::ptr::eq(first, lighter) { 1 } else { SHORTER_TRIES };
         let starts = [(first, 0.5, SHORTER_TRIES), (lighter, core::f64::consts::FRAC_1_SQRT_2, again)];
         for ((r, l, c), k, tries) in starts {
-            if let Some((l, c, o)) = shorter_edges(index, (f, f_loops), r, orig, (l, c, k, tries), trial, tight) {
+            let subject = (f, f_loops, samples);
+            if let Some((l, c, o)) = shorter_edges(index, subject, r, orig, (l, c, k, tries), trial, tight) {
                 made.extend(o.map(|o| (f, l, o)));
                 return Some((l, c));
             }
         }
         let (_, l, _) = *lighter;
-        let (c, o) = lift_needles(index, (f, f_loops), lighter, orig, trial, tight)?;
+        let (c, o) = lift_needles(index, (f, f_loops, samples), lighter, orig, trial, tight)?;
         made.extend(o.map(|o| (f, l, o)));
         Some((l, c))
     }

@@ -172,7 +172,9 @@ mod tests {
     fn flags(surface: &NurbsSurface, tol: f64, tight: f64) -> Vec<(DVec3, bool)> {
         let lim = Limits { tol, angle: 0.5, max_edge: f64::INFINITY, min_edge: 0.0 };
         let border = [crate::tessellate::face::domain_loop(surface).expect("domain")];
-        let mut o = crate::tessellate::face::outline(0, surface, &border, true, &lim, usize::MAX).expect("outline");
+        let mut o =
+            crate::tessellate::face::outline(0, (surface, &Default::default()), &border, true, &lim, usize::MAX)
+                .expect("outline");
         let faces = vec![Some((surface as &dyn Surface, &mut o))];
         let pos = super::super::outlines::positions(&faces);
         let inside = Inside::new(&faces, &pos, tight);
