@@ -173,6 +173,14 @@ impl Surface for FaceSurface {
             Self::Offset { base, distance } => offset_derivs(base, *distance, uv),
         }
     }
+    fn point_grid(&self, us: &[f64], vs: &[f64]) -> Vec<DVec3> {
+        match self {
+            Self::Nurbs(s) | Self::Rebuilt(s) => Surface::point_grid(s, us, vs),
+            Self::Offset { .. } => {
+                us.iter().flat_map(|&u| vs.iter().map(move |&v| self.point(DVec2::new(u, v)))).collect()
+            }
+        }
+    }
     fn tangents(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
         match self {
             Self::Nurbs(s) | Self::Rebuilt(s) => s.tangents(uv),

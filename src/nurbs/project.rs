@@ -459,14 +459,10 @@ impl SurfaceFacts {
     fn grid(&self, surface: &dyn Surface, n: usize) -> Cow<'_, [DVec3]> {
         let make = || {
             let [lo, hi] = surface.domain();
-            let m = n + 1;
-            let mut pts: Vec<DVec3> = Vec::with_capacity(m * m);
-            for i in 0..m {
-                for j in 0..m {
-                    pts.push(surface.point(param(lo, hi, n, i, j)));
-                }
-            }
-            pts
+            // `param` works per component: its u depends on `i` alone, its v on `j`.
+            let us: Vec<f64> = (0..=n).map(|i| param(lo, hi, n, i, 0).x).collect();
+            let vs: Vec<f64> = (0..=n).map(|j| param(lo, hi, n, 0, j).y).collect();
+            surface.point_grid(&us, &vs)
         };
         let (kept, pts) = self.grid.get_or_init(|| (n, make()));
         if *kept == n {

@@ -3,7 +3,7 @@
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3, DVec4};
 
-use super::knots::KnotVector;
+use super::knots::{KnotVector, MAX_DERIV};
 use super::speed::speed_bound;
 use super::{Aabb, NurbsError, Surface, SurfaceDerivs};
 
@@ -225,6 +225,95 @@ impl NurbsSurface {
         out
     }
 
+    /// `S(u, v)` at every `(us[i], vs[j])`, `u` outer, bit for bit what
+    /// [`Surface::point`] gives at each: the same basis and the same sums in
+    /// the same order, but each column's basis is computed once, and each
+    /// row's basis and its contraction with the control rows (the sums over
+    /// `u`, which depend on `u` alone) once per row instead of once per point.
+    pub fn point_grid(&self, us: &[f64], vs: &[f64]) -> Vec<DVec3> {
+        match (self.ku.degree(), self.kv.degree()) {
+            (1, 1) => self.point_grid_n::<2, 2>(1, 1, us, vs),
+            (1, 2) => self.point_grid_n::<2, 3>(1, 2, us, vs),
+            (2, 1) => self.point_grid_n::<3, 2>(2, 1, us, vs),
+            (2, 2) => self.point_grid_n::<3, 3>(2, 2, us, vs),
+            (1, 3) => self.point_grid_n::<2, 4>(1, 3, us, vs),
+            (3, 1) => self.point_grid_n::<4, 2>(3, 1, us, vs),
+            (2, 3) => self.point_grid_n::<3, 4>(2, 3, us, vs),
+            (3, 2) => self.point_grid_n::<4, 3>(3, 2, us, vs),
+            (3, 3) => self.point_grid_n::<4, 4>(3, 3, us, vs),
+            (p, q) => match p.max(q) {
+                0..=3 => self.point_grid_n::<4, 4>(p, q, us, vs),
+                4..=7 => self.point_grid_n::<8, 8>(p, q, us, vs),
+                8..=11 => self.point_grid_n::<12, 12>(p, q, us, vs),
+                _ => self.point_grid_n::<{ super::MAX_DEGREE + 1 }, { super::MAX_DEGREE + 1 }>(p, q, us, vs),
+            },
+        }
+    }
+
+    /// [`NurbsSurface::point_grid`] in the scratch sizes
+    /// [`NurbsSurface::homogeneous_derivs`] picks for these degrees.
+    fn point_grid_n<const NU: usize, const NV: usize>(&self, p: usize, q: usize, us: &[f64], vs: &[f64]) -> Vec<DVec3> {
+        let nv = self.kv.control_count();
+        let columns: Vec<(usize, [f64; NV])> = vs
+            .iter()
+            .map(|&v| {
+                let mut b = [[0.0; NV]; MAX_DERIV + 1];
+                let span = self.basis_pair::<NU, NV, NV>(false, p, q, v, 0, &mut b);
+                (span, b[0])
+            })
+            .collect();
+        // The control columns the points need: the sums over u are kept for these only.
+        let first = columns.iter().map(|c| c.0.saturating_sub(q)).min().unwrap_or(0);
+        let last = columns.iter().map(|c| c.0).max().unwrap_or(0).min(nv.saturating_sub(1));
+        let mut line = alloc::vec![DVec4::ZERO; (last + 1).saturating_sub(first)];
+        let mut out = Vec::with_capacity(us.len() * vs.len());
+        for &u in us {
+            let mut bu = [[0.0; NU]; MAX_DERIV + 1];
+            let su = self.basis_pair::<NU, NV, NU>(true, p, q, u, 0, &mut bu);
+            // line[j] = sum over r of P[r][first + j]·Nu[r], summed from zero in r's order.
+            line.fill(DVec4::ZERO);
+            for (r, &w) in bu[0].iter().enumerate().take(p + 1) {
+                let start = (su + r).saturating_sub(p) * nv + first;
+                let Some(row) = self.points.get(start..start + line.len()) else {
+                    continue;
+                };
+                for (t, h) in line.iter_mut().zip(row) {
+                    *t += *h * w;
+                }
+            }
+            for (sv, bv) in &columns {
+                let from = sv.saturating_sub(q).saturating_sub(first);
+                let mut a = DVec4::ZERO;
+                for (t, w) in line.iter().skip(from).zip(bv).take(q + 1) {
+                    a += *t * *w;
+                }
+                out.push(a.truncate() / a.w);
+            }
+        }
+        out
+    }
+
+    /// The basis along u (`along_u`) or v at `t` as
+    /// [`NurbsSurface::homogeneous_derivs_n`] computes it for scratch sizes
+    /// `NU` × `NV` (`N` the one of this direction), returning its span.
+    #[inline(always)]
+    fn basis_pair<const NU: usize, const NV: usize, const N: usize>(
+        &self,
+        along_u: bool,
+        p: usize,
+        q: usize,
+        t: f64,
+        order: usize,
+        b: &mut [[f64; N]; MAX_DERIV + 1],
+    ) -> usize {
+        let k = if along_u { &self.ku } else { &self.kv };
+        if p + 1 == NU && q + 1 == NV {
+            k.basis_into(t, order, b)
+        } else {
+            k.basis_fast(None, t, order, b)
+        }
+    }
+
     /// Degrees `NU - 1` and `NV - 1` (the caller checked), as constants.
     fn homogeneous_derivs_exact<const NU: usize, const NV: usize>(&self, uv: DVec2, order: usize) -> [[DVec4; 3]; 3] {
         self.homogeneous_derivs_n::<NU, NV>(NU - 1, NV - 1, uv, order)
@@ -249,11 +338,8 @@ impl NurbsSurface {
         let mut bv = [[0.0; NV]; 3];
         // Exact scratch already unrolls the basis; a degree class gets the
         // basis in exact scratch (degrees up to 7) and copies it.
-        let (su, sv) = if p + 1 == NU && q + 1 == NV {
-            (self.ku.basis_into(uv.x, order, &mut bu), self.kv.basis_into(uv.y, order, &mut bv))
-        } else {
-            (self.ku.basis_fast(None, uv.x, order, &mut bu), self.kv.basis_fast(None, uv.y, order, &mut bv))
-        };
+        let su = self.basis_pair::<NU, NV, NU>(true, p, q, uv.x, order, &mut bu);
+        let sv = self.basis_pair::<NU, NV, NV>(false, p, q, uv.y, order, &mut bv);
         let nv = self.kv.control_count();
         let mut out = [[DVec4::ZERO; 3]; 3];
         // temp[k][s] = sum over r of P[r][s]·Nu^(k)[r]: each control row is
@@ -475,6 +561,10 @@ impl Surface for NurbsSurface {
         SurfaceDerivs { point: s, su, sv, suu, suv, svv }
     }
 
+    fn point_grid(&self, us: &[f64], vs: &[f64]) -> Vec<DVec3> {
+        NurbsSurface::point_grid(self, us, vs)
+    }
+
     fn breaks(&self, along_u: bool) -> Vec<f64> {
         if along_u {
             self.ku.breakpoints()
@@ -489,5 +579,65 @@ impl Surface for NurbsSurface {
 
     fn derivative_bounds(&self) -> Option<[f64; 2]> {
         NurbsSurface::derivative_bounds(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alloc::vec;
+
+    /// A wavy rational surface of degrees `p` × `q` with uneven inner knots
+    /// (one doubled, one a sliver), for comparing evaluation paths.
+    fn wavy(p: usize, q: usize) -> NurbsSurface {
+        let knots = |d: usize, inner: &[f64]| {
+            let mut k = vec![0.0; d + 1];
+            k.extend_from_slice(inner);
+            k.extend(core::iter::repeat_n(1.0, d + 1));
+            k
+        };
+        let ku = knots(p, &[0.2, 0.45, 0.45, 0.7]);
+        let kv = knots(q, &[0.3, 0.3 + 1e-17, 0.55, 0.8]);
+        let (nu, nv) = (ku.len() - p - 1, kv.len() - q - 1);
+        let pts: Vec<Vec<DVec3>> = (0..nu)
+            .map(|i| {
+                (0..nv)
+                    .map(|j| {
+                        let (x, y) = (i as f64 * 1.3, j as f64 * 0.7);
+                        DVec3::new(x, y, libm::sin(x + 2.0 * y) + 0.1 * (i * j) as f64)
+                    })
+                    .collect()
+            })
+            .collect();
+        let w: Vec<Vec<f64>> =
+            (0..nu).map(|i| (0..nv).map(|j| 1.0 + 0.3 * ((i + 2 * j) % 3) as f64).collect()).collect();
+        NurbsSurface::try_new([p, q], ku, kv, &pts, Some(&w)).unwrap()
+    }
+
+    /// The grid gives bit for bit the points `point` gives, for exact and
+    /// degree-class scratch sizes, at knots, inside slivers and outside the
+    /// domain (clamped), in any order of the parameters.
+    #[test]
+    fn point_grid_equals_point_bitwise() {
+        let ts = [-0.1, 0.0, 0.1, 0.2, 0.3, 0.3 + 5e-18, 0.31, 0.45, 0.5, 0.551, 0.7, 0.9999, 1.0, 1.2, 0.05];
+        for (p, q) in [(1, 1), (1, 2), (2, 1), (2, 2), (3, 3), (1, 3), (3, 2), (2, 4), (5, 5), (1, 8), (8, 11), (4, 13)]
+        {
+            let s = wavy(p, q);
+            for (us, vs) in [(&ts[..], &ts[..]), (&ts[2..3], &ts[..]), (&ts[..], &ts[5..6]), (&ts[..0], &ts[..])] {
+                let grid = s.point_grid(us, vs);
+                assert_eq!(grid.len(), us.len() * vs.len());
+                for (i, &u) in us.iter().enumerate() {
+                    for (j, &v) in vs.iter().enumerate() {
+                        let want = Surface::point(&s, DVec2::new(u, v));
+                        let got = grid[i * vs.len() + j];
+                        assert_eq!(
+                            got.to_array().map(f64::to_bits),
+                            want.to_array().map(f64::to_bits),
+                            "({p},{q}) at ({u},{v})"
+                        );
+                    }
+                }
+            }
+        }
     }
 }
