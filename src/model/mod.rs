@@ -181,6 +181,14 @@ impl Surface for FaceSurface {
             }
         }
     }
+    fn iso_point_normal(&self, along_u: bool, s: f64) -> Box<dyn Fn(f64) -> (DVec3, DVec3) + '_> {
+        match self {
+            Self::Nurbs(n) | Self::Rebuilt(n) => Surface::iso_point_normal(n, along_u, s),
+            Self::Offset { .. } => {
+                Box::new(move |t| self.point_normal(if along_u { DVec2::new(t, s) } else { DVec2::new(s, t) }))
+            }
+        }
+    }
     fn tangents(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
         match self {
             Self::Nurbs(s) | Self::Rebuilt(s) => s.tangents(uv),

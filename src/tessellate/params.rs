@@ -508,12 +508,7 @@ fn iso_curves<'s>(
     lines: usize,
 ) -> Vec<(f64, impl Fn(f64) -> (DVec3, DVec3) + 's)> {
     let (s0, s1) = if along_u { (lo.y, hi.y) } else { (lo.x, hi.x) };
-    let make = move |s: f64| {
-        memo_by_bits(move |t: f64| {
-            let uv = if along_u { DVec2::new(t, s) } else { DVec2::new(s, t) };
-            surface.point_normal(uv)
-        })
-    };
+    let make = move |s: f64| memo_by_bits(surface.iso_point_normal(along_u, s));
     (0..=lines).map(|k| s0 + (s1 - s0) * k as f64 / lines as f64).map(|s| (s, make(s))).collect()
 }
 
