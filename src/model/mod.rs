@@ -173,6 +173,22 @@ impl Surface for FaceSurface {
             Self::Offset { base, distance } => offset_derivs(base, *distance, uv),
         }
     }
+    fn point_grid(&self, us: &[f64], vs: &[f64]) -> Vec<DVec3> {
+        match self {
+            Self::Nurbs(s) | Self::Rebuilt(s) => Surface::point_grid(s, us, vs),
+            Self::Offset { .. } => {
+                us.iter().flat_map(|&u| vs.iter().map(move |&v| self.point(DVec2::new(u, v)))).collect()
+            }
+        }
+    }
+    fn iso_point_normal(&self, along_u: bool, s: f64) -> Box<dyn Fn(f64) -> (DVec3, DVec3) + '_> {
+        match self {
+            Self::Nurbs(n) | Self::Rebuilt(n) => Surface::iso_point_normal(n, along_u, s),
+            Self::Offset { .. } => {
+                Box::new(move |t| self.point_normal(if along_u { DVec2::new(t, s) } else { DVec2::new(s, t) }))
+            }
+        }
+    }
     fn tangents(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
         match self {
             Self::Nurbs(s) | Self::Rebuilt(s) => s.tangents(uv),

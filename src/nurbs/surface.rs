@@ -1,9 +1,10 @@
 //! Rational B-spline surfaces with derivatives up to second order.
 
+use alloc::boxed::Box;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3, DVec4};
 
-use super::knots::KnotVector;
+use super::knots::{KnotVector, MAX_DERIV};
 use super::speed::speed_bound;
 use super::{Aabb, NurbsError, Surface, SurfaceDerivs};
 
@@ -225,6 +226,95 @@ impl NurbsSurface {
         out
     }
 
+    /// `S(u, v)` at every `(us[i], vs[j])`, `u` outer, bit for bit what
+    /// [`Surface::point`] gives at each: the same basis and the same sums in
+    /// the same order, but each column's basis is computed once, and each
+    /// row's basis and its contraction with the control rows (the sums over
+    /// `u`, which depend on `u` alone) once per row instead of once per point.
+    pub fn point_grid(&self, us: &[f64], vs: &[f64]) -> Vec<DVec3> {
+        match (self.ku.degree(), self.kv.degree()) {
+            (1, 1) => self.point_grid_n::<2, 2>(1, 1, us, vs),
+            (1, 2) => self.point_grid_n::<2, 3>(1, 2, us, vs),
+            (2, 1) => self.point_grid_n::<3, 2>(2, 1, us, vs),
+            (2, 2) => self.point_grid_n::<3, 3>(2, 2, us, vs),
+            (1, 3) => self.point_grid_n::<2, 4>(1, 3, us, vs),
+            (3, 1) => self.point_grid_n::<4, 2>(3, 1, us, vs),
+            (2, 3) => self.point_grid_n::<3, 4>(2, 3, us, vs),
+            (3, 2) => self.point_grid_n::<4, 3>(3, 2, us, vs),
+            (3, 3) => self.point_grid_n::<4, 4>(3, 3, us, vs),
+            (p, q) => match p.max(q) {
+                0..=3 => self.point_grid_n::<4, 4>(p, q, us, vs),
+                4..=7 => self.point_grid_n::<8, 8>(p, q, us, vs),
+                8..=11 => self.point_grid_n::<12, 12>(p, q, us, vs),
+                _ => self.point_grid_n::<{ super::MAX_DEGREE + 1 }, { super::MAX_DEGREE + 1 }>(p, q, us, vs),
+            },
+        }
+    }
+
+    /// [`NurbsSurface::point_grid`] in the scratch sizes
+    /// [`NurbsSurface::homogeneous_derivs`] picks for these degrees.
+    fn point_grid_n<const NU: usize, const NV: usize>(&self, p: usize, q: usize, us: &[f64], vs: &[f64]) -> Vec<DVec3> {
+        let nv = self.kv.control_count();
+        let columns: Vec<(usize, [f64; NV])> = vs
+            .iter()
+            .map(|&v| {
+                let mut b = [[0.0; NV]; MAX_DERIV + 1];
+                let span = self.basis_pair::<NU, NV, NV>(false, p, q, v, 0, &mut b);
+                (span, b[0])
+            })
+            .collect();
+        // The control columns the points need: the sums over u are kept for these only.
+        let first = columns.iter().map(|c| c.0.saturating_sub(q)).min().unwrap_or(0);
+        let last = columns.iter().map(|c| c.0).max().unwrap_or(0).min(nv.saturating_sub(1));
+        let mut line = alloc::vec![DVec4::ZERO; (last + 1).saturating_sub(first)];
+        let mut out = Vec::with_capacity(us.len() * vs.len());
+        for &u in us {
+            let mut bu = [[0.0; NU]; MAX_DERIV + 1];
+            let su = self.basis_pair::<NU, NV, NU>(true, p, q, u, 0, &mut bu);
+            // line[j] = sum over r of P[r][first + j]·Nu[r], summed from zero in r's order.
+            line.fill(DVec4::ZERO);
+            for (r, &w) in bu[0].iter().enumerate().take(p + 1) {
+                let start = (su + r).saturating_sub(p) * nv + first;
+                let Some(row) = self.points.get(start..start + line.len()) else {
+                    continue;
+                };
+                for (t, h) in line.iter_mut().zip(row) {
+                    *t += *h * w;
+                }
+            }
+            for (sv, bv) in &columns {
+                let from = sv.saturating_sub(q).saturating_sub(first);
+                let mut a = DVec4::ZERO;
+                for (t, w) in line.iter().skip(from).zip(bv).take(q + 1) {
+                    a += *t * *w;
+                }
+                out.push(a.truncate() / a.w);
+            }
+        }
+        out
+    }
+
+    /// The basis along u (`along_u`) or v at `t` as
+    /// [`NurbsSurface::homogeneous_derivs_n`] computes it for scratch sizes
+    /// `NU` × `NV` (`N` the one of this direction), returning its span.
+    #[inline(always)]
+    fn basis_pair<const NU: usize, const NV: usize, const N: usize>(
+        &self,
+        along_u: bool,
+        p: usize,
+        q: usize,
+        t: f64,
+        order: usize,
+        b: &mut [[f64; N]; MAX_DERIV + 1],
+    ) -> usize {
+        let k = if along_u { &self.ku } else { &self.kv };
+        if p + 1 == NU && q + 1 == NV {
+            k.basis_into(t, order, b)
+        } else {
+            k.basis_fast(None, t, order, b)
+        }
+    }
+
     /// Degrees `NU - 1` and `NV - 1` (the caller checked), as constants.
     fn homogeneous_derivs_exact<const NU: usize, const NV: usize>(&self, uv: DVec2, order: usize) -> [[DVec4; 3]; 3] {
         self.homogeneous_derivs_n::<NU, NV>(NU - 1, NV - 1, uv, order)
@@ -249,17 +339,27 @@ impl NurbsSurface {
         let mut bv = [[0.0; NV]; 3];
         // Exact scratch already unrolls the basis; a degree class gets the
         // basis in exact scratch (degrees up to 7) and copies it.
-        let (su, sv) = if p + 1 == NU && q + 1 == NV {
-            (self.ku.basis_into(uv.x, order, &mut bu), self.kv.basis_into(uv.y, order, &mut bv))
-        } else {
-            (self.ku.basis_fast(None, uv.x, order, &mut bu), self.kv.basis_fast(None, uv.y, order, &mut bv))
-        };
+        let su = self.basis_pair::<NU, NV, NU>(true, p, q, uv.x, order, &mut bu);
+        let sv = self.basis_pair::<NU, NV, NV>(false, p, q, uv.y, order, &mut bv);
+        let first = (su - p) * self.kv.control_count() + sv - q;
+        let temp = self.contract_u::<NU, NV>(first, p, q, &bu, order);
+        sum_v(&temp, &bv, q, order)
+    }
+
+    /// `temp[k][s]` = sum over `r <= p` of `P[r][s]·Nu^(k)[r]` for `k <= order`
+    /// and `s <= q`, control point `(r, s)` at `first + r·nv + s`: each control
+    /// row is read once for all orders (sums in the same order as one order at a time).
+    #[inline(always)]
+    fn contract_u<const NU: usize, const NV: usize>(
+        &self,
+        first: usize,
+        p: usize,
+        q: usize,
+        bu: &[[f64; NU]; MAX_DERIV + 1],
+        order: usize,
+    ) -> [[DVec4; NV]; 3] {
         let nv = self.kv.control_count();
-        let mut out = [[DVec4::ZERO; 3]; 3];
-        // temp[k][s] = sum over r of P[r][s]·Nu^(k)[r]: each control row is
-        // read once for all orders (sums in the same order as one order at a time).
         let mut temp = [[DVec4::ZERO; NV]; 3];
-        let first = (su - p) * nv + sv - q;
         for r in 0..=p {
             let Some(row) = self.points.get(first + r * nv..first + r * nv + q + 1) else {
                 continue;
@@ -271,16 +371,86 @@ impl NurbsSurface {
                 }
             }
         }
-        for (k, tk) in temp.iter().enumerate().take(order + 1) {
-            for l in 0..=(order - k) {
-                let mut acc = DVec4::ZERO;
-                for (s, t) in tk.iter().enumerate().take(q + 1) {
-                    acc += *t * bv[l][s];
-                }
-                out[k][l] = acc;
-            }
+        temp
+    }
+
+    /// [`Surface::point_normal`] along the iso-curve where the other
+    /// parameter is `s` (`along_u`: `v = s` and the argument is `u`), bit
+    /// for bit: the fixed parameter's basis is computed once, and with `u`
+    /// fixed also its sums over `u`, once for every control column.
+    pub fn iso_point_normal(&self, along_u: bool, s: f64) -> Box<dyn Fn(f64) -> (DVec3, DVec3) + '_> {
+        match (self.ku.degree(), self.kv.degree()) {
+            (1, 1) => self.iso_n::<2, 2>(1, 1, along_u, s),
+            (1, 2) => self.iso_n::<2, 3>(1, 2, along_u, s),
+            (2, 1) => self.iso_n::<3, 2>(2, 1, along_u, s),
+            (2, 2) => self.iso_n::<3, 3>(2, 2, along_u, s),
+            (1, 3) => self.iso_n::<2, 4>(1, 3, along_u, s),
+            (3, 1) => self.iso_n::<4, 2>(3, 1, along_u, s),
+            (2, 3) => self.iso_n::<3, 4>(2, 3, along_u, s),
+            (3, 2) => self.iso_n::<4, 3>(3, 2, along_u, s),
+            (3, 3) => self.iso_n::<4, 4>(3, 3, along_u, s),
+            (p, q) => match p.max(q) {
+                0..=3 => self.iso_n::<4, 4>(p, q, along_u, s),
+                4..=7 => self.iso_n::<8, 8>(p, q, along_u, s),
+                8..=11 => self.iso_n::<12, 12>(p, q, along_u, s),
+                _ => self.iso_n::<{ super::MAX_DEGREE + 1 }, { super::MAX_DEGREE + 1 }>(p, q, along_u, s),
+            },
         }
-        out
+    }
+
+    /// [`NurbsSurface::iso_point_normal`] in the scratch sizes
+    /// [`NurbsSurface::homogeneous_derivs`] picks for these degrees.
+    fn iso_n<const NU: usize, const NV: usize>(
+        &self,
+        p: usize,
+        q: usize,
+        along_u: bool,
+        s: f64,
+    ) -> Box<dyn Fn(f64) -> (DVec3, DVec3) + '_> {
+        let finish = move |uv: DVec2, a: [[DVec4; 3]; 3]| {
+            let (point, su, sv) = tangents_of(&a);
+            (point, self.normal_from_tangents(uv, su, sv))
+        };
+        if along_u {
+            let mut bv = [[0.0; NV]; MAX_DERIV + 1];
+            let sv = self.basis_pair::<NU, NV, NV>(false, p, q, s, 1, &mut bv);
+            Box::new(move |u: f64| {
+                let mut bu = [[0.0; NU]; MAX_DERIV + 1];
+                let su = self.basis_pair::<NU, NV, NU>(true, p, q, u, 1, &mut bu);
+                let first = (su - p) * self.kv.control_count() + sv - q;
+                let temp = self.contract_u::<NU, NV>(first, p, q, &bu, 1);
+                finish(DVec2::new(u, s), sum_v(&temp, &bv, q, 1))
+            })
+        } else {
+            let mut bu = [[0.0; NU]; MAX_DERIV + 1];
+            let su = self.basis_pair::<NU, NV, NU>(true, p, q, s, 1, &mut bu);
+            // The sums over u for every control column, as `contract_u` forms them.
+            let nv = self.kv.control_count();
+            let mut lines = [alloc::vec![DVec4::ZERO; nv], alloc::vec![DVec4::ZERO; nv]];
+            for r in 0..=p {
+                let start = (su - p + r) * nv;
+                let Some(row) = self.points.get(start..start + nv) else {
+                    continue;
+                };
+                for (k, line) in lines.iter_mut().enumerate() {
+                    let w = bu[k][r];
+                    for (t, h) in line.iter_mut().zip(row) {
+                        *t += *h * w;
+                    }
+                }
+            }
+            Box::new(move |v: f64| {
+                let mut bv = [[0.0; NV]; MAX_DERIV + 1];
+                let sv = self.basis_pair::<NU, NV, NV>(false, p, q, v, 1, &mut bv);
+                let mut temp = [[DVec4::ZERO; NV]; 3];
+                for (tk, line) in temp.iter_mut().zip(&lines) {
+                    for (t, h) in tk.iter_mut().zip(line.iter().skip(sv - q)) {
+                        *t = *h;
+                    }
+                }
+                finish(DVec2::new(s, v), sum_v(&temp, &bv, q, 1))
+            })
+        }
     }
 
     /// Inserts knot `t` once along u (`along_u`) or v; same shape.
@@ -441,6 +611,38 @@ impl NurbsSurface {
     }
 }
 
+/// `A^{(k,l)}` for `k + l <= order` from the sums over u ([`NurbsSurface::contract_u`]):
+/// each a sum over `s <= q` of `temp[k][s]·Nv^(l)[s]`; the others zero.
+#[inline(always)]
+fn sum_v<const NV: usize>(
+    temp: &[[DVec4; NV]; 3],
+    bv: &[[f64; NV]; MAX_DERIV + 1],
+    q: usize,
+    order: usize,
+) -> [[DVec4; 3]; 3] {
+    let mut out = [[DVec4::ZERO; 3]; 3];
+    for (k, tk) in temp.iter().enumerate().take(order + 1) {
+        for l in 0..=(order - k) {
+            let mut acc = DVec4::ZERO;
+            for (s, t) in tk.iter().enumerate().take(q + 1) {
+                acc += *t * bv[l][s];
+            }
+            out[k][l] = acc;
+        }
+    }
+    out
+}
+
+/// `(S, Su, Sv)` from the homogeneous derivatives of first order (quotient rule).
+#[inline(always)]
+fn tangents_of(a: &[[DVec4; 3]; 3]) -> (DVec3, DVec3, DVec3) {
+    let w = a[0][0].w;
+    let s = a[0][0].truncate() / w;
+    let su = (a[1][0].truncate() - s * a[1][0].w) / w;
+    let sv = (a[0][1].truncate() - s * a[0][1].w) / w;
+    (s, su, sv)
+}
+
 impl Surface for NurbsSurface {
     fn domain(&self) -> [DVec2; 2] {
         let (u0, u1) = self.ku.domain();
@@ -455,12 +657,7 @@ impl Surface for NurbsSurface {
 
     fn tangents(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
         // First order only: the same sums as in `derivs`, the second-order ones left out.
-        let a = self.homogeneous_derivs(uv, 1);
-        let w = a[0][0].w;
-        let s = a[0][0].truncate() / w;
-        let su = (a[1][0].truncate() - s * a[1][0].w) / w;
-        let sv = (a[0][1].truncate() - s * a[0][1].w) / w;
-        (s, su, sv)
+        tangents_of(&self.homogeneous_derivs(uv, 1))
     }
 
     fn derivs(&self, uv: DVec2) -> SurfaceDerivs {
@@ -473,6 +670,14 @@ impl Surface for NurbsSurface {
         let svv = (a[0][2].truncate() - sv * (2.0 * a[0][1].w) - s * a[0][2].w) / w;
         let suv = (a[1][1].truncate() - su * a[0][1].w - sv * a[1][0].w - s * a[1][1].w) / w;
         SurfaceDerivs { point: s, su, sv, suu, suv, svv }
+    }
+
+    fn point_grid(&self, us: &[f64], vs: &[f64]) -> Vec<DVec3> {
+        NurbsSurface::point_grid(self, us, vs)
+    }
+
+    fn iso_point_normal(&self, along_u: bool, s: f64) -> Box<dyn Fn(f64) -> (DVec3, DVec3) + '_> {
+        NurbsSurface::iso_point_normal(self, along_u, s)
     }
 
     fn breaks(&self, along_u: bool) -> Vec<f64> {
@@ -489,5 +694,87 @@ impl Surface for NurbsSurface {
 
     fn derivative_bounds(&self) -> Option<[f64; 2]> {
         NurbsSurface::derivative_bounds(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alloc::vec;
+
+    /// A wavy rational surface of degrees `p` × `q` with uneven inner knots
+    /// (one doubled, one a sliver), for comparing evaluation paths.
+    fn wavy(p: usize, q: usize) -> NurbsSurface {
+        let knots = |d: usize, inner: &[f64]| {
+            let mut k = vec![0.0; d + 1];
+            k.extend_from_slice(inner);
+            k.extend(core::iter::repeat_n(1.0, d + 1));
+            k
+        };
+        let ku = knots(p, &[0.2, 0.45, 0.45, 0.7]);
+        let kv = knots(q, &[0.3, 0.3 + 1e-17, 0.55, 0.8]);
+        let (nu, nv) = (ku.len() - p - 1, kv.len() - q - 1);
+        let pts: Vec<Vec<DVec3>> = (0..nu)
+            .map(|i| {
+                (0..nv)
+                    .map(|j| {
+                        let (x, y) = (i as f64 * 1.3, j as f64 * 0.7);
+                        DVec3::new(x, y, libm::sin(x + 2.0 * y) + 0.1 * (i * j) as f64)
+                    })
+                    .collect()
+            })
+            .collect();
+        let w: Vec<Vec<f64>> =
+            (0..nu).map(|i| (0..nv).map(|j| 1.0 + 0.3 * ((i + 2 * j) % 3) as f64).collect()).collect();
+        NurbsSurface::try_new([p, q], ku, kv, &pts, Some(&w)).unwrap()
+    }
+
+    /// The grid gives bit for bit the points `point` gives, for exact and
+    /// degree-class scratch sizes, at knots, inside slivers and outside the
+    /// domain (clamped), in any order of the parameters.
+    #[test]
+    fn point_grid_equals_point_bitwise() {
+        let ts = [-0.1, 0.0, 0.1, 0.2, 0.3, 0.3 + 5e-18, 0.31, 0.45, 0.5, 0.551, 0.7, 0.9999, 1.0, 1.2, 0.05];
+        for (p, q) in [(1, 1), (1, 2), (2, 1), (2, 2), (3, 3), (1, 3), (3, 2), (2, 4), (5, 5), (1, 8), (8, 11), (4, 13)]
+        {
+            let s = wavy(p, q);
+            for (us, vs) in [(&ts[..], &ts[..]), (&ts[2..3], &ts[..]), (&ts[..], &ts[5..6]), (&ts[..0], &ts[..])] {
+                let grid = s.point_grid(us, vs);
+                assert_eq!(grid.len(), us.len() * vs.len());
+                for (i, &u) in us.iter().enumerate() {
+                    for (j, &v) in vs.iter().enumerate() {
+                        let want = Surface::point(&s, DVec2::new(u, v));
+                        let got = grid[i * vs.len() + j];
+                        assert_eq!(
+                            got.to_array().map(f64::to_bits),
+                            want.to_array().map(f64::to_bits),
+                            "({p},{q}) at ({u},{v})"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// Points and normals along iso-curves are bit for bit those of
+    /// `point_normal`, either parameter fixed, for exact and degree-class
+    /// scratch sizes, at knots, inside slivers and outside the domain.
+    #[test]
+    fn iso_point_normal_equals_point_normal_bitwise() {
+        let ts = [-0.1, 0.0, 0.1, 0.2, 0.3, 0.3 + 5e-18, 0.31, 0.45, 0.5, 0.551, 0.7, 0.9999, 1.0, 1.2];
+        let bits = |(p, n): (DVec3, DVec3)| [p.to_array(), n.to_array()].map(|a| a.map(f64::to_bits));
+        for (p, q) in [(1, 1), (1, 2), (2, 1), (2, 2), (3, 3), (1, 3), (3, 2), (2, 4), (5, 5), (1, 8), (8, 11), (4, 13)]
+        {
+            let s = wavy(p, q);
+            for along_u in [true, false] {
+                for &fixed in &ts {
+                    let iso = s.iso_point_normal(along_u, fixed);
+                    for &t in &ts {
+                        let uv = if along_u { DVec2::new(t, fixed) } else { DVec2::new(fixed, t) };
+                        assert_eq!(bits(iso(t)), bits(s.point_normal(uv)), "({p},{q}) at {uv}");
+                    }
+                }
+            }
+        }
     }
 }

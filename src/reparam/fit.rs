@@ -162,16 +162,11 @@ fn even_params(surface: &FaceSurface, along_u: bool, n: usize, spacing: Spacing)
     let mut log_speed = vec![0.0; dense];
     let mut used = 0usize;
     for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
-        let pts: Vec<DVec3> = xs
-            .iter()
-            .map(|&x| {
-                surface.point(if along_u {
-                    DVec2::new(x, lo.y + (hi.y - lo.y) * f)
-                } else {
-                    DVec2::new(lo.x + (hi.x - lo.x) * f, x)
-                })
-            })
-            .collect();
+        let pts: Vec<DVec3> = if along_u {
+            surface.point_grid(&xs, &[lo.y + (hi.y - lo.y) * f])
+        } else {
+            surface.point_grid(&[lo.x + (hi.x - lo.x) * f], &xs)
+        };
         let lengths: Vec<f64> = pts.windows(2).map(|w| w[0].distance(w[1])).collect();
         let total: f64 = lengths.iter().sum();
         if !(total > 0.0 && total.is_finite()) {
@@ -398,8 +393,8 @@ fn unreverse_corners(new: &NurbsSurface, old: &FaceSurface, us: &[f64], vs: &[f6
 fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Result<Fit, RebuildError> {
     let (us, arc_u) = even_params(surface, true, n, spacing);
     let (vs, arc_v) = even_params(surface, false, m, spacing);
-    let grid: Vec<Vec<DVec3>> =
-        us.iter().map(|&u| vs.iter().map(|&v| surface.point(DVec2::new(u, v))).collect()).collect();
+    let flat = surface.point_grid(&us, &vs);
+    let grid: Vec<Vec<DVec3>> = (0..us.len()).map(|i| flat[i * vs.len()..(i + 1) * vs.len()].to_vec()).collect();
     let cols: Vec<Vec<DVec3>> = (0..vs.len()).map(|j| grid.iter().map(|r| r[j]).collect()).collect();
     let s = interp::averaged_params(cols.iter().map(Vec::as_slice), us.len());
     let t = interp::averaged_params(grid.iter().map(Vec::as_slice), vs.len());

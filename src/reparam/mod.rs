@@ -80,17 +80,12 @@ pub fn step_ratio(surface: &dyn Surface) -> f64 {
     let mut longest = 0.0f64;
     for along_u in [true, false] {
         for f in [0.0, 0.5, 1.0] {
-            let pts: Vec<DVec3> = (0..=STEPS)
-                .map(|k| {
-                    let a = k as f64 / STEPS as f64;
-                    let uv = if along_u {
-                        DVec2::new(lo.x + (hi.x - lo.x) * a, lo.y + (hi.y - lo.y) * f)
-                    } else {
-                        DVec2::new(lo.x + (hi.x - lo.x) * f, lo.y + (hi.y - lo.y) * a)
-                    };
-                    surface.point(uv)
-                })
-                .collect();
+            let run = |a: f64, b: f64| (0..=STEPS).map(|k| a + (b - a) * (k as f64 / STEPS as f64)).collect::<Vec<_>>();
+            let pts: Vec<DVec3> = if along_u {
+                surface.point_grid(&run(lo.x, hi.x), &[lo.y + (hi.y - lo.y) * f])
+            } else {
+                surface.point_grid(&[lo.x + (hi.x - lo.x) * f], &run(lo.y, hi.y))
+            };
             let total: f64 = pts.windows(2).map(|w| w[0].distance(w[1])).sum();
             if total.is_finite() {
                 longest = longest.max(total);

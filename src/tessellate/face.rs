@@ -141,10 +141,7 @@ fn refine_twisted_cells(
                     .any(|&(a, b)| m.get((i + a) * nv + j + b).copied().unwrap_or(true))
             })
         };
-        let pts: Vec<DVec3> = (0..nu)
-            .flat_map(|i| pv.iter().map(move |&v| (i, v)))
-            .map(|(i, v)| surface.point(DVec2::new(pu[i], v)))
-            .collect();
+        let pts: Vec<DVec3> = surface.point_grid(pu, pv);
         let mut need_u = alloc::vec![1usize; nu - 1];
         let mut need_v = alloc::vec![1usize; nv - 1];
         let mut any = false;

@@ -32,13 +32,14 @@ impl Samples {
     /// Most values kept (about 70 bytes each).
     const MOST: usize = 1 << 20;
 
-    /// `surface`'s point and unit normal at `uv`, evaluated once.
-    fn point_normal(&self, surface: &dyn Surface, uv: DVec2) -> (DVec3, DVec3) {
+    /// The surface's point and unit normal at `uv`, evaluated once (by
+    /// `eval`, which gives the bits [`Surface::point_normal`] gives).
+    fn point_normal_with(&self, uv: DVec2, eval: impl FnOnce() -> (DVec3, DVec3)) -> (DVec3, DVec3) {
         let key = [uv.x.to_bits(), uv.y.to_bits()];
         if let Some(&x) = self.0.borrow().get(&key) {
             return x;
         }
-        let x = surface.point_normal(uv);
+        let x = eval();
         let mut kept = self.0.borrow_mut();
         if kept.len() < Self::MOST {
             kept.insert(key, x);
@@ -542,10 +543,13 @@ fn iso_curves<'s>(
     lines: usize,
 ) -> Vec<(f64, impl Fn(f64) -> (DVec3, DVec3) + 's)> {
     let (s0, s1) = if along_u { (lo.y, hi.y) } else { (lo.x, hi.x) };
+    // The iso-curve's evaluator (the fixed parameter's work done once) is
+    // made at the first sample the store does not hold.
     let make = move |s: f64| {
+        let iso = core::cell::OnceCell::new();
         move |t: f64| {
             let uv = if along_u { DVec2::new(t, s) } else { DVec2::new(s, t) };
-            samples.point_normal(surface, uv)
+            samples.point_normal_with(uv, || iso.get_or_init(|| surface.iso_point_normal(along_u, s))(t))
         }
     };
     (0..=lines).map(|k| s0 + (s1 - s0) * k as f64 / lines as f64).map(|s| (s, make(s))).collect()
