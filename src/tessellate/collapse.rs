@@ -30,6 +30,54 @@ pub(crate) fn collapse_point_edges<T>(pos: &[DVec3], tris: &mut Vec<[u32; 3]>, w
     collapse_edges_moving(tris, with, same, None, |_, _, _| true).0
 }
 
+/// Drops each pair of triangles on the same three vertices that face
+/// opposite ways (a flap: sewing put two loop nodes of a collapsed side on
+/// one vertex, so the loop runs out to a node and back, and the triangles
+/// over that spike, and whatever refinement splits them into, come in such
+/// pairs). A flap encloses nothing, and one of its two facets is turned
+/// over whatever the surface does; it only adds two uses to each of its
+/// edges. `with` (empty, or one item per triangle) drops the same items.
+/// Returns the triangles dropped.
+pub(crate) fn drop_flaps<T>(tris: &mut Vec<[u32; 3]>, with: &mut Vec<T>) -> usize {
+    // Each triangle by its sorted corners, with whether it runs the other way round.
+    let mut seen: HashMap<[u32; 3], [Vec<u32>; 2]> = HashMap::default();
+    for (i, t) in tris.iter().enumerate() {
+        if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
+            continue;
+        }
+        let k = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
+        let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+        let (key, turn) = if b < c { ([a, b, c], 0) } else { ([a, c, b], 1) };
+        seen.entry(key).or_default()[turn].push(i as u32);
+    }
+    let mut gone: Vec<u32> = Vec::new();
+    for [one, other] in seen.values() {
+        let n = one.len().min(other.len());
+        gone.extend_from_slice(&one[..n]);
+        gone.extend_from_slice(&other[..n]);
+    }
+    if gone.is_empty() {
+        return 0;
+    }
+    let mut keep = alloc::vec![true; tris.len()];
+    for &i in &gone {
+        keep[i as usize] = false;
+    }
+    let mut i = 0;
+    tris.retain(|_| {
+        i += 1;
+        keep[i - 1]
+    });
+    if with.len() == keep.len() {
+        let mut i = 0;
+        with.retain(|_| {
+            i += 1;
+            keep[i - 1]
+        });
+    }
+    gone.len()
+}
+
 /// How far, in census welds, collapses may gather vertices into one: far
 /// enough to clear the clusters refinement leaves at a near-pole (t4mec's
 /// span 17 welds), short of a strip's row of points each a weld apart,
@@ -310,6 +358,33 @@ mod tests {
                 (pos[t[1] as usize] - pos[t[0] as usize]).cross(pos[t[2] as usize] - pos[t[0] as usize]).length();
             assert!(area > 0.1, "a triangle without area is left: {t:?}");
         }
+    }
+
+    /// A face's loop run out along a collapsed side to a node and back to
+    /// one pole vertex (0 at both ends of the spike to 1): the first mesh
+    /// spans the spike with two triangles on the same corners, and a split
+    /// of their long edge at 4 gives a second such pair. Each pair goes,
+    /// the fold it counted with it, and the fan beside it stays whole.
+    #[test]
+    fn a_flap_over_a_spike_goes_and_its_fold_with_it() {
+        let pos = [
+            DVec3::ZERO,
+            DVec3::new(0.0, 0.0, 2e-3),
+            DVec3::new(10.0, 0.0, -1.0),
+            DVec3::new(10.0, 3.0, -1.0),
+            DVec3::new(5.0, 0.2, -0.5),
+        ];
+        let up = DVec3::new(0.1, 0.0, 1.0).normalize();
+        let mut tris = alloc::vec![[2, 3, 0], [0, 1, 4], [4, 2, 0], [1, 0, 4], [2, 4, 0], [0, 2, 1]];
+        let mut normals = alloc::vec![up; tris.len()];
+        assert!(crate::tessellate::refine::count_folded(&pos, &tris, &normals, 1e-2, 0.0) > 0);
+        assert_eq!(drop_flaps(&mut tris, &mut normals), 4);
+        assert_eq!(tris, [[2, 3, 0], [0, 2, 1]]);
+        assert_eq!(normals.len(), 2);
+        assert_eq!(crate::tessellate::refine::count_folded(&pos, &tris, &normals, 1e-2, 0.0), 0);
+        // The same triangle twice the same way round is no flap.
+        let mut twice = alloc::vec![[0, 2, 3], [2, 3, 0]];
+        assert_eq!(drop_flaps(&mut twice, &mut Vec::<()>::new()), 0);
     }
 
     /// Two border vertices at one point joined by an inner edge: collapsing

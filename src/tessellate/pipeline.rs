@@ -476,7 +476,8 @@ impl<'m> Plan<'m> {
     /// mesh for all faces): each face's working state freed as soon as it is
     /// copied, the mesh growing by what each face adds: presized in
     /// full, it sat next to every face's full working state (wasm memory
-    /// never shrinks, so the peak is what a page keeps). An edge whose two
+    /// never shrinks, so the peak is what a page keeps). Flaps (two
+    /// triangles on one corner set, facing apart) go, an edge whose two
     /// ends sewing put on one point is collapsed, and the triangles left that
     /// fold against the surface are counted; the tessellated faces follow.
     pub fn assemble(&self, run: &mut Run<'m>, works: Works<'_>) -> Mesh {
@@ -492,6 +493,7 @@ impl<'m> Plan<'m> {
             // collapse moves a corner by a hundredth of the tolerance at
             // most, and never turns a facet over or against that normal.
             let mut normals: Vec<glam::DVec3> = (0..wm.tris.len()).map(|t| wm.judged_normal(w.surface, t)).collect();
+            collapse::drop_flaps(&mut wm.tris, &mut normals);
             collapse::collapse_point_edges(&wm.pos, &mut wm.tris, &mut normals);
             shift = shift.max(collapse::collapse_short_inner_edges(&wm.pos, &wm.gid, &mut wm.tris, weld, &mut normals));
             run.report.inverted_triangles += refine::count_folded(&wm.pos, &wm.tris, &normals, weld, 1e-6 * self.tol);
