@@ -20,6 +20,33 @@ pub struct NurbsSurface {
     rational: bool,
 }
 
+/// `$s.$method::<NU, NV>(p, q, args…)` in the scratch sizes
+/// [`NurbsSurface::homogeneous_derivs`] picks for the surface's degrees
+/// `(p, q)`: exact ones up to bicubic, else a class of 4, 8, 12 or
+/// `MAX_DEGREE + 1` for both. The grid and iso-curve paths dispatch through it,
+/// so they take the basis in the same scratch as a point does.
+macro_rules! by_scratch_size {
+    ($s:expr, $method:ident($($arg:expr),*)) => {
+        match ($s.ku.degree(), $s.kv.degree()) {
+            (1, 1) => $s.$method::<2, 2>(1, 1, $($arg),*),
+            (1, 2) => $s.$method::<2, 3>(1, 2, $($arg),*),
+            (2, 1) => $s.$method::<3, 2>(2, 1, $($arg),*),
+            (2, 2) => $s.$method::<3, 3>(2, 2, $($arg),*),
+            (1, 3) => $s.$method::<2, 4>(1, 3, $($arg),*),
+            (3, 1) => $s.$method::<4, 2>(3, 1, $($arg),*),
+            (2, 3) => $s.$method::<3, 4>(2, 3, $($arg),*),
+            (3, 2) => $s.$method::<4, 3>(3, 2, $($arg),*),
+            (3, 3) => $s.$method::<4, 4>(3, 3, $($arg),*),
+            (p, q) => match p.max(q) {
+                0..=3 => $s.$method::<4, 4>(p, q, $($arg),*),
+                4..=7 => $s.$method::<8, 8>(p, q, $($arg),*),
+                8..=11 => $s.$method::<12, 12>(p, q, $($arg),*),
+                _ => $s.$method::<{ super::MAX_DEGREE + 1 }, { super::MAX_DEGREE + 1 }>(p, q, $($arg),*),
+            },
+        }
+    };
+}
+
 impl NurbsSurface {
     /// Builds a surface from a grid of Euclidean points (`points[i][j]`, i along u)
     /// and optional weights of the same shape.
@@ -232,23 +259,7 @@ impl NurbsSurface {
     /// row's basis and its contraction with the control rows (the sums over
     /// `u`, which depend on `u` alone) once per row instead of once per point.
     pub fn point_grid(&self, us: &[f64], vs: &[f64]) -> Vec<DVec3> {
-        match (self.ku.degree(), self.kv.degree()) {
-            (1, 1) => self.point_grid_n::<2, 2>(1, 1, us, vs),
-            (1, 2) => self.point_grid_n::<2, 3>(1, 2, us, vs),
-            (2, 1) => self.point_grid_n::<3, 2>(2, 1, us, vs),
-            (2, 2) => self.point_grid_n::<3, 3>(2, 2, us, vs),
-            (1, 3) => self.point_grid_n::<2, 4>(1, 3, us, vs),
-            (3, 1) => self.point_grid_n::<4, 2>(3, 1, us, vs),
-            (2, 3) => self.point_grid_n::<3, 4>(2, 3, us, vs),
-            (3, 2) => self.point_grid_n::<4, 3>(3, 2, us, vs),
-            (3, 3) => self.point_grid_n::<4, 4>(3, 3, us, vs),
-            (p, q) => match p.max(q) {
-                0..=3 => self.point_grid_n::<4, 4>(p, q, us, vs),
-                4..=7 => self.point_grid_n::<8, 8>(p, q, us, vs),
-                8..=11 => self.point_grid_n::<12, 12>(p, q, us, vs),
-                _ => self.point_grid_n::<{ super::MAX_DEGREE + 1 }, { super::MAX_DEGREE + 1 }>(p, q, us, vs),
-            },
-        }
+        by_scratch_size!(self, point_grid_n(us, vs))
     }
 
     /// [`NurbsSurface::point_grid`] in the scratch sizes
@@ -271,17 +282,7 @@ impl NurbsSurface {
         for &u in us {
             let mut bu = [[0.0; NU]; MAX_DERIV + 1];
             let su = self.basis_pair::<NU, NV, NU>(true, p, q, u, 0, &mut bu);
-            // line[j] = sum over r of P[r][first + j]·Nu[r], summed from zero in r's order.
-            line.fill(DVec4::ZERO);
-            for (r, &w) in bu[0].iter().enumerate().take(p + 1) {
-                let start = (su + r).saturating_sub(p) * nv + first;
-                let Some(row) = self.points.get(start..start + line.len()) else {
-                    continue;
-                };
-                for (t, h) in line.iter_mut().zip(row) {
-                    *t += *h * w;
-                }
-            }
+            self.sum_rows(su, p, &bu[0], first, &mut line);
             for (sv, bv) in &columns {
                 let from = sv.saturating_sub(q).saturating_sub(first);
                 let mut a = DVec4::ZERO;
@@ -292,6 +293,24 @@ impl NurbsSurface {
             }
         }
         out
+    }
+
+    /// `line[j]` = the sum over `r <= p` of `P[su - p + r][first + j]·w[r]`,
+    /// from zero in `r`'s order as [`NurbsSurface::contract_u`] sums: the
+    /// sums over u of the control columns from `first` on, for the grid and
+    /// iso-curve paths. A row past the net adds nothing.
+    fn sum_rows(&self, su: usize, p: usize, w: &[f64], first: usize, line: &mut [DVec4]) {
+        line.fill(DVec4::ZERO);
+        let nv = self.kv.control_count();
+        for (r, &w) in w.iter().enumerate().take(p + 1) {
+            let start = (su + r).saturating_sub(p) * nv + first;
+            let Some(row) = self.points.get(start..start + line.len()) else {
+                continue;
+            };
+            for (t, h) in line.iter_mut().zip(row) {
+                *t += *h * w;
+            }
+        }
     }
 
     /// The basis along u (`along_u`) or v at `t` as
@@ -379,23 +398,7 @@ impl NurbsSurface {
     /// for bit: the fixed parameter's basis is computed once, and with `u`
     /// fixed also its sums over `u`, once for every control column.
     pub fn iso_point_normal(&self, along_u: bool, s: f64) -> Box<dyn Fn(f64) -> (DVec3, DVec3) + '_> {
-        match (self.ku.degree(), self.kv.degree()) {
-            (1, 1) => self.iso_n::<2, 2>(1, 1, along_u, s),
-            (1, 2) => self.iso_n::<2, 3>(1, 2, along_u, s),
-            (2, 1) => self.iso_n::<3, 2>(2, 1, along_u, s),
-            (2, 2) => self.iso_n::<3, 3>(2, 2, along_u, s),
-            (1, 3) => self.iso_n::<2, 4>(1, 3, along_u, s),
-            (3, 1) => self.iso_n::<4, 2>(3, 1, along_u, s),
-            (2, 3) => self.iso_n::<3, 4>(2, 3, along_u, s),
-            (3, 2) => self.iso_n::<4, 3>(3, 2, along_u, s),
-            (3, 3) => self.iso_n::<4, 4>(3, 3, along_u, s),
-            (p, q) => match p.max(q) {
-                0..=3 => self.iso_n::<4, 4>(p, q, along_u, s),
-                4..=7 => self.iso_n::<8, 8>(p, q, along_u, s),
-                8..=11 => self.iso_n::<12, 12>(p, q, along_u, s),
-                _ => self.iso_n::<{ super::MAX_DEGREE + 1 }, { super::MAX_DEGREE + 1 }>(p, q, along_u, s),
-            },
-        }
+        by_scratch_size!(self, iso_n(along_u, s))
     }
 
     /// [`NurbsSurface::iso_point_normal`] in the scratch sizes
@@ -427,17 +430,8 @@ impl NurbsSurface {
             // The sums over u for every control column, as `contract_u` forms them.
             let nv = self.kv.control_count();
             let mut lines = [alloc::vec![DVec4::ZERO; nv], alloc::vec![DVec4::ZERO; nv]];
-            for r in 0..=p {
-                let start = (su - p + r) * nv;
-                let Some(row) = self.points.get(start..start + nv) else {
-                    continue;
-                };
-                for (k, line) in lines.iter_mut().enumerate() {
-                    let w = bu[k][r];
-                    for (t, h) in line.iter_mut().zip(row) {
-                        *t += *h * w;
-                    }
-                }
+            for (line, w) in lines.iter_mut().zip(&bu) {
+                self.sum_rows(su, p, w, 0, line);
             }
             Box::new(move |v: f64| {
                 let mut bv = [[0.0; NV]; MAX_DERIV + 1];
