@@ -59,23 +59,29 @@ pub(crate) fn drop_flaps<T>(tris: &mut Vec<[u32; 3]>, with: &mut Vec<T>) -> usiz
     if gone.is_empty() {
         return 0;
     }
-    let mut keep = alloc::vec![true; tris.len()];
+    let mut dropped = alloc::vec![false; tris.len()];
     for &i in &gone {
-        keep[i as usize] = false;
+        dropped[i as usize] = true;
     }
+    drop_marked(tris, with, &dropped);
+    gone.len()
+}
+
+/// Removes the triangles `dropped` marks, and the same items of `with`
+/// when it has one per triangle.
+fn drop_marked<T>(tris: &mut Vec<[u32; 3]>, with: &mut Vec<T>, dropped: &[bool]) {
     let mut i = 0;
     tris.retain(|_| {
         i += 1;
-        keep[i - 1]
+        !dropped[i - 1]
     });
-    if with.len() == keep.len() {
+    if with.len() == dropped.len() {
         let mut i = 0;
         with.retain(|_| {
             i += 1;
-            keep[i - 1]
+            !dropped[i - 1]
         });
     }
-    gone.len()
 }
 
 /// How far, in census welds, collapses may gather vertices into one: far
@@ -315,18 +321,7 @@ fn collapse_edges_moving<T>(
         }
     }
     if count > 0 {
-        let mut i = 0;
-        tris.retain(|_| {
-            i += 1;
-            !dropped[i - 1]
-        });
-        if with.len() == dropped.len() {
-            let mut i = 0;
-            with.retain(|_| {
-                i += 1;
-                !dropped[i - 1]
-            });
-        }
+        drop_marked(tris, with, &dropped);
     }
     (count, moved)
 }
