@@ -67,6 +67,81 @@ pub(crate) fn drop_flaps<T>(tris: &mut Vec<[u32; 3]>, with: &mut Vec<T>) -> usiz
     gone.len()
 }
 
+/// Drops the flaps the mesh's edge census sees: pairs of triangles whose
+/// corners, with points within `weld` taken for one, are the same three
+/// facing opposite ways. Where refinement crowds points (a near-pole, a
+/// pleat of the (u,v) map) two apexes across an edge land closer than the
+/// weld without an edge between them; the census then counts that edge,
+/// and the pair's other edges, three or four times. The pair's corners that
+/// weld are joined in the face (each onto its weld group's first vertex) so
+/// that the face's own triangles match what the census counts. Returns how
+/// far the farthest joined vertex moved (at most `weld`).
+pub(crate) fn drop_welded_flaps<T>(pos: &[DVec3], tris: &mut Vec<[u32; 3]>, weld: f64, with: &mut Vec<T>) -> f64 {
+    let (map, count) = crate::mesh::weld_positions(pos, weld);
+    if count == pos.len() {
+        return 0.0;
+    }
+    let mut first = alloc::vec![u32::MAX; count];
+    for (v, &g) in map.iter().enumerate() {
+        if first[g as usize] == u32::MAX {
+            first[g as usize] = v as u32;
+        }
+    }
+    let rep = |v: u32| map.get(v as usize).map_or(v, |&g| first[g as usize]);
+    let mut welded: Vec<[u32; 3]> = tris.iter().map(|t| t.map(rep)).collect();
+    let mut kept: Vec<u32> = (0..tris.len() as u32).collect();
+    if drop_flaps(&mut welded, &mut kept) == 0 {
+        return 0.0;
+    }
+    let mut dropped = alloc::vec![true; tris.len()];
+    for &i in &kept {
+        dropped[i as usize] = false;
+    }
+    // The flaps' corners that weld onto another vertex go to it everywhere
+    // in the face; a triangle that leaves without area goes too.
+    let mut joined: HashMap<u32, u32> = HashMap::default();
+    for (t, _) in tris.iter().zip(&dropped).filter(|(_, &d)| d) {
+        for &v in t {
+            if rep(v) != v {
+                joined.insert(v, rep(v));
+            }
+        }
+    }
+    // A join that would turn a kept triangle over (a sliver thinner than
+    // the weld) is not made: that vertex keeps its place, a slit narrower
+    // than the weld, which the census closes.
+    let facet = |t: [u32; 3]| {
+        let p = t.map(|v| pos[v as usize]);
+        (p[1] - p[0]).cross(p[2] - p[0])
+    };
+    let mut turns: Vec<u32> = Vec::new();
+    for (t, _) in tris.iter().zip(&dropped).filter(|(_, &d)| !d) {
+        let new = t.map(|v| joined.get(&v).copied().unwrap_or(v));
+        if new != *t && new[0] != new[1] && new[1] != new[2] && new[2] != new[0] && facet(new).dot(facet(*t)) <= 0.0 {
+            turns.extend(t.iter().copied().filter(|v| joined.contains_key(v)));
+        }
+    }
+    for v in turns {
+        joined.remove(&v);
+    }
+    let mut shift: f64 = 0.0;
+    for (&v, &r) in joined.iter() {
+        shift = shift.max(pos[v as usize].distance(pos[r as usize]));
+    }
+    for (t, d) in tris.iter_mut().zip(dropped.iter_mut()) {
+        for v in t.iter_mut() {
+            if let Some(&r) = joined.get(v) {
+                *v = r;
+            }
+        }
+        if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
+            *d = true;
+        }
+    }
+    drop_marked(tris, with, &dropped);
+    shift
+}
+
 /// Removes the triangles `dropped` marks, and the same items of `with`
 /// when it has one per triangle.
 fn drop_marked<T>(tris: &mut Vec<[u32; 3]>, with: &mut Vec<T>, dropped: &[bool]) {
@@ -380,6 +455,34 @@ mod tests {
         // The same triangle twice the same way round is no flap.
         let mut twice = alloc::vec![[0, 2, 3], [2, 3, 0]];
         assert_eq!(drop_flaps(&mut twice, &mut Vec::<()>::new()), 0);
+    }
+
+    /// Two triangles across edge 0-1 whose apexes 2 and 3 lie closer than
+    /// the weld (refinement crowding a near-pole) face opposite ways: to
+    /// the census they are one flap, counting 0-1 three times with the
+    /// fan's triangle 0-4-1. The pair goes, 3 joins 2 in its other
+    /// triangle, and the move is reported; a weld that does not reach from 3
+    /// to 2 leaves the face alone.
+    #[test]
+    fn a_flap_the_weld_makes_goes_and_its_apexes_join() {
+        let pos = [
+            DVec3::ZERO,
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.5, 1.0, 0.0),
+            DVec3::new(0.5, 1.0, 1e-7),
+            DVec3::new(0.5, -1.0, 0.0),
+            DVec3::new(-0.5, 1.0, 0.0),
+        ];
+        let faces = alloc::vec![[0, 1, 2], [1, 0, 3], [0, 4, 1], [3, 0, 5]];
+        let mut tris = faces.clone();
+        let mut tags: Vec<u32> = (0..tris.len() as u32).collect();
+        let shift = drop_welded_flaps(&pos, &mut tris, 1e-6, &mut tags);
+        assert_eq!(tris, [[0, 4, 1], [2, 0, 5]]);
+        assert_eq!(tags, [2, 3]);
+        assert!(shift > 0.0 && shift <= 1e-6, "the join moved 3 by {shift}");
+        let mut apart = faces.clone();
+        assert_eq!(drop_welded_flaps(&pos, &mut apart, 1e-8, &mut Vec::<()>::new()), 0.0);
+        assert_eq!(apart, faces);
     }
 
     /// Two border vertices at one point joined by an inner edge: collapsing

@@ -496,6 +496,7 @@ impl<'m> Plan<'m> {
             collapse::drop_flaps(&mut wm.tris, &mut normals);
             collapse::collapse_point_edges(&wm.pos, &mut wm.tris, &mut normals);
             shift = shift.max(collapse::collapse_short_inner_edges(&wm.pos, &wm.gid, &mut wm.tris, weld, &mut normals));
+            shift = shift.max(collapse::drop_welded_flaps(&wm.pos, &mut wm.tris, weld, &mut normals));
             run.report.inverted_triangles += refine::count_folded(&wm.pos, &wm.tris, &normals, weld, 1e-6 * self.tol);
             append_face(&mut mesh, &wm);
         }
