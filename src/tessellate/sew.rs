@@ -171,6 +171,8 @@ struct Junction {
     gap: f64,
     /// The other face's nodes in between: id and position.
     nodes: Vec<(u32, DVec3)>,
+    /// Per vertex of `run`: whether no other face holds its node.
+    own: Vec<bool>,
 }
 
 /// The T-junctions of [`close_t_junctions`]: per pair of faces, each
@@ -244,8 +246,13 @@ fn t_junctions(faces: &[FaceWork<'_>], uses: &Uses) -> Vec<Junction> {
                     theirs.iter().map(|&x| Some((x, g.mesh.pos[place(x, fb)? as usize]))).collect();
                 let gap =
                     |id: u32| Some(f.mesh.pos[place(id, fa)? as usize].distance(g.mesh.pos[place(id, fb)? as usize]));
+                let own = core::iter::once(ga)
+                    .chain(mine.iter().copied())
+                    .chain([gb])
+                    .map(|x| holders.get(&x).is_some_and(|h| h.len() == 1))
+                    .collect();
                 if let (Some(run), Some(nodes), Some(g0), Some(g1)) = (run, nodes, gap(ga), gap(gb)) {
-                    junctions.push(Junction { face: fa as usize, run, gap: g0.max(g1), nodes });
+                    junctions.push(Junction { face: fa as usize, run, gap: g0.max(g1), nodes, own });
                 }
             }
         }
@@ -255,10 +262,17 @@ fn t_junctions(faces: &[FaceWork<'_>], uses: &Uses) -> Vec<Junction> {
 
 /// Each junction's face takes the other face's nodes on its border, where
 /// all of them run along it within its sewing distance (`sew` of the face); returns
-/// whether any border edge was split.
+/// whether any border edge was split. A node whose nearest border point is
+/// one of the face's own nodes (no other face has it) becomes that node:
+/// the vertex takes its id. Split in beside it, the node would sit a
+/// hair's breadth from it, and where both faces take each other's node
+/// each puts the pair in its own order, so their borders cross and
+/// overlap there.
 fn take_their_nodes(faces: &mut [FaceWork<'_>], junctions: Vec<Junction>, sew: &dyn Fn(usize) -> f64) -> bool {
     let mut split = false;
-    for Junction { face, mut run, gap, nodes } in junctions {
+    // Ids that a vertex gave up for another face's node: old to new.
+    let mut renamed: HashMap<u32, u32> = HashMap::default();
+    for Junction { face, mut run, gap, nodes, mut own } in junctions {
         let sew = sew(face);
         let f = &mut faces[face];
         // Per edge of the run from `from` on: its index, the fraction of its
@@ -282,6 +296,11 @@ fn take_their_nodes(faces: &mut [FaceWork<'_>], junctions: Vec<Junction>, sew: &
         }
         let mut from = 0;
         for (g, p) in nodes {
+            // A node another junction made one with a vertex of this run is here already.
+            let g = renamed.get(&g).copied().unwrap_or(g);
+            if run.iter().any(|&v| f.mesh.gid[v as usize] == g) {
+                continue;
+            }
             // The nearest of the run's edges from the last node added on.
             let Some((i, frac, e, limit)) = near(f, &run, from, p).into_iter().min_by(|x, y| x.2.total_cmp(&y.2))
             else {
@@ -290,12 +309,27 @@ fn take_their_nodes(faces: &mut [FaceWork<'_>], junctions: Vec<Junction>, sew: &
             if e > limit {
                 continue;
             }
+            // The border point at an end of the edge that is this face's own node: that node.
+            let at_node = [(i, 0.0), (i + 1, 1.0)].into_iter().find(|&(j, end)| {
+                let v = run[j] as usize;
+                own[j] && (frac - end).abs() <= 1e-3 && f.mesh.pos[v].distance(p) <= limit
+            });
+            if let Some((j, _)) = at_node {
+                let v = run[j] as usize;
+                renamed.insert(f.mesh.gid[v], g);
+                f.mesh.gid[v] = g;
+                own[j] = false;
+                from = j;
+                split = true;
+                continue;
+            }
             let mut changed = Vec::new();
             let (c, d) = (run[i], run[i + 1]);
             let Some(n) = f.mesh.split_edge_at(f.surface, &f.curves, c, d, frac, None, &mut changed) else { continue };
             f.mesh.gid[n as usize] = g;
             f.mesh.forget(&changed);
             run.insert(i + 1, n);
+            own.insert(i + 1, false);
             from = i + 1;
             split = true;
         }
@@ -723,5 +757,70 @@ mod tests {
             assert_eq!(gids(&faces[0]), want, "sew {sew}");
             assert_eq!(gids(&faces[1]), [(1, 3), (2, 3)], "sew {sew}");
         }
+    }
+
+    /// Faces A and B share nodes 1 and 2; between them each border bends
+    /// at a node of its own, A's 4 at x = 1.01, B's 3 at x = 1.03. B's node
+    /// is nearest A's border at A's node: split in beside it, A's border
+    /// would run 1-3-4-2 while B, taking 4, runs 1-4-3-2, the two crossing
+    /// over and overlapping. A's node takes B's id instead, and B has
+    /// nothing left to take: both run 1-3-2.
+    #[test]
+    fn a_node_nearest_a_node_of_the_other_border_becomes_it() {
+        let plane = plane();
+        let crit = CRIT;
+        let mesh = |pts: &[(f64, f64, u32)], tris: &[[u32; 3]]| {
+            let mut m = WorkMesh::default();
+            for &(x, y, g) in pts {
+                let v = m.add_vertex(DVec3::new(x, y, 0.0), DVec3::Z);
+                if g != 0 {
+                    m.gid[v as usize] = g;
+                }
+            }
+            for t in tris {
+                m.add_triangle(*t, t.map(|v| DVec2::new(pts[v as usize].0, pts[v as usize].1)));
+            }
+            m
+        };
+        let a = mesh(
+            &[(0.0, 0.0, 0), (1.0, 0.0, 1), (1.01, 0.5, 4), (1.0, 1.0, 2), (0.0, 1.0, 0)],
+            &[[0, 1, 2], [0, 2, 3], [0, 3, 4]],
+        );
+        let b = mesh(
+            &[(1.0, 0.0, 1), (2.0, 0.0, 0), (2.0, 1.0, 0), (1.0, 1.0, 2), (1.03, 0.5, 3)],
+            &[[0, 1, 4], [1, 2, 4], [2, 3, 4]],
+        );
+        let mut faces = alloc::vec![
+            FaceWork { surface: &plane, curves: Vec::new(), mesh: a, crit },
+            FaceWork { surface: &plane, curves: Vec::new(), mesh: b, crit },
+        ];
+        close_t_junctions(&mut faces, &|_| 0.1);
+        // Each face's border from node 1 to node 2, by ids.
+        let path = |f: &FaceWork<'_>| -> Vec<u32> {
+            let edges = f.mesh.boundary_edges();
+            let start = f.mesh.gid.iter().position(|&g| g == 1).unwrap_or(0) as u32;
+            let mut out = alloc::vec![1];
+            let mut cur = start;
+            for _ in 0..4 {
+                let next = edges.iter().find_map(|&(a, b)| {
+                    let n = if a == cur {
+                        b
+                    } else if b == cur {
+                        a
+                    } else {
+                        return None;
+                    };
+                    let g = f.mesh.gid[n as usize];
+                    (g != NONE && !out.contains(&g)).then_some(n)
+                });
+                let Some(n) = next else { break };
+                out.push(f.mesh.gid[n as usize]);
+                cur = n;
+            }
+            out
+        };
+        assert_eq!(path(&faces[0]), [1, 3, 2]);
+        assert_eq!(path(&faces[1]), [1, 3, 2]);
+        assert_eq!(faces[0].mesh.pos.len(), 5, "no vertex split in beside A's node");
     }
 }
