@@ -180,11 +180,12 @@ fn demand_parts(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limi
             fold = turn / lim.angle;
         }
     } else if turn > 0.0 {
-        // Within a tenth of the tolerance of a trim border, a turn is split
-        // no finer than refinement splits a triangle for it
-        // (`Criteria::short_for_angle`): lines packed into a curl of the
-        // surface along the border leave slivers between them and the
-        // border, whose facets fold on the surface's bend along them.
+        // Within a tenth of this pass's tolerance of a trim border, a turn
+        // is split no finer than that: refinement splits a triangle for it
+        // down to a tenth of the whole tolerance (`Criteria::short_for_angle`),
+        // and lines packed into a curl of the surface along the border leave
+        // slivers between them and the border, whose facets fold on the
+        // surface's bend along them.
         let floor = BEND_FLOOR * lim.tol;
         let at_border = one_sided
             && side.piece.is_some_and(|(lo, hi)| {
@@ -200,8 +201,10 @@ fn demand_parts(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limi
     Demand { smooth: demand, fold, sag }
 }
 
-/// The shortest part, as a fraction of the tolerance, an interval by a trim
-/// border is split into for its normal's turn: refinement's floor for a bend.
+/// The shortest part, as a fraction of the pass's tolerance (half to all of
+/// the face's), an interval by a trim border is split into for its normal's
+/// turn: at most refinement's floor for a bend. A floor of the whole
+/// tolerance left parts refinement still split, at many more triangles.
 const BEND_FLOOR: f64 = 0.1;
 
 /// Distance from `p` to the segment `ab`.
