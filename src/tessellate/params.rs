@@ -83,17 +83,17 @@ pub(crate) const MAX_PARAMS: usize = 20_000;
 
 /// How badly the interval `[a, b]` fails: the factor by which it must be
 /// split (1.0 = accepted). `eval(t)` gives point and unit normal (or tangent).
-fn interval_need(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits, one_sided: bool) -> (f64, f64) {
-    let (demand, sag) = interval_demand(eval, a, b, lim, one_sided);
+fn interval_need(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits, side: Side) -> (f64, f64) {
+    let (demand, sag) = interval_demand(eval, a, b, lim, side);
     (demand.max(1.0), sag)
 }
 
 /// How many chords `[a, b]` needs, as a fraction, and its largest sag: sag
 /// falls as the square of the step, turn and length as the step, so over
 /// short intervals the demand adds up along the curve. 0 at or below the
-/// shortest edge. With `one_sided`, see [`Probe::one_sided`].
-fn interval_demand(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits, one_sided: bool) -> (f64, f64) {
-    let d = demand_parts(eval, a, b, lim, one_sided);
+/// shortest edge. With `side`, see [`Side`].
+fn interval_demand(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits, side: Side) -> (f64, f64) {
+    let d = demand_parts(eval, a, b, lim, side);
     (d.smooth.max(d.fold), d.sag)
 }
 
@@ -111,8 +111,18 @@ struct Demand {
     sag: f64,
 }
 
+/// How an interval of a probe is judged: `one_sided` as [`Probe::one_sided`],
+/// and `piece`, the run of the iso-line inside the trim loops it lies in
+/// (`None`: the whole line counts).
+#[derive(Clone, Copy)]
+struct Side {
+    one_sided: bool,
+    piece: Option<(f64, f64)>,
+}
+
 /// [`interval_demand`] with the fold's part apart ([`Demand`]).
-fn demand_parts(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits, one_sided: bool) -> Demand {
+fn demand_parts(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits, side: Side) -> Demand {
+    let one_sided = side.one_sided;
     let (pa, na) = eval(a);
     let (pb, nb) = eval(b);
     let chord = pb - pa;
@@ -170,13 +180,32 @@ fn demand_parts(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limi
             fold = turn / lim.angle;
         }
     } else if turn > 0.0 {
-        demand = demand.max(turn / lim.angle);
+        // Within a tenth of this pass's tolerance of a trim border, a turn
+        // is split no finer than that: refinement splits a triangle for it
+        // down to a tenth of the whole tolerance (`Criteria::short_for_angle`),
+        // and lines packed into a curl of the surface along the border leave
+        // slivers between them and the border, whose facets fold on the
+        // surface's bend along them.
+        let floor = BEND_FLOOR * lim.tol;
+        let at_border = one_sided
+            && side.piece.is_some_and(|(lo, hi)| {
+                let gap = |t: f64, end: f64| if t == end { 0.0 } else { eval(t).0.distance(eval(end).0) };
+                gap(a, lo).min(gap(b, hi)) <= floor
+            });
+        let most = if at_border { len / floor } else { f64::INFINITY };
+        demand = demand.max((turn / lim.angle).min(most));
     }
     if len > 0.0 {
         demand = demand.max(len / lim.max_edge);
     }
     Demand { smooth: demand, fold, sag }
 }
+
+/// The shortest part, as a fraction of the pass's tolerance (half to all of
+/// the face's), an interval by a trim border is split into for its normal's
+/// turn: at most refinement's floor for a bend. A floor of the whole
+/// tolerance left parts refinement still split, at many more triangles.
+const BEND_FLOOR: f64 = 0.1;
 
 /// Distance from `p` to the segment `ab`.
 pub(crate) fn dist_to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
@@ -383,12 +412,12 @@ fn demand_all(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits) -> Demand {
         all.fold = all.fold.max(d.fold);
         all.sag = all.sag.max(d.sag);
     };
-    each_part(probes, a, b, |p, x, y| take(demand_parts(p.eval, x, y, lim, p.one_sided)));
+    each_part(probes, a, b, |p, x, y, side| take(demand_parts(p.eval, x, y, lim, side)));
     all
 }
 
 /// A test of one interval of one curve: a need and the largest sag.
-type IntervalTest = fn(&dyn Fn(f64) -> (DVec3, DVec3), f64, f64, &Limits, bool) -> (f64, f64);
+type IntervalTest = fn(&dyn Fn(f64) -> (DVec3, DVec3), f64, f64, &Limits, Side) -> (f64, f64);
 
 /// The largest `test` over the parts of `[a, b]` where each probe matters, starting from `floor`.
 fn over_probes(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits, test: IntervalTest, floor: f64) -> (f64, f64) {
@@ -398,23 +427,23 @@ fn over_probes(probes: &[Probe<'_>], a: f64, b: f64, lim: &Limits, test: Interva
         need = need.max(n);
         sag = sag.max(s);
     };
-    each_part(probes, a, b, |p, x, y| take(test(p.eval, x, y, lim, p.one_sided)));
+    each_part(probes, a, b, |p, x, y, side| take(test(p.eval, x, y, lim, side)));
     (need, sag)
 }
 
 /// Calls `f` with each probe and each part `[x, y]` of `[a, b]` where it
 /// matters: the whole interval, or only the parts inside the probe's
-/// region (a piece a rounding error long says nothing).
-fn each_part<'e>(probes: &[Probe<'e>], a: f64, b: f64, mut f: impl FnMut(&Probe<'e>, f64, f64)) {
+/// region (a piece a rounding error long says nothing), with how to judge it.
+fn each_part<'e>(probes: &[Probe<'e>], a: f64, b: f64, mut f: impl FnMut(&Probe<'e>, f64, f64, Side)) {
     for p in probes {
         match &p.inside {
-            None => f(p, a, b),
+            None => f(p, a, b, Side { one_sided: p.one_sided, piece: None }),
             Some(pieces) => {
                 let eps = (b - a) * 1e-9;
                 for &(lo, hi) in pieces {
                     let (x, y) = (a.max(lo), b.min(hi));
                     if y - x > eps {
-                        f(p, x, y);
+                        f(p, x, y, Side { one_sided: p.one_sided, piece: Some((lo, hi)) });
                     }
                 }
             }
@@ -754,6 +783,35 @@ mod tests {
         let (ts, _) = subdivide_probes(&probes, &[0.0, 1.0], &l, MAX_PARAMS);
         let steps: Vec<f64> = ts.windows(2).map(|w| w[1] - w[0]).collect();
         assert!(steps.iter().all(|d| (d - steps[0]).abs() < 1e-12), "{ts:?}");
+    }
+
+    /// A surface that curls over within a hair of its trim border (the
+    /// iso-line runs straight, then its normal turns 80° over its last
+    /// 0.002, and the loop cuts it inside that curl): lines are not packed
+    /// into the curl against the border, where they left slivers between
+    /// them and the border that folded once refined. The same curl inside
+    /// the loops, away from any border, is still split for its turn.
+    #[test]
+    fn a_curl_at_a_trim_border_gets_no_packed_lines() {
+        let curl_at = |c: f64| {
+            move |t: f64| {
+                let s = ((t - c) / 0.002).clamp(0.0, 1.0);
+                let a = 1.4 * s;
+                (DVec3::new(t, 0.0, 0.0), DVec3::new(0.0, a.sin(), a.cos()))
+            }
+        };
+        let l = lim(0.05);
+        let floor = BEND_FLOOR * l.tol;
+        let (edge, border) = (curl_at(0.9985), 0.9995);
+        let probes = [Probe { eval: &edge, inside: Some(alloc::vec![(0.0, border)]), one_sided: true }];
+        let (ts, _) = subdivide_probes(&probes, &[0.0, 1.0], &l, MAX_PARAMS);
+        let packed = ts.iter().filter(|&&t| t < border && border - t < 0.5 * floor).count();
+        assert!(packed == 0, "{packed} lines within {} of the border: {ts:?}", 0.5 * floor);
+        let inner = curl_at(0.5);
+        let probes = [Probe { eval: &inner, inside: Some(alloc::vec![(0.0, border)]), one_sided: true }];
+        let (ts, _) = subdivide_probes(&probes, &[0.0, 1.0], &l, MAX_PARAMS);
+        let across = ts.iter().filter(|&&t| (0.5..=0.502).contains(&t)).count();
+        assert!(across >= 2, "{ts:?}");
     }
 
     /// On a curve whose bend is concentrated (a parabola sharp at one end),
