@@ -598,6 +598,66 @@ mod tests {
         NurbsSurface::try_new([3, 3], k.clone(), k, pts, None).unwrap()
     }
 
+    /// A wavy bicubic over 7 by 5 control points whose u parameter crowds
+    /// (most of its range covers the first tenth of x), as rebuilds get.
+    fn crowded_wave() -> FaceSurface {
+        let xs = [0.0, 0.05, 0.1, 0.15, 0.2, 4.0, 10.0];
+        let pts: Vec<Vec<DVec3>> = xs
+            .iter()
+            .map(|&x| (0..5).map(|j| DVec3::new(x, j as f64, libm::sin(0.6 * x) + 0.3 * libm::cos(j as f64))).collect())
+            .collect();
+        let ku = vec![0.0, 0.0, 0.0, 0.0, 0.2, 0.5, 0.7, 1.0, 1.0, 1.0, 1.0];
+        let kv = vec![0.0, 0.0, 0.0, 0.0, 0.4, 1.0, 1.0, 1.0, 1.0];
+        FaceSurface::Nurbs(NurbsSurface::try_new([3, 3], ku, kv, &pts, None).unwrap())
+    }
+
+    /// The fold check point by point, as it read before it went by rows.
+    fn folds_one_by_one(fit: &Fit, old: &FaceSurface) -> [bool; 2] {
+        let mut out = [false; 2];
+        for k in (0..fit.check_keys()).filter(|k| k % 3 < 2) {
+            let Some((st, start)) = fit.check_point(k) else { continue };
+            let n = fit.surface.normal(st);
+            if crate::math::angle_between(n, old.normal(start)) <= FOLD {
+                continue;
+            }
+            let at = crate::nurbs::project_to_surface(old, fit.surface.point(st), Some(start), &projection()).uv;
+            out[k % 3] |= crate::math::angle_between(n, old.normal(at)) > FOLD;
+        }
+        out
+    }
+
+    /// The check's distances from grids are, bit for bit and key by key,
+    /// those of each point evaluated alone; the fold check by rows finds
+    /// what it finds point by point, on a rebuild that does not fold and
+    /// on one turned over (its v reversed, so every normal flips).
+    #[test]
+    fn grid_and_row_checks_match_the_pointwise_ones() {
+        let old = crowded_wave();
+        let facts = SurfaceFacts::default();
+        for (n, m) in [(7, 5), (16, 3), (40, 21)] {
+            let mut fit = fit_once(&old, &facts, (n, m), Spacing::Mean).unwrap();
+            let want: Vec<(u64, u32)> = (0..fit.check_keys())
+                .filter_map(|k| {
+                    let (st, start) = fit.check_point(k)?;
+                    Some((fit.surface.point(st).distance(old.point(start)).to_bits(), k as u32))
+                })
+                .collect();
+            let got: Vec<(u64, u32)> = fit.start_distances(&old).iter().map(|&(d, k)| (d.to_bits(), k)).collect();
+            assert_eq!(got, want, "{n} x {m}");
+            assert_eq!(fit.folds(&old, &facts), folds_one_by_one(&fit, &old));
+            assert_eq!(fit.folds(&old, &facts), [false; 2], "{n} x {m}");
+            // Turned over: S'(u, v) = S(u, 1 - v).
+            let [_, cv] = fit.surface.counts();
+            let net: Vec<DVec3> = fit.surface.control_points().collect();
+            let pts: Vec<Vec<DVec3>> = net.chunks(cv).map(|row| row.iter().rev().copied().collect()).collect();
+            let kv: Vec<f64> = fit.surface.knots_v().knots().iter().rev().map(|k| 1.0 - k).collect();
+            let ku = fit.surface.knots_u().knots().to_vec();
+            fit.surface = NurbsSurface::try_new([3, 3], ku, kv, &pts, None).unwrap();
+            assert_eq!(fit.folds(&old, &facts), folds_one_by_one(&fit, &old));
+            assert_eq!(fit.folds(&old, &facts), [true; 2], "{n} x {m} turned over");
+        }
+    }
+
     /// A border that leaves its corner backwards is turned to the original's
     /// direction with its length kept; nothing else moves, and a net with
     /// no such border is left alone.
