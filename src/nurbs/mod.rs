@@ -27,7 +27,7 @@ pub use curve::{CurveDerivs, NurbsCurve};
 pub use error::NurbsError;
 pub use knots::{BasisDers, KnotVector};
 pub use project::{project_to_surface, CurveProjection, Projection, ProjectionOptions};
-pub(crate) use project::{project_until, project_with, SurfaceFacts};
+pub(crate) use project::{project_with, SurfaceFacts};
 pub use surface::NurbsSurface;
 
 /// Highest degree accepted (basis functions use fixed-size scratch arrays).

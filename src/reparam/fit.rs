@@ -9,7 +9,7 @@ use glam::{DVec2, DVec3};
 use super::interp::{self, chord_params, interpolate_surface};
 use super::{FIT_LIMIT, FIT_SHARE, MAX_SAMPLES};
 use crate::model::FaceSurface;
-use crate::nurbs::{project_to_surface, project_until, NurbsSurface, ProjectionOptions, Surface, SurfaceDerivs};
+use crate::nurbs::{project_with, NurbsSurface, ProjectionOptions, Surface, SurfaceDerivs, SurfaceFacts};
 use crate::warning::RebuildError;
 
 /// Piecewise-linear monotone map between the original parameters of the
@@ -307,20 +307,83 @@ impl Fit {
     /// Per direction (`[along u, along v]`), whether the new surface's
     /// normal turns more than [`FOLD`] from the original's at the mid-point
     /// of an edge along it (a cell centre folds with its edges). A start
-    /// whose normal is off is checked again at the projection, since across
-    /// a tight bend the mapped start can lie past it.
-    fn folds(&self, old: &FaceSurface) -> [bool; 2] {
+    /// whose normal is off is checked again at the projection (`facts`
+    /// belong to `old`), since across a tight bend the mapped start can lie
+    /// past it. The normals are taken a row of checked points at a time
+    /// ([`Surface::iso_point_normal`]: the same values, the row's own sums once).
+    fn folds(&self, old: &FaceSurface, facts: &SurfaceFacts) -> [bool; 2] {
         let opts = projection();
         let mut out = [false; 2];
-        for k in (0..self.check_keys()).filter(|k| k % 3 < 2) {
-            let dir = k % 3;
-            let Some((st, start)) = self.check_point(k).filter(|_| !out[dir]) else { continue };
-            let n = self.surface.normal(st);
-            if crate::math::angle_between(n, old.normal(start)) <= FOLD {
+        let (lu, lv) = (&self.line_u, &self.line_v);
+        // Edge mid-points along u sit on the odd rows at even columns, those
+        // along v on the even rows at odd columns.
+        for (a, (&su, &ou)) in lu.new.iter().zip(&lu.old).enumerate() {
+            let dir = if a % 2 == 1 { 0 } else { 1 };
+            if out[dir] {
                 continue;
             }
-            let at = project_to_surface(old, self.surface.point(st), Some(start), &opts).uv;
-            out[dir] = crate::math::angle_between(n, old.normal(at)) > FOLD;
+            let (new_row, old_row) = (self.surface.iso_point_normal(false, su), old.iso_point_normal(false, ou));
+            for (&sv, &ov) in lv.new.iter().zip(&lv.old).skip(dir).step_by(2) {
+                let n = new_row(sv).1;
+                if crate::math::angle_between(n, old_row(ov).1) <= FOLD {
+                    continue;
+                }
+                let (st, start) = (DVec2::new(su, sv), DVec2::new(ou, ov));
+                let p = self.surface.point(st);
+                let at = project_with(old, facts, p, Some(start), &opts, f64::NEG_INFINITY).uv;
+                if crate::math::angle_between(n, old.normal(at)) > FOLD {
+                    out[dir] = true;
+                    break;
+                }
+            }
+            if out == [true; 2] {
+                break;
+            }
+        }
+        out
+    }
+
+    /// Per checked point by key ([`Fit::check_point`]), in key order: the
+    /// distance between the new surface's point and the original's at the
+    /// start its parameters map to, with the key. The points are evaluated
+    /// on grids a few node rows at a time ([`Surface::point_grid`]: the same
+    /// values, each row's and column's basis found once).
+    fn start_distances(&self, old: &FaceSurface) -> Vec<(f64, u32)> {
+        /// Node rows per block: the grids stay small (two surfaces, about
+        /// 32 rows of 801 points at 400 × 400 samples).
+        const BLOCK: usize = 16;
+        let (lu, lv) = (&self.line_u, &self.line_v);
+        let (nu, nv) = (self.map_u.new.len(), self.map_v.new.len());
+        let odd = |x: &[f64]| -> Vec<f64> { x.iter().skip(1).step_by(2).copied().collect() };
+        let (odd_new, odd_old) = (odd(&lv.new), odd(&lv.old));
+        let mut out = Vec::with_capacity(self.check_keys());
+        for i0 in (0..nu).step_by(BLOCK) {
+            let i1 = (i0 + BLOCK).min(nu);
+            // Grid rows 2i + 1 at every column, rows 2i at the odd ones.
+            let rows = |x: &[f64], first: usize| -> Vec<f64> {
+                (i0..i1).filter_map(|i| x.get(2 * i + first).copied()).collect()
+            };
+            let full_new = self.surface.point_grid(&rows(&lu.new, 1), &lv.new);
+            let full_old = old.point_grid(&rows(&lu.old, 1), &lv.old);
+            let half_new = self.surface.point_grid(&rows(&lu.new, 0), &odd_new);
+            let half_old = old.point_grid(&rows(&lu.old, 0), &odd_old);
+            let (wf, wh) = (lv.new.len(), odd_new.len());
+            for i in i0..i1 {
+                let r = i - i0;
+                for j in 0..nv {
+                    let node = i * nv + j;
+                    // Keys 3 × node + 0, 1, 2: (2i + 1, 2j), (2i, 2j + 1), (2i + 1, 2j + 1).
+                    let at = [(r * wf + 2 * j, true), (r * wh + j, false), (r * wf + 2 * j + 1, true)];
+                    for (dir, (k, full)) in at.into_iter().enumerate() {
+                        let (new, old) = if full { (&full_new, &full_old) } else { (&half_new, &half_old) };
+                        let inside = if full { 2 * i + 1 < lu.new.len() } else { true };
+                        let inside = inside && (if dir == 0 { 2 * j } else { 2 * j + 1 }) < lv.new.len();
+                        if let (true, Some(p), Some(q)) = (inside, new.get(k), old.get(k)) {
+                            out.push((p.distance(*q), (3 * node + dir) as u32));
+                        }
+                    }
+                }
+            }
         }
         out
     }
@@ -389,8 +452,14 @@ fn unreverse_corners(new: &NurbsSurface, old: &FaceSurface, us: &[f64], vs: &[f6
 
 /// Samples, interpolates (paper 001 steps 3–4) and checks one rebuild at
 /// `n × m` intervals: the new surface at mid-points of grid edges and cells
-/// is projected onto the original from the mapped parameters.
-fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Result<Fit, RebuildError> {
+/// is projected onto the original from the mapped parameters (`facts`
+/// belong to the original).
+fn fit_once(
+    surface: &FaceSurface,
+    facts: &SurfaceFacts,
+    (n, m): (usize, usize),
+    spacing: Spacing,
+) -> Result<Fit, RebuildError> {
     let (us, arc_u) = even_params(surface, true, n, spacing);
     let (vs, arc_v) = even_params(surface, false, m, spacing);
     let flat = surface.point_grid(&us, &vs);
@@ -408,12 +477,7 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Resu
     let opts = projection();
     // Each point with its distance to the original's point at the start
     // (kept small: a 400 × 400 rebuild checks half a million points).
-    let mut checks: Vec<(f64, u32)> = Vec::with_capacity(fit.check_keys());
-    for key in 0..fit.check_keys() {
-        if let Some((st, start)) = fit.check_point(key) {
-            checks.push((fit.surface.point(st).distance(surface.point(start)), key as u32));
-        }
-    }
+    let mut checks = fit.start_distances(surface);
     // Both the projection and the start point are actual points of the
     // original, so the smaller distance still bounds the true one (Newton
     // can stall where the original's parameter speed jumps). A point whose
@@ -426,7 +490,7 @@ fn fit_once(surface: &FaceSurface, n: usize, m: usize, spacing: Spacing) -> Resu
         let dir = key as usize % 3;
         let Some((st, start)) = fit.check_point(key as usize).filter(|_| near > worst[dir]) else { continue };
         let p = fit.surface.point(st);
-        worst[dir] = worst[dir].max(project_until(surface, p, Some(start), &opts, worst[dir]).distance.min(near));
+        worst[dir] = worst[dir].max(project_with(surface, facts, p, Some(start), &opts, worst[dir]).distance.min(near));
     }
     let (mut errors, centre) = ([worst[0], worst[1]], worst[2]);
     // A cell centre off the original is charged to the direction whose edges are worse.
@@ -450,15 +514,17 @@ pub(super) fn fit_within(surface: &FaceSurface, tol: f64, spacing: Spacing) -> R
     let mut n = sample_count(surface, true, tol);
     let mut m = sample_count(surface, false, tol);
     let mut best: Option<Fit> = None;
+    // What the projections onto the original learn about it, for all fits.
+    let facts = SurfaceFacts::default();
     // The first fit within the goal that folds, kept while more samples try
     // to unfold it; if they cannot, it is used (the mesh trial judges it).
     let mut folded: Option<Fit> = None;
     let mut unfold_steps = 0;
     let fit = loop {
-        let fit = fit_once(surface, n, m, spacing)?;
+        let fit = fit_once(surface, &facts, (n, m), spacing)?;
         let [eu, ev] = fit.errors;
         if eu <= goal && ev <= goal {
-            let folds = fit.folds(surface);
+            let folds = fit.folds(surface, &facts);
             if folds == [false; 2] {
                 break fit;
             }
@@ -530,6 +596,66 @@ mod tests {
     fn bicubic(pts: &[Vec<DVec3>]) -> NurbsSurface {
         let k = vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
         NurbsSurface::try_new([3, 3], k.clone(), k, pts, None).unwrap()
+    }
+
+    /// A wavy bicubic over 7 by 5 control points whose u parameter crowds
+    /// (most of its range covers the first tenth of x), as rebuilds get.
+    fn crowded_wave() -> FaceSurface {
+        let xs = [0.0, 0.05, 0.1, 0.15, 0.2, 4.0, 10.0];
+        let pts: Vec<Vec<DVec3>> = xs
+            .iter()
+            .map(|&x| (0..5).map(|j| DVec3::new(x, j as f64, libm::sin(0.6 * x) + 0.3 * libm::cos(j as f64))).collect())
+            .collect();
+        let ku = vec![0.0, 0.0, 0.0, 0.0, 0.2, 0.5, 0.7, 1.0, 1.0, 1.0, 1.0];
+        let kv = vec![0.0, 0.0, 0.0, 0.0, 0.4, 1.0, 1.0, 1.0, 1.0];
+        FaceSurface::Nurbs(NurbsSurface::try_new([3, 3], ku, kv, &pts, None).unwrap())
+    }
+
+    /// The fold check point by point, as it read before it went by rows.
+    fn folds_one_by_one(fit: &Fit, old: &FaceSurface) -> [bool; 2] {
+        let mut out = [false; 2];
+        for k in (0..fit.check_keys()).filter(|k| k % 3 < 2) {
+            let Some((st, start)) = fit.check_point(k) else { continue };
+            let n = fit.surface.normal(st);
+            if crate::math::angle_between(n, old.normal(start)) <= FOLD {
+                continue;
+            }
+            let at = crate::nurbs::project_to_surface(old, fit.surface.point(st), Some(start), &projection()).uv;
+            out[k % 3] |= crate::math::angle_between(n, old.normal(at)) > FOLD;
+        }
+        out
+    }
+
+    /// The check's distances from grids are, bit for bit and key by key,
+    /// those of each point evaluated alone; the fold check by rows finds
+    /// what it finds point by point, on a rebuild that does not fold and
+    /// on one turned over (its v reversed, so every normal flips).
+    #[test]
+    fn grid_and_row_checks_match_the_pointwise_ones() {
+        let old = crowded_wave();
+        let facts = SurfaceFacts::default();
+        for (n, m) in [(7, 5), (16, 3), (40, 21)] {
+            let mut fit = fit_once(&old, &facts, (n, m), Spacing::Mean).unwrap();
+            let want: Vec<(u64, u32)> = (0..fit.check_keys())
+                .filter_map(|k| {
+                    let (st, start) = fit.check_point(k)?;
+                    Some((fit.surface.point(st).distance(old.point(start)).to_bits(), k as u32))
+                })
+                .collect();
+            let got: Vec<(u64, u32)> = fit.start_distances(&old).iter().map(|&(d, k)| (d.to_bits(), k)).collect();
+            assert_eq!(got, want, "{n} x {m}");
+            assert_eq!(fit.folds(&old, &facts), folds_one_by_one(&fit, &old));
+            assert_eq!(fit.folds(&old, &facts), [false; 2], "{n} x {m}");
+            // Turned over: S'(u, v) = S(u, 1 - v).
+            let [_, cv] = fit.surface.counts();
+            let net: Vec<DVec3> = fit.surface.control_points().collect();
+            let pts: Vec<Vec<DVec3>> = net.chunks(cv).map(|row| row.iter().rev().copied().collect()).collect();
+            let kv: Vec<f64> = fit.surface.knots_v().knots().iter().rev().map(|k| 1.0 - k).collect();
+            let ku = fit.surface.knots_u().knots().to_vec();
+            fit.surface = NurbsSurface::try_new([3, 3], ku, kv, &pts, None).unwrap();
+            assert_eq!(fit.folds(&old, &facts), folds_one_by_one(&fit, &old));
+            assert_eq!(fit.folds(&old, &facts), [true; 2], "{n} x {m} turned over");
+        }
     }
 
     /// A border that leaves its corner backwards is turned to the original's

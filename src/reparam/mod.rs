@@ -20,7 +20,7 @@ use glam::{DVec2, DVec3};
 use serde::Serialize;
 
 use crate::model::{Face, FaceSurface, Model, TrimLoop};
-use crate::nurbs::{project_to_surface, NurbsCurve, ProjectionOptions, Surface};
+use crate::nurbs::{project_with, NurbsCurve, ProjectionOptions, Surface, SurfaceFacts};
 use crate::options::{Reparam, Tolerance};
 use crate::warning::{RebuildError, Reparameterized, Warning, WarningKind};
 use crate::Error;
@@ -402,6 +402,8 @@ struct Lander<'a> {
     new: &'a FaceSurface,
     fit: &'a Fit,
     opts: ProjectionOptions,
+    /// What projections onto the new surface learn about it, for all points.
+    facts: SurfaceFacts,
     /// One sample interval of the new surface, per direction.
     cell: DVec2,
     /// The old surface's domain.
@@ -414,7 +416,7 @@ impl<'a> Lander<'a> {
         let cell =
             DVec2::new(1.0 / (fit.map_u.new.len().max(2) - 1) as f64, 1.0 / (fit.map_v.new.len().max(2) - 1) as f64);
         let [lo, hi] = old.domain();
-        Self { old, new, fit, opts: projection(), cell, lo, hi }
+        Self { old, new, fit, opts: projection(), facts: SurfaceFacts::default(), cell, lo, hi }
     }
 
     /// The fit's map of an old (u,v) to the new parameters.
@@ -429,7 +431,7 @@ impl<'a> Lander<'a> {
         let edge = |x: f64, a: f64, b: f64| (x - a).abs() <= 1e-9 * (b - a) || (b - x).abs() <= 1e-9 * (b - a);
         let hint = self.map(uv);
         let p = self.old.point(uv);
-        let pr = project_to_surface(self.new, p, Some(hint), &self.opts);
+        let pr = project_with(self.new, &self.facts, p, Some(hint), &self.opts, f64::NEG_INFINITY);
         let off = (pr.uv - hint).abs();
         let cell = self.cell;
         let mut at =
