@@ -646,6 +646,22 @@ mod tests {
     /// The limits the test faces are held to.
     const CRIT: Criteria = Criteria::PLANE_TEST;
 
+    /// A face of [`plane`]: points `(x, y, node id)` (0: no node) at (u,v)
+    /// = (x, y), and the triangles on them.
+    fn mesh(pts: &[(f64, f64, u32)], tris: &[[u32; 3]]) -> WorkMesh {
+        let mut m = WorkMesh::default();
+        for &(x, y, g) in pts {
+            let v = m.add_vertex(DVec3::new(x, y, 0.0), DVec3::Z);
+            if g != 0 {
+                m.gid[v as usize] = g;
+            }
+        }
+        for t in tris {
+            m.add_triangle(*t, t.map(|v| DVec2::new(pts[v as usize].0, pts[v as usize].1)));
+        }
+        m
+    }
+
     /// One triangle on the plane z = 0 (u = x, v = y), its vertex `node` the model node 7.
     fn face(corners: [(f64, f64); 3], node: usize) -> WorkMesh {
         let mut m = WorkMesh::default();
@@ -715,22 +731,8 @@ mod tests {
     /// under the gap it does not.
     #[test]
     fn a_node_of_the_neighbours_border_closes_the_t_junction() {
-        let corner = |x: f64, y: f64| DVec3::new(x, y, 0.0);
         let plane = plane();
         let crit = CRIT;
-        let mesh = |pts: &[(f64, f64, u32)], tris: &[[u32; 3]]| {
-            let mut m = WorkMesh::default();
-            for &(x, y, g) in pts {
-                let v = m.add_vertex(corner(x, y), DVec3::Z);
-                if g != 0 {
-                    m.gid[v as usize] = g;
-                }
-            }
-            for t in tris {
-                m.add_triangle(*t, t.map(|v| DVec2::new(pts[v as usize].0, pts[v as usize].1)));
-            }
-            m
-        };
         let gids = |f: &FaceWork<'_>| -> Vec<(u32, u32)> {
             let mut e: Vec<(u32, u32)> = f
                 .mesh
@@ -769,19 +771,6 @@ mod tests {
     fn a_node_nearest_a_node_of_the_other_border_becomes_it() {
         let plane = plane();
         let crit = CRIT;
-        let mesh = |pts: &[(f64, f64, u32)], tris: &[[u32; 3]]| {
-            let mut m = WorkMesh::default();
-            for &(x, y, g) in pts {
-                let v = m.add_vertex(DVec3::new(x, y, 0.0), DVec3::Z);
-                if g != 0 {
-                    m.gid[v as usize] = g;
-                }
-            }
-            for t in tris {
-                m.add_triangle(*t, t.map(|v| DVec2::new(pts[v as usize].0, pts[v as usize].1)));
-            }
-            m
-        };
         let a = mesh(
             &[(0.0, 0.0, 0), (1.0, 0.0, 1), (1.01, 0.5, 4), (1.0, 1.0, 2), (0.0, 1.0, 0)],
             &[[0, 1, 2], [0, 2, 3], [0, 3, 4]],
