@@ -189,8 +189,8 @@ fn demand_parts(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limi
         let floor = BEND_FLOOR * lim.tol;
         let at_border = one_sided
             && side.piece.is_some_and(|(lo, hi)| {
-                let gap = |t: f64, end: f64| if t == end { 0.0 } else { eval(t).0.distance(eval(end).0) };
-                gap(a, lo).min(gap(b, hi)) <= floor
+                let gap = |t: f64, p: DVec3, end: f64| if t == end { 0.0 } else { p.distance(eval(end).0) };
+                gap(a, pa, lo).min(gap(b, pb, hi)) <= floor
             });
         let most = if at_border { len / floor } else { f64::INFINITY };
         demand = demand.max((turn / lim.angle).min(most));
