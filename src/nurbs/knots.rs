@@ -70,6 +70,7 @@ impl KnotVector {
     }
 
     /// The degree the knot vector serves.
+    #[inline]
     pub fn degree(&self) -> usize {
         self.degree
     }
@@ -80,11 +81,13 @@ impl KnotVector {
     }
 
     /// Number of control points this knot vector takes.
+    #[inline]
     pub fn control_count(&self) -> usize {
         self.knots.len() - self.degree - 1
     }
 
     /// Parameter range `[knots[p], knots[n]]`.
+    #[inline]
     pub fn domain(&self) -> (f64, f64) {
         (self.knots[self.degree], self.knots[self.control_count()])
     }
@@ -102,17 +105,25 @@ impl KnotVector {
     }
 
     /// Clamps `t` into the domain (NaN goes to the start).
+    ///
+    /// Compares instead of calling `f64::clamp`, whose check of its bounds
+    /// (always ordered here) kept this out of line in the wasm build, where a
+    /// call per basis evaluation cost more than the span search itself.
+    #[inline]
     pub fn clamp(&self, t: f64) -> f64 {
         let (a, b) = self.domain();
-        if t.is_nan() {
+        if t.is_nan() || t < a {
             a
+        } else if t > b {
+            b
         } else {
-            t.clamp(a, b)
+            t
         }
     }
 
     /// Knot span index `i` with `knots[i] <= t < knots[i+1]` (the last non-empty
     /// span at the domain's end); `t` is clamped first. Binary search.
+    #[inline]
     pub fn span(&self, t: f64) -> usize {
         let p = self.degree;
         let n = self.control_count() - 1;
@@ -146,11 +157,15 @@ impl KnotVector {
     /// grid split down to its cap), so `t` is evaluated as if the sliver's
     /// two ends were one knot: on the next span, or at the domain's end on
     /// the last span before the sliver.
+    #[inline]
     pub(crate) fn eval_span(&self, t: f64) -> usize {
         let span = self.span(t);
         let u = &self.knots;
         let (a, b) = self.domain();
-        let sliver = SLIVER * a.abs().max(b.abs()).max(b - a);
+        // The larger of values never NaN nor -0 by comparison: `f64::max` is
+        // a call to `fmax` in wasm, once per evaluation here.
+        let larger = |x: f64, y: f64| if x > y { x } else { y };
+        let sliver = SLIVER * larger(larger(a.abs(), b.abs()), b - a);
         if u[span + 1] - u[span] > sliver {
             return span;
         }

@@ -33,7 +33,8 @@ struct Side {
 
 /// Closes every hole of three to [`MAX_SIDES`] sides between faces
 /// narrower than `width`; returns how many triangles it added. A hole of
-/// more sides takes one triangle on its longest side per pass.
+/// more sides takes one triangle on its longest side per pass. Then two
+/// faces' triangles on the same three nodes go ([`remove_shared_triangles`]).
 pub(crate) fn close_slivers(faces: &mut [FaceWork<'_>], width: f64) -> usize {
     if width.is_nan() || width <= 0.0 {
         return 0;
@@ -52,6 +53,7 @@ pub(crate) fn close_slivers(faces: &mut [FaceWork<'_>], width: f64) -> usize {
             break;
         }
     }
+    remove_shared_triangles(faces);
     added
 }
 
@@ -104,6 +106,62 @@ fn remove_flaps(faces: &mut [FaceWork<'_>], width: f64) -> usize {
         }
     }
     removed
+}
+
+/// Removes each pair of triangles of two faces on the same three model
+/// nodes where that leaves each of their sides with two triangles or none.
+/// A hole closed in one face where another face's triangles already span
+/// the place (a node of the other face's second loop, nearer than the
+/// sewing distance, was sewn into the first face's border) lies on the
+/// other face: both triangles enclose nothing, and each of their sides
+/// counts four triangles, or only their two. Returns how many it removed.
+fn remove_shared_triangles(faces: &mut [FaceWork<'_>]) -> usize {
+    // Triangles by their three nodes, and how many triangles have each node pair.
+    let mut by_nodes: HashMap<[u32; 3], Vec<(u32, u32)>> = HashMap::default();
+    let mut uses: HashMap<(u32, u32), u32> = HashMap::default();
+    for (fi, f) in faces.iter().enumerate() {
+        let m = &f.mesh;
+        for (t, v) in m.tris.iter().enumerate() {
+            let mut g = v.map(|x| m.gid[x as usize]);
+            for k in 0..3 {
+                let (ga, gb) = (g[k], g[(k + 1) % 3]);
+                if ga != NONE && gb != NONE && ga != gb {
+                    *uses.entry((ga.min(gb), ga.max(gb))).or_default() += 1;
+                }
+            }
+            g.sort_unstable();
+            if g[0] != NONE && g[2] != NONE && g[0] != g[1] && g[1] != g[2] {
+                by_nodes.entry(g).or_default().push((fi as u32, t as u32));
+            }
+        }
+    }
+    let mut keys: Vec<[u32; 3]> = by_nodes.iter().filter(|(_, l)| l.len() == 2).map(|(k, _)| *k).collect();
+    keys.sort_unstable();
+    let mut gone: Vec<(u32, u32)> = Vec::new();
+    for g in keys {
+        let pair = &by_nodes[&g];
+        if pair[0].0 == pair[1].0 {
+            continue;
+        }
+        let sides = [(g[0], g[1]), (g[1], g[2]), (g[0], g[2])];
+        let counts = sides.map(|e| uses.get(&e).copied().unwrap_or(0));
+        // Only the pair on every side is a body of two triangles: it stays.
+        if !counts.iter().all(|&u| u == 2 || u == 4) || !counts.contains(&4) {
+            continue;
+        }
+        for e in sides {
+            if let Some(u) = uses.get_mut(&e) {
+                *u -= 2;
+            }
+        }
+        gone.extend_from_slice(pair);
+    }
+    // Highest first within each face: removing one moves only the last triangle.
+    gone.sort_unstable();
+    for &(f, t) in gone.iter().rev() {
+        faces[f as usize].mesh.remove_triangle(t as usize);
+    }
+    gone.len()
 }
 
 /// Calls `visit` with every border edge whose ends are two different model
@@ -357,6 +415,42 @@ mod tests {
         let mut faces = alloc::vec![work(upper), work(lower)];
         assert_eq!(close_slivers(&mut faces, 0.1), 0);
         assert_eq!(faces[0].mesh.tris.len(), 2);
+    }
+
+    /// Face A spans from its border 3-2-1 to node 5 of its second loop; the
+    /// border of face B, sewn to node 5 instead of node 2, runs 3-2-5-2-1
+    /// (a hole closed in it). Both have a triangle on nodes 1, 2, 5: that
+    /// pair goes, and every edge between nodes has two triangles or none.
+    #[test]
+    fn two_faces_on_one_triangle_lose_it() {
+        let plane = plane();
+        let work = |mesh| FaceWork { surface: &plane, curves: Vec::new(), mesh, crit: CRIT };
+        let a = mesh(
+            &[(10.0, 0.0, 1), (0.0, 0.0, 2), (-10.0, 0.0, 3), (-3.0, 1.5, 4), (1.0, 0.5, 5), (8.0, 1.5, 6)],
+            &[[1, 0, 4], [1, 4, 3], [2, 1, 3], [0, 5, 4]],
+        );
+        let b = mesh(
+            &[(-10.0, 0.0, 3), (0.0, -10.0, NONE), (1.0, 0.5, 5), (10.0, 0.0, 1), (0.0, 0.0, 2), (0.0, 0.0, 2)],
+            &[[0, 1, 2], [2, 1, 3], [4, 2, 0], [5, 3, 2]],
+        );
+        let mut faces = alloc::vec![work(a), work(b)];
+        let uses = |faces: &[FaceWork<'_>], pair: (u32, u32)| {
+            let mut n = 0;
+            for f in faces {
+                let m = &f.mesh;
+                for t in &m.tris {
+                    for k in 0..3 {
+                        let (x, y) = (m.gid[t[k] as usize], m.gid[t[(k + 1) % 3] as usize]);
+                        n += usize::from((x.min(y), x.max(y)) == pair);
+                    }
+                }
+            }
+            n
+        };
+        assert_eq!([(2, 5), (1, 5)].map(|p| uses(&faces, p)), [4, 4]);
+        close_slivers(&mut faces, 0.1);
+        assert_eq!([faces[0].mesh.tris.len(), faces[1].mesh.tris.len()], [3, 3]);
+        assert_eq!([(2, 5), (1, 5), (1, 2), (2, 3)].map(|p| uses(&faces, p)), [2, 2, 0, 2]);
     }
 
     /// A narrow triangle reaching past its face's border: one side of it is
