@@ -159,7 +159,16 @@ fn remove_shared_triangles(faces: &mut [FaceWork<'_>]) -> usize {
     // Highest first within each face: removing one moves only the last triangle.
     gone.sort_unstable();
     for &(f, t) in gone.iter().rev() {
-        faces[f as usize].mesh.remove_triangle(t as usize);
+        let m = &mut faces[f as usize].mesh;
+        let v = m.tris[t as usize];
+        m.remove_triangle(t as usize);
+        // A side left on the border runs along the other face's.
+        for k in 0..3 {
+            let (a, b) = (v[k], v[(k + 1) % 3]);
+            if m.edge_triangles(a, b) == 1 {
+                m.shared.insert((a.min(b), a.max(b)), ());
+            }
+        }
     }
     gone.len()
 }
