@@ -583,6 +583,9 @@ impl WorkMesh {
         self.add_triangle([b, a, x], [uv_b, uv_a, uv]);
         self.measure_slots();
         if self.fits_placed(surface, c, self.tris.len() - 1) {
+            // Its two new sides run along the other faces' borders: shared.
+            self.shared.insert(key(a, x), ());
+            self.shared.insert(key(x, b), ());
             return true;
         }
         self.pop_triangle();
