@@ -15,7 +15,7 @@ use crate::collections::HashMap;
 use alloc::vec::Vec;
 use glam::DVec3;
 
-use super::refine::NONE;
+use super::refine::{key, NONE};
 use super::sew::FaceWork;
 /// The most sides a hole closed here may have.
 const MAX_SIDES: usize = 8;
@@ -71,7 +71,7 @@ fn remove_flaps(faces: &mut [FaceWork<'_>], width: f64) -> usize {
         if ga == NONE || gb == NONE || ga == gb {
             return 0;
         }
-        uses.get(&(ga.min(gb), ga.max(gb))).copied().unwrap_or(0)
+        uses.get(&key(ga, gb)).copied().unwrap_or(0)
     };
     let mut removed = 0;
     for f in faces.iter_mut() {
@@ -101,7 +101,7 @@ fn remove_flaps(faces: &mut [FaceWork<'_>], width: f64) -> usize {
         for &(t, prev, next) in flaps.iter().rev() {
             f.mesh.remove_triangle(t);
             // Its inner side is now the border, along the neighbours' gap.
-            f.mesh.shared.insert((prev.min(next), prev.max(next)), ());
+            f.mesh.shared.insert(key(prev, next), ());
             removed += 1;
         }
     }
@@ -126,7 +126,7 @@ fn remove_shared_triangles(faces: &mut [FaceWork<'_>]) -> usize {
             for k in 0..3 {
                 let (ga, gb) = (g[k], g[(k + 1) % 3]);
                 if ga != NONE && gb != NONE && ga != gb {
-                    *uses.entry((ga.min(gb), ga.max(gb))).or_default() += 1;
+                    *uses.entry(key(ga, gb)).or_default() += 1;
                 }
             }
             g.sort_unstable();
@@ -166,7 +166,7 @@ fn remove_shared_triangles(faces: &mut [FaceWork<'_>]) -> usize {
         for k in 0..3 {
             let (a, b) = (v[k], v[(k + 1) % 3]);
             if m.edge_triangles(a, b) == 1 {
-                m.shared.insert((a.min(b), a.max(b)), ());
+                m.shared.insert(key(a, b), ());
             }
         }
     }

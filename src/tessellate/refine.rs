@@ -115,7 +115,8 @@ struct SplitSide {
     guess: DVec2,
 }
 
-fn key(a: u32, b: u32) -> (u32, u32) {
+/// An edge's key in the tables: its two ends, lower first.
+pub(crate) fn key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
 }
 

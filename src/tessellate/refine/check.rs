@@ -364,6 +364,10 @@ mod tests {
         assert_eq!(m.check_tables(), Ok(()), "after refinement");
         m.rest();
         assert_eq!(m.check_tables(), Ok(()), "refined, at rest");
+        // The added triangles' sides are loose borders by construction; no
+        // trim or shared edge may be stale.
+        let stale = m.trim.keys().chain(m.shared.keys()).find(|e| m.edge_triangles(e.0, e.1) == 0);
+        assert_eq!(stale, None, "refined, at rest");
     }
 
     /// Each invariant, broken on purpose, is the one reported.
