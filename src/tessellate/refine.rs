@@ -41,6 +41,10 @@ pub(crate) struct TrimEdge {
     pub t_hi: f64,
 }
 
+/// A corner within this fraction of the tolerance of the surface point at
+/// its (u,v) lies on the surface (sewing moves border nodes farther).
+const ON_SURFACE: f64 = 1e-6;
+
 /// Marks a vertex no triangle has given a (u,v) yet: a NaN with a payload
 /// arithmetic does not make (it propagates only a NaN it is given).
 const UV_UNSET: u64 = 0x7ff8_5eed_0000_0001;
@@ -811,7 +815,15 @@ impl WorkMesh {
         self.measure_slots();
         let mut fold_splits = 0usize;
         let fold_limit = 2 * stack.iter().filter(|&&t| self.inverted(surface, t as usize)).count() + 16;
-        while let Some(t) = stack.pop() {
+        // Splits for folds of shape end as their slivers shrink; the cap
+        // only bounds a surface that is not smooth at any scale.
+        let (mut shape_splits, shape_limit) = (0usize, stack.len() + 64);
+        let (mut waiting, mut waited) = (Vec::new(), crate::collections::HashSet::default());
+        while let Some(t) = stack.pop().or_else(|| {
+            waiting.reverse();
+            stack.append(&mut waiting);
+            stack.pop()
+        }) {
             let t = t as usize;
             // A sample over the tolerance fails the triangle whatever the
             // others measure (one over it is never short for its angle).
@@ -823,12 +835,30 @@ impl WorkMesh {
             // A folded sliver along a border is mended by splitting it, but
             // a fold splitting cannot mend (its corners off the surface
             // after sewing) would only breed more: such splits are rationed.
-            let folded = !limits && fold_splits < fold_limit && self.inverted(surface, t);
+            // A fold of the triangle's shape alone is not
+            // ([`Self::folds_by_shape`]): it waits until the rest is refined,
+            // which mends many, then is flipped where a flip mends it (as
+            // mending does, at no cost in triangles), else split.
+            let mut folded = !limits && self.inverted(surface, t);
+            if folded {
+                if shape_splits < shape_limit
+                    && measured.is_some_and(|(_, turn)| self.folds_by_shape(surface, c, t, turn))
+                {
+                    if waited.insert(t as u32) {
+                        waiting.push(t as u32);
+                        continue;
+                    }
+                    if self.flip_fold(surface, c, t as u32) {
+                        continue;
+                    }
+                    shape_splits += 1;
+                } else {
+                    folded = fold_splits < fold_limit;
+                    fold_splits += usize::from(folded);
+                }
+            }
             if !(limits || folded) {
                 continue;
-            }
-            if folded {
-                fold_splits += 1;
             }
             if len <= c.min_edge {
                 continue;
@@ -844,6 +874,36 @@ impl WorkMesh {
         }
         self.edge_samples = EdgeSamples::default();
         budget_hit
+    }
+
+    /// Unfolds folded triangle `t` by flipping one of its edges where that
+    /// passes [`Self::try_flip`]'s tests; whether it did.
+    fn flip_fold(&mut self, surface: &dyn Surface, c: &Criteria, t: u32) -> bool {
+        let v = self.tris[t as usize];
+        for k in 0..3 {
+            if let Some(u) = self.try_flip(surface, c, t, v[k], v[(k + 1) % 3]) {
+                self.forget(&[t, u]);
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Whether folded triangle `t` (normal turn `turn`) folds by its shape
+    /// alone, which splitting mends: its corners lie on the surface at
+    /// their (u,v) and their normals agree within the angle limit, so the
+    /// surface is smooth under it, yet its facet faces away, as a sliver
+    /// does whose long edge sags sideways more than its height (an edge of
+    /// a thin grid cell where the surface curls across the cell and bends
+    /// along it). Halving the long edge quarters its sag while the height
+    /// stays, so the halves face the surface's way.
+    fn folds_by_shape(&self, surface: &dyn Surface, c: &Criteria, t: usize, turn: f64) -> bool {
+        let uv = self.uv(t);
+        turn <= c.angle
+            && self.tris[t]
+                .iter()
+                .zip(uv)
+                .all(|(&v, q)| self.pos[v as usize].distance(surface.point(q)) <= ON_SURFACE * c.tol)
     }
 
     /// Triangle `t`'s measure, from the cache while it is valid (the cache

@@ -357,3 +357,54 @@ fn a_long_triangle_across_a_narrow_curl_is_creased() {
     let (n, _) = refined(0.5);
     assert!(n > 20, "{n} triangles");
 }
+
+/// A flat sheet whose u-lines are parabolas `y = x²/2` for x in ±0.2 (sag
+/// 0.02 over their chord of 0.4) and whose v-lines are straight up `y`,
+/// `height` long: a plane parameterized so that its rows bend within it.
+fn bent_rows(height: f64) -> crate::nurbs::NurbsSurface {
+    let (w, a) = (0.2, 0.5);
+    let row = |x: f64, y: f64| alloc::vec![DVec3::new(x, y, 0.0), DVec3::new(x, y + height, 0.0)];
+    let points = [row(-w, a * w * w), row(0.0, -a * w * w), row(w, a * w * w)];
+    crate::nurbs::NurbsSurface::try_new(
+        [2, 1],
+        alloc::vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        alloc::vec![0.0, 0.0, 1.0, 1.0],
+        &points,
+        None,
+    )
+    .unwrap()
+}
+
+/// A column of thin cells, each split on its diagonal for the edge limit:
+/// the diagonal's middle lies half a row (0.01) from the cell's lower side,
+/// whose chord sags 0.02 sideways, so the triangle between them folds
+/// though every corner lies on the surface and it is within all limits.
+/// More such folds arise than the ration of fold splits (16 when the
+/// first mesh has none); each is split all the same, none is left folded,
+/// and the halves of their long sides are enough.
+#[test]
+fn slivers_folded_by_their_shape_are_split() {
+    let rows = 24;
+    let s = bent_rows(0.02 * rows as f64);
+    let mut m = WorkMesh::default();
+    let w = |i: usize, j: usize| at(i as f64, j as f64 / rows as f64);
+    for j in 0..=rows {
+        for i in 0..2 {
+            m.add_vertex(s.point(w(i, j)), s.normal(w(i, j)));
+        }
+    }
+    let v = |i: usize, j: usize| (2 * j + i) as u32;
+    for j in 0..rows {
+        m.add_triangle([v(0, j), v(1, j), v(1, j + 1)], [w(0, j), w(1, j), w(1, j + 1)]);
+        m.add_triangle([v(0, j), v(1, j + 1), v(0, j + 1)], [w(0, j), w(1, j + 1), w(0, j + 1)]);
+    }
+    assert!(m.folded(&s).is_empty(), "the cells fold before refinement");
+    // Between a cell's side (0.4) and its diagonal.
+    let side = m.pos[1].distance(m.pos[0]);
+    let diagonal = m.pos[3].distance(m.pos[0]);
+    let c =
+        Criteria { tol: 0.1, angle: 0.5, max_edge: 0.5 * (side + diagonal), min_edge: 0.0, steps: 2, lift: Lift::NONE };
+    m.refine(&s, &[], &c, 100_000);
+    assert!(m.folded(&s).is_empty(), "{} triangles still folded", m.folded(&s).len());
+    assert!(m.tris.len() <= 8 * rows, "{} triangles", m.tris.len());
+}
