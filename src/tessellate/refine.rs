@@ -823,7 +823,11 @@ impl WorkMesh {
             // A folded sliver along a border is mended by splitting it, but
             // a fold splitting cannot mend (its corners off the surface
             // after sewing) would only breed more: such splits are rationed.
-            let folded = !limits && fold_splits < fold_limit && self.inverted(surface, t);
+            // A fold on a border edge refinement would never split (a side
+            // collapsed to a hair on the far side of its pole) is not split
+            // at all: each child keeps the hair and the fold.
+            let folded =
+                !limits && fold_splits < fold_limit && self.inverted(surface, t) && !self.on_hair(t, c.min_edge);
             if !(limits || folded) {
                 continue;
             }
@@ -844,6 +848,17 @@ impl WorkMesh {
         }
         self.edge_samples = EdgeSamples::default();
         budget_hit
+    }
+
+    /// Whether triangle `t` has a border edge (one triangle) no longer than
+    /// `hair`; the mesh must be awake.
+    fn on_hair(&self, t: usize, hair: f64) -> bool {
+        let v = self.tris[t];
+        (0..3).any(|k| {
+            let (a, b) = (v[k], v[(k + 1) % 3]);
+            self.pair(a, b).is_some_and(|e| e.contains(&NONE))
+                && self.pos[a as usize].distance(self.pos[b as usize]) <= hair
+        })
     }
 
     /// Triangle `t`'s measure, from the cache while it is valid (the cache
