@@ -838,8 +838,11 @@ impl WorkMesh {
             // A fold of the triangle's shape alone is not
             // ([`Self::folds_by_shape`]): it waits until the rest is refined,
             // which mends many, then is flipped where a flip mends it (as
-            // mending does, at no cost in triangles), else split.
-            let mut folded = !limits && self.inverted(surface, t);
+            // mending does, at no cost in triangles), else split. A fold on
+            // a border edge refinement would never split (a side collapsed to
+            // a hair on the far side of its pole) is not split at all: each
+            // child keeps the hair and the fold.
+            let mut folded = !limits && self.inverted(surface, t) && !self.on_hair(t, c.min_edge);
             if folded {
                 if shape_splits < shape_limit
                     && measured.is_some_and(|(_, turn)| self.folds_by_shape(surface, c, t, turn))
@@ -904,6 +907,17 @@ impl WorkMesh {
                 .iter()
                 .zip(uv)
                 .all(|(&v, q)| self.pos[v as usize].distance(surface.point(q)) <= ON_SURFACE * c.tol)
+    }
+
+    /// Whether triangle `t` has a border edge (one triangle) no longer than
+    /// `hair`; the mesh must be awake.
+    fn on_hair(&self, t: usize, hair: f64) -> bool {
+        let v = self.tris[t];
+        (0..3).any(|k| {
+            let (a, b) = (v[k], v[(k + 1) % 3]);
+            self.pair(a, b).is_some_and(|e| e.contains(&NONE))
+                && self.pos[a as usize].distance(self.pos[b as usize]) <= hair
+        })
     }
 
     /// Triangle `t`'s measure, from the cache while it is valid (the cache

@@ -259,6 +259,29 @@ fn a_folded_fan_collapses_into_a_neighbour() {
     }
 }
 
+/// A triangle folded against the surface on a border edge no longer than
+/// the shortest edge refinement splits (a side collapsed to a hair, on the
+/// far side of its pole) is left whole: splitting its long sides keeps the
+/// hair and the fold. The same fold on a longer border edge is split.
+#[cfg(feature = "std")]
+#[test]
+fn a_fold_on_a_hair_of_border_is_not_split() {
+    let s = plane();
+    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: f64::INFINITY, min_edge: 1e-4, steps: 2, lift: Lift::NONE };
+    for (edge, split) in [(0.5e-4, false), (1e-2, true)] {
+        let mut m = WorkMesh::default();
+        // Clockwise in (u,v) and in space: its facet faces -z on the plane.
+        let q = [at(0.0, 0.0), at(0.0, edge), at(1.0, 0.5)];
+        for p in q {
+            m.add_vertex(DVec3::new(p.x, p.y, 0.0), DVec3::Z);
+        }
+        m.add_triangle([0, 1, 2], q);
+        assert!(m.inverted(&s, 0), "the test triangle faces the surface's way");
+        m.refine(&s, &[], &c, 1000);
+        assert_eq!(m.tris.len() > 1, split, "border edge {edge}: {} triangles", m.tris.len());
+    }
+}
+
 /// A needle folded against the surface whose two near corners lie within
 /// the census's weld is no triangle of the welded mesh and is not counted;
 /// the same needle with them farther apart is, and one facing the
