@@ -1,16 +1,16 @@
 //! The JSON model reader (DESIGN.md's schema).
 //!
-//! Parsing happens in two steps: serde turns the text into plain nested
+//! Parsing happens in two steps: the text is scanned into plain nested
 //! vectors (`Raw*` below, which mirror the file one to one), then [`read_json`]
 //! checks sizes, shapes and numbers and builds the validated geometry, naming
 //! the face, loop, curve and field of the first problem it finds.
 
 use alloc::format;
-use alloc::string::{String, ToString};
+use alloc::string::String;
 use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
-use serde::Deserialize;
 
+use super::json_text::{Scan, Text, TextError};
 use crate::nurbs::{KnotVector, NurbsCurve, NurbsError, NurbsSurface};
 use crate::{Error, Face, FaceSurface, Model, TrimLoop};
 
@@ -29,25 +29,17 @@ const MAX_TOTAL_POINTS: usize = 20_000_000;
 /// Loop ends must meet within this fraction of the surface's parameter range.
 const CLOSURE_TOLERANCE: f64 = 1e-9;
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawModel {
     units: Option<String>,
-    #[serde(default)]
     faces: Vec<RawFace>,
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawFace {
     name: Option<String>,
     surface: Option<RawSurface>,
-    #[serde(default)]
     loops: Vec<RawLoop>,
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawSurface {
     degree: Vec<usize>,
     knots: Vec<Vec<f64>>,
@@ -55,14 +47,10 @@ struct RawSurface {
     weights: Option<Vec<Vec<f64>>>,
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawLoop {
     curves: Vec<RawCurve>,
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawCurve {
     degree: usize,
     knots: Vec<f64>,
@@ -79,7 +67,11 @@ struct RawCurve {
 /// than the reader accepts.
 pub fn read_json(bytes: &[u8]) -> Result<Model, Error> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    let raw: RawModel = serde_json::from_slice(bytes).map_err(json_error)?;
+    let mut text = Text::new(bytes);
+    let raw = raw_model(&mut text).and_then(|raw| text.end().map(|()| raw)).map_err(|e| {
+        let (line, column) = text.line_column(e.at);
+        Error::Json { line, column, message: e.message }
+    })?;
     if raw.faces.is_empty() {
         return Err(model_error("faces".into(), "the model has no faces"));
     }
@@ -94,16 +86,108 @@ pub fn read_json(bytes: &[u8]) -> Result<Model, Error> {
     Ok(Model { units: raw.units.unwrap_or_else(|| "mm".into()), faces, ..Model::default() })
 }
 
-/// Turns serde's error into [`Error::Json`], dropping serde's own
-/// " at line L column C" suffix since the variant carries both.
-fn json_error(e: serde_json::Error) -> Error {
-    let (line, column) = (e.line(), e.column());
-    let mut message = e.to_string();
-    let suffix = format!(" at line {line} column {column}");
-    if message.ends_with(&suffix) {
-        message.truncate(message.len() - suffix.len());
+/// The error for a key the record does not have.
+fn unknown(t: &Text<'_>, key: &str, expected: &str) -> TextError {
+    t.error(format!("unknown field `{key}`, expected {expected}"))
+}
+
+/// The error for a required key the record lacks (at the record's end).
+fn missing(t: &Text<'_>, key: &str) -> TextError {
+    t.error(format!("missing field `{key}`"))
+}
+
+/// `null`, or what `read` reads.
+fn nullable<'a, T>(t: &mut Text<'a>, read: impl FnOnce(&mut Text<'a>) -> Scan<T>) -> Scan<Option<T>> {
+    if t.null() {
+        Ok(None)
+    } else {
+        read(t).map(Some)
     }
-    Error::Json { line, column, message }
+}
+
+/// An array of what `read` reads.
+fn list<'a, T>(t: &mut Text<'a>, read: impl Fn(&mut Text<'a>) -> Scan<T>) -> Scan<Vec<T>> {
+    let mut out = Vec::new();
+    t.array(&mut |t| {
+        out.push(read(t)?);
+        Ok(())
+    })?;
+    Ok(out)
+}
+
+fn raw_model(t: &mut Text<'_>) -> Scan<RawModel> {
+    let (mut units, mut faces) = (None, Vec::new());
+    t.object(&mut |t, key| {
+        match key {
+            "units" => units = nullable(t, Text::string)?,
+            "faces" => faces = list(t, raw_face)?,
+            _ => return Err(unknown(t, key, "`units` or `faces`")),
+        }
+        Ok(())
+    })?;
+    Ok(RawModel { units, faces })
+}
+
+fn raw_face(t: &mut Text<'_>) -> Scan<RawFace> {
+    let (mut name, mut surface, mut loops) = (None, None, Vec::new());
+    t.object(&mut |t, key| {
+        match key {
+            "name" => name = nullable(t, Text::string)?,
+            "surface" => surface = nullable(t, raw_surface)?,
+            "loops" => loops = list(t, |t| raw_loop(t))?,
+            _ => return Err(unknown(t, key, "one of `name`, `surface`, `loops`")),
+        }
+        Ok(())
+    })?;
+    Ok(RawFace { name, surface, loops })
+}
+
+fn raw_surface(t: &mut Text<'_>) -> Scan<RawSurface> {
+    let (mut degree, mut knots, mut points, mut weights) = (None, None, None, None);
+    t.object(&mut |t, key| {
+        match key {
+            "degree" => degree = Some(list(t, Text::count)?),
+            "knots" => knots = Some(list(t, Text::numbers)?),
+            "points" => points = Some(list(t, |t| list(t, Text::numbers))?),
+            "weights" => weights = nullable(t, |t| list(t, Text::numbers))?,
+            _ => return Err(unknown(t, key, "one of `degree`, `knots`, `points`, `weights`")),
+        }
+        Ok(())
+    })?;
+    let degree = degree.ok_or_else(|| missing(t, "degree"))?;
+    let knots = knots.ok_or_else(|| missing(t, "knots"))?;
+    let points = points.ok_or_else(|| missing(t, "points"))?;
+    Ok(RawSurface { degree, knots, points, weights })
+}
+
+fn raw_loop(t: &mut Text<'_>) -> Scan<RawLoop> {
+    let mut curves = None;
+    t.object(&mut |t, key| {
+        match key {
+            "curves" => curves = Some(list(t, raw_curve)?),
+            _ => return Err(unknown(t, key, "`curves`")),
+        }
+        Ok(())
+    })?;
+    Ok(RawLoop { curves: curves.ok_or_else(|| missing(t, "curves"))? })
+}
+
+fn raw_curve(t: &mut Text<'_>) -> Scan<RawCurve> {
+    let (mut degree, mut knots, mut points, mut weights) = (None, None, None, None);
+    t.object(&mut |t, key| {
+        match key {
+            "degree" => degree = Some(t.count()?),
+            "knots" => knots = Some(t.numbers()?),
+            "points" => points = Some(list(t, Text::numbers)?),
+            "weights" => weights = nullable(t, Text::numbers)?,
+            _ => return Err(unknown(t, key, "one of `degree`, `knots`, `points`, `weights`")),
+        }
+        Ok(())
+    })?;
+    let degree = degree.ok_or_else(|| missing(t, "degree"))?;
+    let knots = knots.ok_or_else(|| missing(t, "knots"))?;
+    let points = points.ok_or_else(|| missing(t, "points"))?;
+    Ok(RawCurve { degree, knots, points, weights })
 }
 
 fn model_error(location: String, message: &str) -> Error {

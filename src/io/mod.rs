@@ -11,6 +11,7 @@ mod iges;
 #[cfg(feature = "writers")]
 mod iges_write;
 mod json;
+mod json_text;
 #[cfg(feature = "repair")]
 mod meshfile;
 #[cfg(feature = "writers")]

@@ -135,10 +135,12 @@ fn remove_shared_triangles(faces: &mut [FaceWork<'_>]) -> usize {
             }
         }
     }
-    let mut keys: Vec<[u32; 3]> = by_nodes.iter().filter(|(_, l)| l.len() == 2).map(|(k, _)| *k).collect();
-    keys.sort_unstable();
+    let mut keys: Vec<(u32, u32, u32)> =
+        by_nodes.iter().filter(|(_, l)| l.len() == 2).map(|(k, _)| (k[0], k[1], k[2])).collect();
+    crate::sort::triples(&mut keys);
     let mut gone: Vec<(u32, u32)> = Vec::new();
-    for g in keys {
+    for (a, b, c) in keys {
+        let g = [a, b, c];
         let pair = &by_nodes[&g];
         if pair[0].0 == pair[1].0 {
             continue;
@@ -157,7 +159,7 @@ fn remove_shared_triangles(faces: &mut [FaceWork<'_>]) -> usize {
         gone.extend_from_slice(pair);
     }
     // Highest first within each face: removing one moves only the last triangle.
-    gone.sort_unstable();
+    crate::sort::pairs(&mut gone);
     for &(f, t) in gone.iter().rev() {
         let m = &mut faces[f as usize].mesh;
         let v = m.tris[t as usize];

@@ -317,17 +317,17 @@ fn candidate_pairs(pts: &[(DVec2, DVec2)]) -> Vec<(usize, usize)> {
             }
         }
     }
-    let mut pairs: Vec<(usize, usize)> = Vec::new();
+    let mut pairs: Vec<(u32, u32)> = Vec::new();
     for bucket in &grid {
         for (k, &i) in bucket.iter().enumerate() {
             for &j in &bucket[k + 1..] {
-                pairs.push((i.min(j), i.max(j)));
+                pairs.push((i.min(j) as u32, i.max(j) as u32));
             }
         }
     }
-    pairs.sort_unstable();
+    crate::sort::pairs(&mut pairs);
     pairs.dedup();
-    pairs
+    pairs.into_iter().map(|(i, j)| (i as usize, j as usize)).collect()
 }
 
 /// The net pieces that bound the region of positive winding, each turned

@@ -51,9 +51,10 @@ pub(crate) fn part_touching(faces: &mut [FaceWork<'_>], apart: f64) -> usize {
             split.extend(points.into_iter().map(|p| p.1));
         }
     }
-    split.sort_unstable();
+    let mut split: Vec<(u32, u32, u32)> = split.into_iter().map(|(f, (a, b))| (f, a, b)).collect();
+    crate::sort::triples(&mut split);
     let mut made = 0;
-    for (f, (a, b)) in split {
+    for (f, a, b) in split {
         let w = &mut faces[f as usize];
         if w.mesh.edge_triangles(a, b) != 2 || w.mesh.is_border(a, b) {
             continue;

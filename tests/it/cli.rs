@@ -249,6 +249,52 @@ fn reader_limits_control_points_per_surface() {
     assert!(matches!(&err, Error::Limit(m) if m.contains("face 0") && m.contains("1000000")), "{err}");
 }
 
+/// A one-face model whose first control point's x is written as `x`.
+fn model_with_x(x: &str) -> String {
+    format!(
+        r#"{{"faces": [{{"name": "caf\u00e9 \ud83d\ude00", "surface": {{"degree": [1, 1],
+        "knots": [[0, 0, 1, 1], [0, 0, 1, 1]], "points": [[[{x}, 0, 0], [0, 1, 0]], [[1, 0, 0], [1, 1, 0]]]}}}}]}}"#
+    )
+}
+
+#[test]
+fn reader_reads_numbers_correctly_rounded() {
+    // Shortest round-trip forms (as JavaScript and Rust print doubles): each
+    // must read back as the very double printed. serde_json's default float
+    // parser read these one unit in the last place off.
+    for x in [1.8138734630502207_f64, 9.798104955800099, 3.9030933678265853, 1.9243053591130521, 4.724074003728306e-35]
+    {
+        let model = read_json(model_with_x(&x.to_string()).as_bytes()).unwrap();
+        let surfmesh::FaceSurface::Nurbs(s) = &model.faces[0].surface else { panic!("not a NURBS face") };
+        let first = s.control_points().next().unwrap();
+        assert_eq!(first.x.to_bits(), x.to_bits(), "{x} read as {}", first.x);
+        assert_eq!(model.faces[0].name.as_deref(), Some("caf\u{e9} \u{1f600}"));
+    }
+}
+
+#[test]
+fn reader_rejects_what_json_or_the_schema_does_not_allow() {
+    let good = model_with_x("0");
+    assert!(read_json(good.as_bytes()).is_ok());
+    for (bad, line, word) in [
+        (good.replace(r#""degree": [1, 1]"#, r#""degree": [1.0, 1]"#), 1, "integer"),
+        (good.replace(r#""degree": [1, 1],"#, r#""degree": [1, 1], "degree": [1, 1],"#), 1, "duplicate"),
+        (good.replace(r#""degree": [1, 1],"#, ""), 2, "missing field `degree`"),
+        (good.replace("[[[0, 0, 0]", "[[[01, 0, 0]"), 2, "number"),
+        (good.replace("[[[0, 0, 0]", "[[[-, 0, 0]"), 2, "number"),
+        (good.replace("[[[0, 0, 0]", "[[[1e400, 0, 0]"), 2, "out of range"),
+        (good.replace("[[[0, 0, 0]", "[[[0, 0, 0],]"), 2, "expected"),
+        (good.replace("caf", "\tcaf"), 1, "control character"),
+        (good.replace(r"\u00e9", r"\u00g9"), 1, "unicode"),
+        (good[..good.len() - 2].to_string(), 2, "EOF"),
+    ] {
+        let err = read_json(bad.as_bytes()).unwrap_err();
+        let Error::Json { line: at, message, .. } = &err else { panic!("{bad}: {err:?}") };
+        assert_eq!(*at, line, "{bad}: {message}");
+        assert!(message.contains(word), "{bad}: {message}");
+    }
+}
+
 // ---------------------------------------------------------------- writers
 
 /// A unit square in the z = 0 plane split into two triangles, one per face,

@@ -130,7 +130,7 @@ fn border_uses(faces: &[Option<(&dyn Surface, &mut Outline<'_>)>]) -> (HashMap<(
                 face_of.entry(ga).and_modify(|x| *x = x.filter(|&x| x == f)).or_insert(Some(f));
             }
         }
-        mine.sort_unstable();
+        crate::sort::pairs(&mut mine);
         mine.dedup();
         for p in mine {
             *pairs.entry(p).or_insert(0) += 1;

@@ -59,7 +59,7 @@ fn header_entity(lx: &mut Lexer<'_>, g: &mut Graph, scratch: &mut Vec<Value>) ->
             expect(lx, g, 0, &Tok::Semicolon, "';' after a header entity")?;
             Ok(true)
         }
-        other => Err(lx.error(0, format!("expected an entity or ENDSEC, found {other:?}"))),
+        other => Err(lx.error(0, format!("expected an entity or ENDSEC, found {other}"))),
     }
 }
 

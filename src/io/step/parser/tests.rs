@@ -198,3 +198,13 @@ fn every_prefix_of_a_file_parses_or_fails_cleanly() {
         let _ = parse(&bytes[..n]);
     }
 }
+
+#[test]
+fn syntax_errors_name_the_token_as_the_file_spells_it() {
+    let m = message(file("#1 = FOO(1.5 2);").as_bytes());
+    assert!(m.contains("found the integer `2`"), "{m}");
+    let m = message(file("#1 = FOO(1,2)\n#2 = BAR();").as_bytes());
+    assert!(m.contains("found the instance name `#2`"), "{m}");
+    let m = message(file("#1 FOO(1);").as_bytes());
+    assert!(m.contains("found the keyword `FOO`"), "{m}");
+}
