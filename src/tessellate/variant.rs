@@ -8,7 +8,7 @@ use alloc::vec::Vec;
 use super::mend_loops;
 use super::params::Samples;
 use super::pipeline::Plan;
-use super::trial::{lift_needles, outline_of, rebuild_loses, shorter_edges, tris_of, SHORTER_TRIES};
+use super::trial::{beats_unrefined, lift_needles, outline_of, rebuild_loses, shorter_edges, tris_of, SHORTER_TRIES};
 use super::{face, face_loops, params, refine};
 use crate::options::Reparam;
 use crate::report::Report;
@@ -202,10 +202,15 @@ impl<'m> Plan<'m> {
 
     /// Paper 001's rebuild is kept where it pays: under `auto` the original
     /// is meshed too and wins on more triangles or worse angles (and it wins
-    /// whenever the rebuild fails to mesh). The original goes first, so the
-    /// rebuild's trial stops as soon as it takes more triangles (a creased
-    /// face's rebuild can take 100×). `v` becomes the variant kept; `made`
-    /// collects the outlines the trials made.
+    /// whenever the rebuild fails to mesh). The original's first mesh goes
+    /// first, so the rebuild's trial stops as soon as it takes more
+    /// triangles than that (a creased face's rebuild can take 100×); a
+    /// rebuild that beats that mesh ([`trial::beats_unrefined`]) is kept
+    /// without refining the original, which refinement only makes larger.
+    /// Otherwise the original is refined and judged as a whole, the
+    /// rebuild's trial made again within the original's full count where
+    /// that count ran past the first mesh's. `v` becomes the variant kept;
+    /// `made` collects the outlines the trials made.
     fn judge_rebuild<'p>(
         &'p self,
         index: usize,
@@ -219,21 +224,35 @@ impl<'m> Plan<'m> {
         let budget = self.options.max_triangles;
         let auto = self.options.reparam == Reparam::Auto;
         let orig_loops = self.loops_of(index, original);
-        let mesh_original =
-            || face::mesh_face(index, (original, orig_loops), &self.lim, &self.crit, budget, tight, orig_samples);
-        let mut orig = auto.then(mesh_original);
-        let trial = match &orig {
-            Some(Ok(o)) => budget.min(o.mesh.tris.len().saturating_add(1)),
-            _ => budget,
+        let start_original = || face::start_face(index, (original, orig_loops), &self.lim, budget, tight, orig_samples);
+        let started = auto.then(start_original);
+        // Refinement only splits: the original's first mesh is a floor under its count.
+        let floor = match &started {
+            Some(Ok(s)) => Some(s.mesh.tris.len()),
+            _ => None,
         };
+        let within = |n: usize| budget.min(n.saturating_add(1));
+        let trial = floor.map_or(budget, within);
         let f_loops = self.loops_of(index, f);
-        let mut fr = face::mesh_face(index, (f, f_loops), &v.lim, &v.crit, trial, tight, samples);
+        let mesh_rebuild = |trial: usize| face::mesh_face(index, (f, f_loops), &v.lim, &v.crit, trial, tight, samples);
+        let mut fr = mesh_rebuild(trial);
         let failed = !matches!(&fr, Ok(r) if !r.mesh.tris.is_empty());
-        if !(failed || auto) {
+        let cheap_win = matches!((&fr, &started), (Ok(r), Some(Ok(s))) if beats_unrefined(r, &s.mesh));
+        if cheap_win || !(failed || auto) {
             made.extend(outline_of(&mut fr).map(|o| (f, v.lim, o)));
             return;
         }
-        let mut orig = orig.take().unwrap_or_else(mesh_original);
+        let mut orig = match started {
+            Some(s) => s.map(|s| s.finish(&original.surface, &self.crit, budget)),
+            None => start_original().map(|s| s.finish(&original.surface, &self.crit, budget)),
+        };
+        // The rebuild's trial ran within the floor; the original's own count
+        // is the budget it is judged within.
+        let full = within(tris_of(&orig));
+        if auto && full != trial && (failed || tris_of(&fr) >= trial) {
+            fr = mesh_rebuild(full);
+        }
+        let trial = if auto { full } else { trial };
         let mut why = rebuild_loses(&fr, &orig);
         made.extend(outline_of(&mut fr).map(|o| (f, v.lim, o)));
         if why.is_some() && auto {
