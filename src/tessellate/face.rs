@@ -238,13 +238,15 @@ pub(crate) fn start_face<'a>(
             tight,
             tight + lim.tol,
         );
-        let mesh = initial_from_outline(index, &face.surface, &o, budget)?;
+        let mut mesh = initial_from_outline(index, &face.surface, &o, budget)?;
+        mesh.log_measures();
         Ok(Started { mesh, curves: o.loops.curves, outline: Some(unsewn) })
     }
     #[cfg(not(feature = "std"))]
     {
         let _ = (tight, loops, samples);
-        let (mesh, curves) = initial_face(index, face, lim, budget)?;
+        let (mut mesh, curves) = initial_face(index, face, lim, budget)?;
+        mesh.log_measures();
         Ok(Started { mesh, curves, outline: None })
     }
 }

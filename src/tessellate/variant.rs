@@ -22,6 +22,8 @@ pub(crate) struct Chosen<'a> {
     #[cfg(feature = "std")]
     pub outline: face::Outline<'a>,
     pub fit_error: f64,
+    /// What the trial mesh of this variant measured, within these criteria.
+    carried: refine::Carried,
     /// The grid's limits (with `std` they went into the outline).
     #[cfg(not(feature = "std"))]
     lim: params::Limits,
@@ -52,7 +54,7 @@ impl<'a> Chosen<'a> {
         index: usize,
         (face, loops, samples): (&'a Face, &'a [crate::TrimLoop], &params::Samples),
         (lim, crit): (params::Limits, refine::Criteria),
-        fit_error: f64,
+        (fit_error, carried): (f64, refine::Carried),
         ready: Option<face::Outline<'a>>,
     ) -> Result<Self, Error> {
         #[cfg(feature = "std")]
@@ -67,6 +69,7 @@ impl<'a> Chosen<'a> {
             #[cfg(feature = "std")]
             outline,
             fit_error,
+            carried,
             #[cfg(not(feature = "std"))]
             lim,
             crit,
@@ -118,19 +121,22 @@ impl<'a> Chosen<'a> {
         false
     }
 
-    /// The face's mesh before refinement, and the curves its trim edges follow.
+    /// The face's mesh before refinement, and the curves its trim edges
+    /// follow; the mesh carries what its trial measured.
     pub fn initial(
-        &self,
+        &mut self,
         index: usize,
         budget: usize,
     ) -> Result<(refine::WorkMesh, Vec<&'a crate::NurbsCurve>), Error> {
         #[cfg(feature = "std")]
-        {
-            let wm = face::initial_from_outline(index, &self.face.surface, &self.outline, budget)?;
-            Ok((wm, self.outline.loops.curves.clone()))
-        }
+        let (mut wm, curves) = (
+            face::initial_from_outline(index, &self.face.surface, &self.outline, budget)?,
+            self.outline.loops.curves.clone(),
+        );
         #[cfg(not(feature = "std"))]
-        face::initial_face(index, self.face, &self.lim, budget)
+        let (mut wm, curves) = face::initial_face(index, self.face, &self.lim, budget)?;
+        wm.carried = core::mem::take(&mut self.carried);
+        Ok((wm, curves))
     }
 }
 
@@ -171,19 +177,21 @@ impl<'m> Plan<'m> {
             return Ok(None);
         }
         let mut made: Made<'p> = Vec::new();
+        let mut carried = refine::Carried::default();
         // Grid samples of the original's surface and of the rebuild's, each
         // shared by its trials.
         let samples = Samples::default();
         let rebuild_samples = Samples::default();
         if v.fit_error > 0.0 {
             let cap = self.rebuilt.get(index).and_then(Option::as_ref).map_or(f64::INFINITY, |r| r.max_edge);
-            self.judge_rebuild(index, (cap, [&samples, &rebuild_samples]), &mut v, &mut made, report);
+            let kept = (&mut made, &mut carried);
+            self.judge_rebuild(index, (cap, [&samples, &rebuild_samples]), &mut v, kept, report);
         }
         let loops = self.loops_of(index, v.face);
         let ready =
             made.into_iter().find(|(g, l, _)| core::ptr::eq(*g, v.face) && l.same_as(&v.lim)).map(|(_, _, o)| o);
         let kept = if core::ptr::eq(v.face, original) { &samples } else { &rebuild_samples };
-        let c = Chosen::new(index, (v.face, loops, kept), (v.lim, v.crit), v.fit_error, ready)?;
+        let c = Chosen::new(index, (v.face, loops, kept), (v.lim, v.crit), (v.fit_error, carried), ready)?;
         if let Some(m) = c.mended() {
             report.warnings.push(Warning::face(index, WarningKind::LoopsMended(m)));
         }
@@ -210,15 +218,19 @@ impl<'m> Plan<'m> {
     /// Otherwise the original is refined and judged as a whole, the
     /// rebuild's trial made again within the original's full count where
     /// that count ran past the first mesh's. `v` becomes the variant kept;
-    /// `made` collects the outlines the trials made.
+    /// `made` collects the outlines the trials made, and `carried` what the
+    /// trial of the variant kept measured, when it was meshed within its
+    /// final criteria.
     fn judge_rebuild<'p>(
         &'p self,
         index: usize,
         (cap, [orig_samples, samples]): (f64, [&Samples; 2]),
         v: &mut Variant<'p>,
-        made: &mut Made<'p>,
+        (made, carried): (&mut Made<'p>, &mut refine::Carried),
         report: &mut Report,
     ) {
+        let measured =
+            |r: &TrialMesh<'_>| r.as_ref().map_or_else(|_| refine::Carried::default(), |r| r.mesh.measured());
         let original = &self.model.faces[index];
         let (f, tight) = (v.face, self.auto_tight * self.scale_of(index));
         let budget = self.options.max_triangles;
@@ -239,6 +251,7 @@ impl<'m> Plan<'m> {
         let failed = !matches!(&fr, Ok(r) if !r.mesh.tris.is_empty());
         let cheap_win = matches!((&fr, &started), (Ok(r), Some(Ok(s))) if beats_unrefined(r, &s.mesh));
         if cheap_win || !(failed || auto) {
+            *carried = measured(&fr);
             made.extend(outline_of(&mut fr).map(|o| (f, v.lim, o)));
             return;
         }
@@ -254,6 +267,9 @@ impl<'m> Plan<'m> {
         }
         let trial = if auto { full } else { trial };
         let mut why = rebuild_loses(&fr, &orig);
+        if why.is_none() {
+            *carried = measured(&fr);
+        }
         made.extend(outline_of(&mut fr).map(|o| (f, v.lim, o)));
         if why.is_some() && auto {
             let capped = (fr, v.lim, v.crit);
@@ -267,6 +283,7 @@ impl<'m> Plan<'m> {
                 r.rebuilt = false;
             }
             *v = Variant { face: original, fit_error: 0.0, lim: self.lim, crit: self.crit };
+            *carried = measured(&orig);
             made.extend(outline_of(&mut orig).map(|o| (original, self.lim, o)));
         }
     }
