@@ -197,6 +197,28 @@ pub(crate) fn mesh_face<'a>(
     tight: f64,
     samples: &Samples,
 ) -> Result<FaceResult<'a>, Error> {
+    let started = start_face(index, (face, loops), lim, budget, tight, samples)?;
+    Ok(started.finish(&face.surface, crit, budget))
+}
+
+/// A trial mesh of one face before refinement ([`start_face`]); refinement
+/// only adds triangles, so its count is a floor under the finished mesh's.
+pub(crate) struct Started<'a> {
+    pub mesh: WorkMesh,
+    curves: Vec<&'a crate::NurbsCurve>,
+    outline: Option<Outline<'a>>,
+}
+
+/// The first half of [`mesh_face`]: face `index`'s outline sewn to itself
+/// and triangulated, not yet refined.
+pub(crate) fn start_face<'a>(
+    index: usize,
+    (face, loops): (&'a Face, &'a [crate::TrimLoop]),
+    lim: &Limits,
+    budget: usize,
+    tight: f64,
+    samples: &Samples,
+) -> Result<Started<'a>, Error> {
     #[cfg(feature = "std")]
     {
         // A grid of more cells than [`check_band_cells`] lets through need
@@ -216,29 +238,44 @@ pub(crate) fn mesh_face<'a>(
             tight,
             tight + lim.tol,
         );
-        let mut wm = initial_from_outline(index, &face.surface, &o, budget)?;
-        let outcome = wm.refine(&face.surface, &o.loops.curves, crit, budget);
-        if wm.tris.len() >= budget {
-            // Out of its budget: it loses to any mesh within it, whatever
-            // its shapes; mending them (seconds on a folded face) would
-            // change nothing the comparison reads.
-            return Ok(FaceResult { mesh: wm, outcome, outline: Some(unsewn) });
-        }
-        // Flipped as the model's faces are, so that the shapes compared are
-        // those the model's mesh would have.
-        let flipped = wm.improve_angles(&face.surface, crit, &mut crate::collections::HashSet::default());
-        wm.forget(&flipped);
-        let lifted = wm.lift_angles(&face.surface, crit);
-        wm.forget(&lifted);
-        let outcome = wm.outcome(&face.surface, crit);
-        Ok(FaceResult { mesh: wm, outcome, outline: Some(unsewn) })
+        let mut mesh = initial_from_outline(index, &face.surface, &o, budget)?;
+        mesh.log_measures();
+        Ok(Started { mesh, curves: o.loops.curves, outline: Some(unsewn) })
     }
     #[cfg(not(feature = "std"))]
     {
         let _ = (tight, loops, samples);
-        let (mut wm, curves) = initial_face(index, face, lim, budget)?;
-        let outcome = wm.refine(&face.surface, &curves, crit, budget);
-        Ok(FaceResult { mesh: wm, outcome, outline: None })
+        let (mut mesh, curves) = initial_face(index, face, lim, budget)?;
+        mesh.log_measures();
+        Ok(Started { mesh, curves, outline: None })
+    }
+}
+
+impl<'a> Started<'a> {
+    /// The second half of [`mesh_face`]: the mesh refined on `surface`
+    /// within `crit` and `budget`, and (with `std`) its angles improved.
+    pub(crate) fn finish(self, surface: &dyn Surface, crit: &Criteria, budget: usize) -> FaceResult<'a> {
+        let Started { mesh: mut wm, curves, outline } = self;
+        let outcome = wm.refine(surface, &curves, crit, budget);
+        #[cfg(feature = "std")]
+        {
+            if wm.tris.len() >= budget {
+                // Out of its budget: it loses to any mesh within it, whatever
+                // its shapes; mending them (seconds on a folded face) would
+                // change nothing the comparison reads.
+                return FaceResult { mesh: wm, outcome, outline };
+            }
+            // Flipped as the model's faces are, so that the shapes compared are
+            // those the model's mesh would have.
+            let flipped = wm.improve_angles(surface, crit, &mut crate::collections::HashSet::default());
+            wm.forget(&flipped);
+            let lifted = wm.lift_angles(surface, crit);
+            wm.forget(&lifted);
+            let outcome = wm.outcome(surface, crit);
+            FaceResult { mesh: wm, outcome, outline }
+        }
+        #[cfg(not(feature = "std"))]
+        FaceResult { mesh: wm, outcome, outline }
     }
 }
 

@@ -299,7 +299,7 @@ impl<'m> Plan<'m> {
         for (index, c) in sewn.faces.into_iter().enumerate() {
             let f = &self.model.faces[index];
             works.pinched.push(c.as_ref().is_some_and(Chosen::pinched));
-            let Some(c) = c else {
+            let Some(mut c) = c else {
                 works.faces.push(empty_work(f, self.crit));
                 works.fit_errors.push(0.0);
                 continue;
@@ -351,6 +351,9 @@ impl<'m> Plan<'m> {
     ) -> Result<Refined, Error> {
         let sew = |f: usize| self.sew_tol * self.scale_of(f);
         works.budget_hit = sew::refine_all(&mut works.faces, works.ids, &sew, self.options.max_triangles, progress)?;
+        for w in works.faces.iter_mut() {
+            w.mesh.carried = Default::default();
+        }
         let (settled, places) = sew::settle_nodes(&mut works.faces, 1e-6 * self.tol);
         works.check("refinement", Known::SEWN);
         for (w, moved) in works.faces.iter_mut().zip(&settled) {

@@ -102,7 +102,22 @@ pub(crate) struct WorkMesh {
     /// Distances at edge samples whose other triangle is still to be
     /// measured; held only while a refinement or an outcome measures.
     edge_samples: EdgeSamples,
+    /// Measures a trial mesh of this face took within the same criteria,
+    /// by triangle ([`WorkMesh::measure_key`]): the one refinement of the
+    /// model's mesh would take again where its triangles are the trial's.
+    pub carried: Carried,
+    /// Every measure taken, by triangle, while logging (a trial mesh's:
+    /// the triangles refinement went on to split are measured again when
+    /// the model's mesh is refined).
+    log: Option<Carried>,
 }
+
+/// A triangle's corner points, (u,v)s and normals, bit for bit: all its
+/// measure depends on, for one surface and criteria.
+pub(crate) type MeasureKey = ([u64; 15], [u32; 9]);
+
+/// Measures by [`MeasureKey`], carried from a trial mesh to the model's.
+pub(crate) type Carried = HashMap<MeasureKey, Packed>;
 
 /// One triangle of an edge being split.
 #[derive(Debug, Clone, Copy)]
@@ -940,13 +955,57 @@ impl WorkMesh {
         if !x.max.is_nan() {
             return Some(x.unpack());
         }
+        if let Some(&x) = (!self.carried.is_empty()).then(|| self.carried.get(&self.measure_key(t))).flatten() {
+            // As measured here: whole where within `limit`, else `None` (left
+            // stale), unless packing's rounding up leaves that in doubt.
+            if f64::from(x.max) <= limit {
+                self.measures[t] = x;
+                return Some(x.unpack());
+            }
+            if x.max_above() >= limit {
+                return None;
+            }
+        }
         let mut shared = core::mem::take(&mut self.edge_samples);
         let measured = self.measure_sharing(surface, t, c, Some(&mut shared), limit);
         self.edge_samples = shared;
         let (m, turn) = measured?;
         let x = Packed::pack(m, turn);
         self.measures[t] = x;
+        if self.log.is_some() {
+            let key = self.measure_key(t);
+            self.log.get_or_insert_with(Carried::default).insert(key, x);
+        }
         Some(x.unpack())
+    }
+
+    /// Triangle `t`'s [`MeasureKey`].
+    fn measure_key(&self, t: usize) -> MeasureKey {
+        let (v, uv) = (self.tris[t], self.uv(t));
+        let mut k = ([0u64; 15], [0u32; 9]);
+        for c in 0..3 {
+            let (p, n) = (self.pos[v[c] as usize], self.normal[v[c] as usize]);
+            k.0[5 * c..5 * c + 5].copy_from_slice(&[p.x, p.y, p.z, uv[c].x, uv[c].y].map(f64::to_bits));
+            k.1[3 * c..3 * c + 3].copy_from_slice(&[n.x, n.y, n.z].map(f32::to_bits));
+        }
+        k
+    }
+
+    /// Keeps every measure taken from now on for [`WorkMesh::measured`].
+    pub fn log_measures(&mut self) {
+        self.log.get_or_insert_with(Carried::default);
+    }
+
+    /// The measures this mesh holds and those it logged, by triangle, for
+    /// the model's mesh of the same face and criteria ([`WorkMesh::carried`]).
+    pub fn measured(&self) -> Carried {
+        let mut out = self.log.clone().unwrap_or_default();
+        for (t, x) in self.measures.iter().enumerate().take(self.tris.len()) {
+            if !x.max.is_nan() {
+                out.insert(self.measure_key(t), *x);
+            }
+        }
+        out
     }
 
     /// Drops the cached measures of triangles `ts` (they changed).

@@ -128,6 +128,29 @@ pub(super) fn p1(m: &refine::WorkMesh) -> f64 {
     a.get(a.len().saturating_sub(1) / 100).map_or(0.0, |x| x.to_degrees())
 }
 
+/// How many times the 1st-percentile angle of the original's first mesh
+/// a rebuild's must be for [`beats_unrefined`]: refinement and its flips
+/// move the original's either way (the fuselage's faces fell from 0.1° to
+/// 0.007°; asmo_car's face 1 rose from 1.4° to 4.2°, the most in the
+/// corpus survey), and the judgement made without them must agree with the
+/// one made with them.
+const FIRST_ANGLE_MARGIN: f64 = 3.0;
+
+/// Whether the trial mesh of a rebuilt face, `new`, wins against the
+/// original's first mesh, before refinement (`first`): what
+/// [`rebuild_loses`] reads, found without refining the original. `new` is
+/// proven (so no less than the original), has no more triangles than
+/// `first` (refinement only adds them) and a 1st-percentile angle
+/// [`FIRST_ANGLE_MARGIN`] times `first`'s. On a face whose crowded
+/// parameters give the original thousands of triangles before refinement
+/// (the fuselage's), refining them was most of the trial's time.
+pub(super) fn beats_unrefined(new: &face::FaceResult<'_>, first: &refine::WorkMesh) -> bool {
+    !new.mesh.tris.is_empty()
+        && new.outcome.unproven == 0
+        && new.mesh.tris.len() <= first.tris.len()
+        && p1(&new.mesh) >= FIRST_ANGLE_MARGIN * p1(first)
+}
+
 /// Why the mesh of a rebuilt face loses to the original's, if it does: it
 /// failed or is empty, is not proven where the original is, has more
 /// triangles, or a smaller 1st-percentile angle. `None` keeps the rebuild.
@@ -177,5 +200,40 @@ mod tests {
         assert!(!loses_on_shape_alone(&result(60, 3), &old), "more unproven");
         assert!(!loses_on_shape_alone(&result(100, 0), &old), "as many triangles");
         assert!(!loses_on_shape_alone(&result(0, 0), &old), "empty");
+    }
+
+    /// A mesh of `n` triangles, each a fan corner of apex angle `deg`
+    /// degrees (its smallest), apart from one another.
+    fn fan(n: usize, deg: f64) -> refine::WorkMesh {
+        let mut m = refine::WorkMesh::default();
+        let (s, c) = (libm::sin(deg.to_radians()), libm::cos(deg.to_radians()));
+        for k in 0..n {
+            let o = glam::DVec3::new(10.0 * k as f64, 0.0, 0.0);
+            let v = m.pos.len() as u32;
+            m.pos.extend([o, o + glam::DVec3::new(1.0, 0.0, 0.0), o + glam::DVec3::new(c, s, 0.0)]);
+            m.gid.extend([u32::MAX; 3]);
+            m.tris.push([v, v + 1, v + 2]);
+        }
+        m
+    }
+
+    /// A rebuild is kept on the original's first mesh alone only when it is
+    /// proven, no larger than that mesh (refinement only adds to it) and
+    /// its angles beat that mesh's by the margin; anything less leaves the
+    /// judgement to the original's refined mesh.
+    #[test]
+    fn a_rebuild_beats_the_unrefined_original_only_by_a_margin() {
+        let first = fan(100, 2.0);
+        let new = |n: usize, deg: f64, unproven: usize| face::FaceResult {
+            mesh: fan(n, deg),
+            outcome: refine::Outcome { unproven, ..Default::default() },
+            outline: None,
+        };
+        assert!(beats_unrefined(&new(40, 6.5, 0), &first));
+        assert!(beats_unrefined(&new(100, 6.5, 0), &first), "as many triangles");
+        assert!(!beats_unrefined(&new(101, 6.5, 0), &first), "more triangles than the first mesh");
+        assert!(!beats_unrefined(&new(40, 6.5, 1), &first), "unproven");
+        assert!(!beats_unrefined(&new(40, 5.0, 0), &first), "better shaped, but within the margin");
+        assert!(!beats_unrefined(&new(0, 6.5, 0), &first), "empty");
     }
 }

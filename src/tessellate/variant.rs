@@ -8,7 +8,7 @@ use alloc::vec::Vec;
 use super::mend_loops;
 use super::params::Samples;
 use super::pipeline::Plan;
-use super::trial::{lift_needles, outline_of, rebuild_loses, shorter_edges, tris_of, SHORTER_TRIES};
+use super::trial::{beats_unrefined, lift_needles, outline_of, rebuild_loses, shorter_edges, tris_of, SHORTER_TRIES};
 use super::{face, face_loops, params, refine};
 use crate::options::Reparam;
 use crate::report::Report;
@@ -22,6 +22,8 @@ pub(crate) struct Chosen<'a> {
     #[cfg(feature = "std")]
     pub outline: face::Outline<'a>,
     pub fit_error: f64,
+    /// What the trial mesh of this variant measured, within these criteria.
+    carried: refine::Carried,
     /// The grid's limits (with `std` they went into the outline).
     #[cfg(not(feature = "std"))]
     lim: params::Limits,
@@ -52,7 +54,7 @@ impl<'a> Chosen<'a> {
         index: usize,
         (face, loops, samples): (&'a Face, &'a [crate::TrimLoop], &params::Samples),
         (lim, crit): (params::Limits, refine::Criteria),
-        fit_error: f64,
+        (fit_error, carried): (f64, refine::Carried),
         ready: Option<face::Outline<'a>>,
     ) -> Result<Self, Error> {
         #[cfg(feature = "std")]
@@ -67,6 +69,7 @@ impl<'a> Chosen<'a> {
             #[cfg(feature = "std")]
             outline,
             fit_error,
+            carried,
             #[cfg(not(feature = "std"))]
             lim,
             crit,
@@ -118,19 +121,22 @@ impl<'a> Chosen<'a> {
         false
     }
 
-    /// The face's mesh before refinement, and the curves its trim edges follow.
+    /// The face's mesh before refinement, and the curves its trim edges
+    /// follow; the mesh carries what its trial measured.
     pub fn initial(
-        &self,
+        &mut self,
         index: usize,
         budget: usize,
     ) -> Result<(refine::WorkMesh, Vec<&'a crate::NurbsCurve>), Error> {
         #[cfg(feature = "std")]
-        {
-            let wm = face::initial_from_outline(index, &self.face.surface, &self.outline, budget)?;
-            Ok((wm, self.outline.loops.curves.clone()))
-        }
+        let (mut wm, curves) = (
+            face::initial_from_outline(index, &self.face.surface, &self.outline, budget)?,
+            self.outline.loops.curves.clone(),
+        );
         #[cfg(not(feature = "std"))]
-        face::initial_face(index, self.face, &self.lim, budget)
+        let (mut wm, curves) = face::initial_face(index, self.face, &self.lim, budget)?;
+        wm.carried = core::mem::take(&mut self.carried);
+        Ok((wm, curves))
     }
 }
 
@@ -171,19 +177,21 @@ impl<'m> Plan<'m> {
             return Ok(None);
         }
         let mut made: Made<'p> = Vec::new();
+        let mut carried = refine::Carried::default();
         // Grid samples of the original's surface and of the rebuild's, each
         // shared by its trials.
         let samples = Samples::default();
         let rebuild_samples = Samples::default();
         if v.fit_error > 0.0 {
             let cap = self.rebuilt.get(index).and_then(Option::as_ref).map_or(f64::INFINITY, |r| r.max_edge);
-            self.judge_rebuild(index, (cap, [&samples, &rebuild_samples]), &mut v, &mut made, report);
+            let kept = (&mut made, &mut carried);
+            self.judge_rebuild(index, (cap, [&samples, &rebuild_samples]), &mut v, kept, report);
         }
         let loops = self.loops_of(index, v.face);
         let ready =
             made.into_iter().find(|(g, l, _)| core::ptr::eq(*g, v.face) && l.same_as(&v.lim)).map(|(_, _, o)| o);
         let kept = if core::ptr::eq(v.face, original) { &samples } else { &rebuild_samples };
-        let c = Chosen::new(index, (v.face, loops, kept), (v.lim, v.crit), v.fit_error, ready)?;
+        let c = Chosen::new(index, (v.face, loops, kept), (v.lim, v.crit), (v.fit_error, carried), ready)?;
         if let Some(m) = c.mended() {
             report.warnings.push(Warning::face(index, WarningKind::LoopsMended(m)));
         }
@@ -202,39 +210,66 @@ impl<'m> Plan<'m> {
 
     /// Paper 001's rebuild is kept where it pays: under `auto` the original
     /// is meshed too and wins on more triangles or worse angles (and it wins
-    /// whenever the rebuild fails to mesh). The original goes first, so the
-    /// rebuild's trial stops as soon as it takes more triangles (a creased
-    /// face's rebuild can take 100×). `v` becomes the variant kept; `made`
-    /// collects the outlines the trials made.
+    /// whenever the rebuild fails to mesh). The original's first mesh goes
+    /// first, so the rebuild's trial stops as soon as it takes more
+    /// triangles than that (a creased face's rebuild can take 100×); a
+    /// rebuild that beats that mesh ([`trial::beats_unrefined`]) is kept
+    /// without refining the original, which refinement only makes larger.
+    /// Otherwise the original is refined and judged as a whole, the
+    /// rebuild's trial made again within the original's full count where
+    /// that count ran past the first mesh's. `v` becomes the variant kept;
+    /// `made` collects the outlines the trials made, and `carried` what the
+    /// trial of the variant kept measured, when it was meshed within its
+    /// final criteria.
     fn judge_rebuild<'p>(
         &'p self,
         index: usize,
         (cap, [orig_samples, samples]): (f64, [&Samples; 2]),
         v: &mut Variant<'p>,
-        made: &mut Made<'p>,
+        (made, carried): (&mut Made<'p>, &mut refine::Carried),
         report: &mut Report,
     ) {
+        let measured =
+            |r: &TrialMesh<'_>| r.as_ref().map_or_else(|_| refine::Carried::default(), |r| r.mesh.measured());
         let original = &self.model.faces[index];
         let (f, tight) = (v.face, self.auto_tight * self.scale_of(index));
         let budget = self.options.max_triangles;
         let auto = self.options.reparam == Reparam::Auto;
         let orig_loops = self.loops_of(index, original);
-        let mesh_original =
-            || face::mesh_face(index, (original, orig_loops), &self.lim, &self.crit, budget, tight, orig_samples);
-        let mut orig = auto.then(mesh_original);
-        let trial = match &orig {
-            Some(Ok(o)) => budget.min(o.mesh.tris.len().saturating_add(1)),
-            _ => budget,
+        let start_original = || face::start_face(index, (original, orig_loops), &self.lim, budget, tight, orig_samples);
+        let started = auto.then(start_original);
+        // Refinement only splits: the original's first mesh is a floor under its count.
+        let floor = match &started {
+            Some(Ok(s)) => Some(s.mesh.tris.len()),
+            _ => None,
         };
+        let within = |n: usize| budget.min(n.saturating_add(1));
+        let trial = floor.map_or(budget, within);
         let f_loops = self.loops_of(index, f);
-        let mut fr = face::mesh_face(index, (f, f_loops), &v.lim, &v.crit, trial, tight, samples);
+        let mesh_rebuild = |trial: usize| face::mesh_face(index, (f, f_loops), &v.lim, &v.crit, trial, tight, samples);
+        let mut fr = mesh_rebuild(trial);
         let failed = !matches!(&fr, Ok(r) if !r.mesh.tris.is_empty());
-        if !(failed || auto) {
+        let cheap_win = matches!((&fr, &started), (Ok(r), Some(Ok(s))) if beats_unrefined(r, &s.mesh));
+        if cheap_win || !(failed || auto) {
+            *carried = measured(&fr);
             made.extend(outline_of(&mut fr).map(|o| (f, v.lim, o)));
             return;
         }
-        let mut orig = orig.take().unwrap_or_else(mesh_original);
+        let mut orig = match started {
+            Some(s) => s.map(|s| s.finish(&original.surface, &self.crit, budget)),
+            None => start_original().map(|s| s.finish(&original.surface, &self.crit, budget)),
+        };
+        // The rebuild's trial ran within the floor; the original's own count
+        // is the budget it is judged within.
+        let full = within(tris_of(&orig));
+        if auto && full != trial && (failed || tris_of(&fr) >= trial) {
+            fr = mesh_rebuild(full);
+        }
+        let trial = if auto { full } else { trial };
         let mut why = rebuild_loses(&fr, &orig);
+        if why.is_none() {
+            *carried = measured(&fr);
+        }
         made.extend(outline_of(&mut fr).map(|o| (f, v.lim, o)));
         if why.is_some() && auto {
             let capped = (fr, v.lim, v.crit);
@@ -248,6 +283,7 @@ impl<'m> Plan<'m> {
                 r.rebuilt = false;
             }
             *v = Variant { face: original, fit_error: 0.0, lim: self.lim, crit: self.crit };
+            *carried = measured(&orig);
             made.extend(outline_of(&mut orig).map(|o| (original, self.lim, o)));
         }
     }

@@ -9,7 +9,7 @@ use super::TriMeasure;
 pub(crate) const FOLD_TURN: f64 = core::f64::consts::FRAC_PI_2;
 
 /// Limits a triangle must meet.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Criteria {
     pub tol: f64,
     pub angle: f64,
@@ -116,6 +116,12 @@ fn up(x: f64) -> f32 {
 impl Packed {
     pub(super) fn pack(m: TriMeasure, turn: f64) -> Self {
         Self { max: up(m.max), sum: m.sum as f32, turn: up(turn) }
+    }
+
+    /// The largest `f32` below the packed largest distance: the measured one
+    /// lies above it (packing rounds up).
+    pub(super) fn max_above(self) -> f64 {
+        f64::from(if self.max > 0.0 { f32::from_bits(self.max.to_bits() - 1) } else { 0.0 })
     }
 
     pub(super) fn unpack(self) -> (TriMeasure, f64) {

@@ -431,3 +431,72 @@ fn slivers_folded_by_their_shape_are_split() {
     assert!(m.folded(&s).is_empty(), "{} triangles still folded", m.folded(&s).len());
     assert!(m.tris.len() <= 8 * rows, "{} triangles", m.tris.len());
 }
+
+/// A surface that counts its evaluations.
+struct Counted<S> {
+    s: S,
+    calls: core::cell::Cell<usize>,
+}
+
+impl<S: Surface> Counted<S> {
+    fn tick(&self) {
+        self.calls.set(self.calls.get() + 1);
+    }
+}
+
+impl<S: Surface> Surface for Counted<S> {
+    fn domain(&self) -> [DVec2; 2] {
+        self.s.domain()
+    }
+    fn point(&self, uv: DVec2) -> DVec3 {
+        self.tick();
+        self.s.point(uv)
+    }
+    fn derivs(&self, uv: DVec2) -> crate::nurbs::SurfaceDerivs {
+        self.tick();
+        self.s.derivs(uv)
+    }
+    fn tangents(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
+        self.tick();
+        self.s.tangents(uv)
+    }
+    fn breaks(&self, along_u: bool) -> Vec<f64> {
+        self.s.breaks(along_u)
+    }
+    fn bounding_box(&self) -> crate::nurbs::Aabb {
+        self.s.bounding_box()
+    }
+}
+
+/// Measures a trial mesh took serve the model's mesh of the same face and
+/// criteria: refined from the same first mesh, it ends the same, bit for
+/// bit, measuring only the triangles the trial did not measure (here
+/// none: its evaluations fall to the new vertices and the fold checks), and
+/// a carried measure over the limits still fails its triangle.
+#[test]
+fn carried_measures_stand_in_for_measuring() {
+    let s = Counted { s: plane(), calls: core::cell::Cell::new(0) };
+    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 0.6, min_edge: 0.0, steps: 4, lift: Lift::NONE };
+    let mut trial = grid();
+    trial.log_measures();
+    let want = trial.refine(&s, &[], &c, 100_000);
+    let (mut fresh, mut carried) = (grid(), grid());
+    carried.carried = trial.measured();
+    assert!(carried.carried.len() > trial.tris.len(), "the split triangles' measures are carried too");
+    let calls = [&mut fresh, &mut carried].map(|m| {
+        s.calls.set(0);
+        let got = m.refine(&s, &[], &c, 100_000);
+        assert_eq!(m.tris, trial.tris);
+        assert_eq!((got.max.to_bits(), got.sum.to_bits(), got.unproven), (want.max.to_bits(), want.sum.to_bits(), 0));
+        s.calls.get()
+    });
+    // What is left is placing the new vertices and checking for folds.
+    assert!(calls[0] > 12 * trial.tris.len(), "{calls:?}");
+    assert!(4 * calls[1] < calls[0], "{calls:?}");
+    // A triangle whose carried measure is over the tolerance is split as if measured.
+    let mut over = grid();
+    let big = limits::Packed::pack(TriMeasure { max: 1.0, sum: 1.0 }, 0.0);
+    over.carried = (0..over.tris.len()).map(|t| (over.measure_key(t), big)).collect();
+    over.refine(&s, &[], &Criteria { max_edge: f64::INFINITY, ..c }, 100_000);
+    assert!(over.tris.len() > grid().tris.len(), "{} triangles", over.tris.len());
+}
