@@ -53,9 +53,12 @@ static A: Counting = Counting;
 /// trj6 (801 faces, 42k triangles): 191 bytes a triangle, 8.0 MB; 226 with
 /// faces kept awake between refinement visits. The output is 28 bytes a triangle.
 /// With no lines packed against trim borders (params.rs) it took 1% fewer
-/// triangles at the same 7.68 MB peak: 207 bytes a triangle.
+/// triangles at the same 7.68 MB peak: 207 bytes a triangle. The log of
+/// the measures reparam's trials took, held until the model's refinement
+/// has used it, raised the peak by 113 KB (1.5%) to 7.79 MB, and fold
+/// splitting's changes took 0.2% fewer triangles: 211 bytes a triangle.
 #[test]
-fn meshing_the_largest_model_peaks_under_210_bytes_a_triangle() {
+fn meshing_the_largest_model_peaks_under_215_bytes_a_triangle() {
     let bytes = corpus_files::corpus_bytes("trj6_pm4-ec-203.stp");
     let model = read_model(&bytes, Format::detect(&bytes).unwrap()).unwrap();
     let before = NOW.load(Relaxed);
@@ -65,5 +68,5 @@ fn meshing_the_largest_model_peaks_under_210_bytes_a_triangle() {
     let tris = r.report.triangles;
     assert!(tris > 30_000, "{tris} triangles");
     let per = peak as f64 / tris as f64;
-    assert!(per < 210.0, "mesh phase peak {peak} bytes over the model: {per:.0} bytes a triangle");
+    assert!(per < 215.0, "mesh phase peak {peak} bytes over the model: {per:.0} bytes a triangle");
 }
