@@ -110,14 +110,8 @@ impl<'a> Text<'a> {
             self.eat(b':')?;
             field(self, &key)?;
             seen.push(key);
-            match self.peek() {
-                Some(b',') => self.pos += 1,
-                Some(b'}') => {
-                    self.pos += 1;
-                    return Ok(());
-                }
-                Some(_) => return Err(self.error("expected `,` or `}`")),
-                None => return Err(self.error("EOF while parsing an object")),
+            if self.next_or_end(b'}', "an object")? {
+                return Ok(());
             }
         }
     }
@@ -134,15 +128,27 @@ impl<'a> Text<'a> {
         }
         loop {
             item(self)?;
-            match self.peek() {
-                Some(b',') => self.pos += 1,
-                Some(b']') => {
-                    self.pos += 1;
-                    return Ok(());
-                }
-                Some(_) => return Err(self.error("expected `,` or `]`")),
-                None => return Err(self.error("EOF while parsing a list")),
+            if self.next_or_end(b']', "a list")? {
+                return Ok(());
             }
+        }
+    }
+
+    /// After an object's field or an array's item: `,` before the next
+    /// (false) or `end`, which closes it (true); `what` names it in the
+    /// error where the text ends.
+    fn next_or_end(&mut self, end: u8, what: &str) -> Scan<bool> {
+        match self.peek() {
+            Some(b',') => {
+                self.pos += 1;
+                Ok(false)
+            }
+            Some(b) if b == end => {
+                self.pos += 1;
+                Ok(true)
+            }
+            Some(_) => Err(self.error(format!("expected `,` or `{}`", end as char))),
+            None => Err(self.error(format!("EOF while parsing {what}"))),
         }
     }
 

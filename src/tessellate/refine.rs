@@ -370,7 +370,6 @@ impl WorkMesh {
     }
 
     /// Whether edge `a-b` is a border edge (one triangle), at rest as awake.
-    #[cfg(feature = "std")]
     pub fn is_border(&self, a: u32, b: u32) -> bool {
         if self.resting {
             return self.rim.contains_key(&key(a, b));
@@ -924,14 +923,12 @@ impl WorkMesh {
                 .all(|(&v, q)| self.pos[v as usize].distance(surface.point(q)) <= ON_SURFACE * c.tol)
     }
 
-    /// Whether triangle `t` has a border edge (one triangle) no longer than
-    /// `hair`; the mesh must be awake.
+    /// Whether triangle `t` has a border edge (one triangle) no longer than `hair`.
     fn on_hair(&self, t: usize, hair: f64) -> bool {
         let v = self.tris[t];
         (0..3).any(|k| {
             let (a, b) = (v[k], v[(k + 1) % 3]);
-            self.pair(a, b).is_some_and(|e| e.contains(&NONE))
-                && self.pos[a as usize].distance(self.pos[b as usize]) <= hair
+            self.is_border(a, b) && self.pos[a as usize].distance(self.pos[b as usize]) <= hair
         })
     }
 

@@ -255,10 +255,7 @@ impl<'m> Plan<'m> {
             made.extend(outline_of(&mut fr).map(|o| (f, v.lim, o)));
             return;
         }
-        let mut orig = match started {
-            Some(s) => s.map(|s| s.finish(&original.surface, &self.crit, budget)),
-            None => start_original().map(|s| s.finish(&original.surface, &self.crit, budget)),
-        };
+        let mut orig = started.unwrap_or_else(start_original).map(|s| s.finish(&original.surface, &self.crit, budget));
         // The rebuild's trial ran within the floor; the original's own count
         // is the budget it is judged within.
         let full = within(tris_of(&orig));
