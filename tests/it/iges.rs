@@ -322,6 +322,21 @@ fn fuzz_timeout_off_surface_trim_curve_reads_and_fails_cleanly() {
     assert!(r.mesh.face_ranges.iter().enumerate().all(|(i, f)| i == 1 || f.count > 0));
 }
 
+/// Found by fuzzing (a debug build's invariant check): a mutated B-spline
+/// sheet whose surface folds over itself. Mending flipped an edge between
+/// inner nodes into a pair that turns clockwise in (u,v), because the pair
+/// happened to face the surface's normal in space at the quad's middle. An
+/// inner node's (u,v) is exact, so such a flip is refused; the debug build
+/// checks every triangle's turn after each stage.
+#[test]
+fn fuzz_folded_sheet_keeps_inner_triangles_counter_clockwise() {
+    let model = read_iges(&data("iges_fuzz_folded_flip.igs")).unwrap();
+    let options = MeshOptions::default().with_relative_tolerance(0.05).with_max_triangles(5_000);
+    let r = mesh_model(&model, &options).expect("meshes");
+    assert!(r.report.triangles > 0, "{:?}", r.report.warnings);
+    assert!(r.report.max_deviation <= r.report.tolerance, "{} > {}", r.report.max_deviation, r.report.tolerance);
+}
+
 #[test]
 fn format_from_extension_and_first_line() {
     assert_eq!(Format::from_name("igs").unwrap(), Format::Iges);

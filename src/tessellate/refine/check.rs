@@ -11,6 +11,8 @@
 use alloc::vec::Vec;
 use core::fmt;
 
+use glam::DVec2;
+
 use super::{key, WorkMesh, NONE, UV_UNSET};
 use crate::collections::HashMap;
 use crate::nurbs::Surface;
@@ -178,9 +180,14 @@ impl WorkMesh {
     /// one line in (u,v) (`twice_area` within rounding of zero), as on an
     /// iso-line, where the surface curves between them.
     fn uv_cannot_tell(&self, t: usize, twice_area: f64) -> bool {
-        let w = self.uv(t);
+        self.uv_cannot_tell_of(self.tris[t], self.uv(t), twice_area)
+    }
+
+    /// [`WorkMesh::uv_cannot_tell`] for corners `v` at (u,v) `w`, before
+    /// they are a triangle of the mesh (a flip's candidates).
+    pub(super) fn uv_cannot_tell_of(&self, v: [u32; 3], w: [DVec2; 3], twice_area: f64) -> bool {
         let longest = (0..3).map(|k| w[k].distance_squared(w[(k + 1) % 3])).fold(0.0, f64::max);
-        self.tris[t].iter().any(|&v| self.gid[v as usize] != NONE) || twice_area.abs() <= FLAT_UV * longest
+        v.iter().any(|&v| self.gid[v as usize] != NONE) || twice_area.abs() <= FLAT_UV * longest
     }
 
     /// The tables agree: the per-vertex tables (position, normal, node id,

@@ -245,11 +245,21 @@ impl WorkMesh {
         let sense = uv_area([qb2, qa2, qd]);
         let (t1, t2) = ([a, d, cv], [d, b, cv]);
         let (w1, w2) = ([qa, qd, qc], [qd, qb, qc]);
-        let uv_ok = uv_area(w1) * sense > 0.0 && uv_area(w2) * sense > 0.0;
+        let turns = |v: [u32; 3], w: [DVec2; 3]| {
+            let area = uv_area(w);
+            (area * sense > 0.0, self.uv_cannot_tell_of(v, w, area))
+        };
+        let ((ok1, stale1), (ok2, stale2)) = (turns(t1, w1), turns(t2, w2));
+        let uv_ok = ok1 && ok2;
         // Sewing moves border nodes in space, not in (u,v): where it folded a
         // triangle, the flip that unfolds it can look folded in the stale
         // (u,v), so the new pair is judged in space against the surface's
-        // normal there too.
+        // normal there too. So is a pair flat in (u,v) on an iso-line. Inner
+        // nodes' (u,v) are exact: a pair turned there stays refused, however
+        // it faces in space where the surface itself folds over.
+        if !(ok1 || stale1) || !(ok2 || stale2) {
+            return None;
+        }
         let space_ok = || {
             let n = surface.normal((qa + qb + qc + qd) / 4.0);
             let p = |v: u32| self.pos[v as usize];
