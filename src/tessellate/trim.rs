@@ -244,12 +244,14 @@ fn discretize_loop<'a>(
 /// normal and tangent are evaluated once and kept (by the parameter's bits)
 /// while the curve is discretized.
 fn curve_parameters(c: &crate::NurbsCurve, surface: &dyn Surface, lim: &Limits) -> Vec<f64> {
+    // First derivatives are all the tests use: `tangents` gives the bits
+    // `derivs` gives for them without the second-order sums.
     let on_surface = memo_by_bits(|t: f64| {
         let d = c.derivs(t);
         let uv = d.point.truncate();
-        let s = surface.derivs(uv);
-        let tangent = s.su * d.d1.x + s.sv * d.d1.y;
-        (s.point, surface.normal_from_tangents(uv, s.su, s.sv), tangent)
+        let (point, su, sv) = surface.tangents(uv);
+        let tangent = su * d.d1.x + sv * d.d1.y;
+        (point, surface.normal_from_tangents(uv, su, sv), tangent)
     });
     let by_normal = |t: f64| {
         let (p, n, _) = on_surface(t);
@@ -716,6 +718,53 @@ mod tests {
         for (s, at) in poly.seg.iter().zip(&poly.at) {
             assert_eq!((s.0, s.1), (at.curve, at.t));
         }
+    }
+
+    /// A surface that counts its evaluations with second derivatives.
+    struct CountingDerivs<'a> {
+        inner: &'a dyn Surface,
+        derivs: core::cell::Cell<usize>,
+    }
+
+    impl Surface for CountingDerivs<'_> {
+        fn domain(&self) -> [DVec2; 2] {
+            self.inner.domain()
+        }
+        fn point(&self, uv: DVec2) -> DVec3 {
+            self.inner.point(uv)
+        }
+        fn derivs(&self, uv: DVec2) -> crate::nurbs::SurfaceDerivs {
+            self.derivs.set(self.derivs.get() + 1);
+            self.inner.derivs(uv)
+        }
+        fn tangents(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
+            self.inner.tangents(uv)
+        }
+        fn breaks(&self, along_u: bool) -> Vec<f64> {
+            self.inner.breaks(along_u)
+        }
+        fn bounding_box(&self) -> crate::nurbs::Aabb {
+            self.inner.bounding_box()
+        }
+    }
+
+    /// Discretizing a trim curve tests chords, normals and tangents, all of
+    /// first order: it evaluates the surface without second derivatives
+    /// (each costs about a third more, for nothing), to the same nodes.
+    #[test]
+    fn trim_curves_take_no_second_derivatives() {
+        let k = alloc::vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        let pts: Vec<Vec<DVec3>> = (0..4)
+            .map(|i| (0..4).map(|j| DVec3::new(i as f64, j as f64, if (i + j) % 3 == 0 { 1.5 } else { 0.0 })).collect())
+            .collect();
+        let bump = crate::FaceSurface::Nurbs(crate::NurbsSurface::try_new([3, 3], k.clone(), k, &pts, None).unwrap());
+        let counting = CountingDerivs { inner: &bump, derivs: core::cell::Cell::new(0) };
+        let c = bezier(DVec2::new(0.05, 0.1), DVec2::new(0.9, 0.2), DVec2::new(0.7, 0.95));
+        let lim = Limits { tol: 1e-3, angle: 0.2, max_edge: f64::INFINITY, min_edge: 1e-6 };
+        let ts = curve_parameters(&c, &counting, &lim);
+        assert!(ts.len() > 8, "the curve must be split: {} nodes", ts.len());
+        assert_eq!(counting.derivs.get(), 0, "evaluations with second derivatives");
+        assert_eq!(ts, curve_parameters(&c, &bump, &lim));
     }
 
     /// No loop at all is an error naming the face, not a panic in ordering
