@@ -675,7 +675,18 @@ impl WorkMesh {
         if target.is_some() {
             (p, normal) = unfold_target(surface, &mut plan).unwrap_or((p, normal));
         } else if self.splits_nothing(a, b, p, &plan) {
-            return None;
+            // An inner corner beyond the curve's point moves inside, then the edge splits.
+            let moved = match (trim_at, plan.as_slice()) {
+                (Some(_), [side]) => self.make_room(surface, side, out),
+                _ => false,
+            };
+            if !moved {
+                return None;
+            }
+            (plan, p, normal) = self.plan_split(surface, adj, a, b, frac, trim_at.map(|s| s.0), None)?;
+            if self.splits_nothing(a, b, p, &plan) {
+                return None;
+            }
         }
         let m = self.apply_split(a, b, p, normal, plan, out);
         if !unlisted.is_empty() {
@@ -750,6 +761,62 @@ impl WorkMesh {
         let near = 1e-6 * pa.distance(pb);
         !(p.distance(pa) > near && p.distance(pb) > near)
             || plan.iter().any(|s| p.distance(self.pos[s.corners[2] as usize]) <= near || split_folds(s.uv, s.uv_m))
+    }
+
+    /// Where the curve of trim edge `side` bulges into the face past its
+    /// inner third corner (a vertex split in on an inner edge between the
+    /// chord and the curve: outside the face, where a surface that rolls
+    /// over at its border faces the other way), so that the edge's split
+    /// would fold a child in (u,v), moves that corner to the (u,v) centre of
+    /// its neighbours, where the split folds nothing and every triangle
+    /// round it keeps its orientation. Its triangles go to `out` to be
+    /// measured again; returns whether it moved.
+    fn make_room(&mut self, surface: &dyn Surface, side: &SplitSide, out: &mut Vec<u32>) -> bool {
+        let x = side.corners[2];
+        if self.gid[x as usize] != NONE || !split_folds(side.uv, side.uv_m) {
+            return false;
+        }
+        self.wake();
+        let Some(ring) = self.fan(side.t, x) else { return false };
+        let mut centre = DVec2::ZERO;
+        let mut n = 0.0;
+        for &t in &ring {
+            let (tv, tuv) = (self.tris[t as usize], self.uv(t as usize));
+            for k in 0..3 {
+                if tv[k] != x {
+                    centre += tuv[k];
+                    n += 1.0;
+                } else if !same_uv(tuv[k], side.uv[2]) {
+                    return false; // another chart: a seam or pole
+                }
+            }
+        }
+        let q = centre / n;
+        if n == 0.0 || !q.is_finite() || split_folds([side.uv[0], side.uv[1], q], side.uv_m) {
+            return false;
+        }
+        let turns = |m: &Self, t: u32, q: DVec2| {
+            let (tv, mut tuv) = (m.tris[t as usize], m.uv(t as usize));
+            let before = uv_area(tuv);
+            for k in 0..3 {
+                if tv[k] == x {
+                    tuv[k] = q;
+                }
+            }
+            uv_area(tuv) * before <= 0.0
+        };
+        if ring.iter().any(|&t| turns(self, t, q)) {
+            return false;
+        }
+        let (p, normal) = (surface.point(q), surface.normal(q));
+        if !p.is_finite() || !normal.is_finite() {
+            return false;
+        }
+        self.pos[x as usize] = p;
+        self.normal[x as usize] = normal.as_vec3();
+        self.move_uv(x, &ring, q);
+        out.extend_from_slice(&ring);
+        true
     }
 
     /// Makes the split `plan` of edge `a-b`: a new vertex at `p`, each

@@ -485,10 +485,10 @@ pub(crate) fn settle_nodes(faces: &mut [FaceWork<'_>], negligible: f64) -> (Vec<
         }
     }
     let mut places = Places::default();
-    for f in faces.iter() {
+    for (fi, f) in faces.iter().enumerate() {
         for (v, &g) in f.mesh.gid.iter().enumerate() {
             if wide.get(g as usize).copied().unwrap_or(false) {
-                places.0.push((g, f.mesh.pos[v]));
+                places.0.push((g, fi as u32, f.mesh.pos[v]));
             }
         }
     }
@@ -515,55 +515,82 @@ pub(crate) fn settle_nodes(faces: &mut [FaceWork<'_>], negligible: f64) -> (Vec<
     (changed, places)
 }
 
-/// Per node, the places its faces put it before settling: one flat list
-/// sorted by node (a map of small lists costs several times the memory).
+/// Per node, the places its faces put it before settling, each with the
+/// face that put it there: one flat list sorted by node (a map of small
+/// lists costs several times the memory).
 #[derive(Debug, Default)]
-pub(crate) struct Places(Vec<(u32, DVec3)>);
+pub(crate) struct Places(Vec<(u32, u32, DVec3)>);
 
 impl Places {
     /// Sorts by node, keeping face order (the sort is stable), and drops a
-    /// node's repeated places.
+    /// face's repeated place for a node (a seam's vertices of one node).
     fn index(&mut self) {
-        crate::sort::by_u64(&mut self.0, |&(g, _)| u64::from(g));
-        let mut kept: Vec<(u32, DVec3)> = Vec::with_capacity(self.0.len());
-        let mut start = 0;
-        for &(g, p) in &self.0 {
-            if kept.last().is_none_or(|&(h, _)| h != g) {
-                start = kept.len();
-            }
-            if !kept[start..].iter().any(|&(_, q)| q == p) {
-                kept.push((g, p));
-            }
-        }
-        self.0 = kept;
+        crate::sort::by_u64(&mut self.0, |&(g, _, _)| u64::from(g));
+        self.0.dedup_by(|b, a| a.0 == b.0 && a.1 == b.1 && a.2 == b.2);
     }
 
-    /// The places of node `g`, if its faces disagreed.
-    fn get(&self, g: u32) -> Option<impl Iterator<Item = DVec3> + '_> {
-        let lo = self.0.partition_point(|&(n, _)| n < g);
-        let hi = self.0.partition_point(|&(n, _)| n <= g);
-        (hi > lo).then(|| self.0[lo..hi].iter().map(|&(_, p)| p))
+    /// The entries of node `g`.
+    fn of_node(&self, g: u32) -> &[(u32, u32, DVec3)] {
+        let lo = self.0.partition_point(|&(n, _, _)| n < g);
+        let hi = self.0.partition_point(|&(n, _, _)| n <= g);
+        &self.0[lo..hi]
+    }
+
+    /// Whether node `g`'s faces disagreed.
+    fn has(&self, g: u32) -> bool {
+        !self.of_node(g).is_empty()
+    }
+
+    /// Where face `f` put node `g`, if its faces disagreed.
+    fn by_face(&self, g: u32, f: u32) -> Option<DVec3> {
+        self.of_node(g).iter().find(|e| e.1 == f).map(|e| e.2)
+    }
+
+    /// Node by node, the places of `nodes` one face put them all (every
+    /// face that put each of them), each set once, in face order.
+    fn sets(&self, nodes: &[u32]) -> Vec<Vec<DVec3>> {
+        let first = nodes.first().map_or(&[][..], |&g| self.of_node(g));
+        let mut out: Vec<Vec<DVec3>> = Vec::new();
+        for &(_, f, _) in first {
+            let set: Option<Vec<DVec3>> = nodes.iter().map(|&g| self.by_face(g, f)).collect();
+            if let Some(set) = set.filter(|s| !out.contains(s)) {
+                out.push(set);
+            }
+        }
+        out
     }
 }
+
+/// Each use of a node (face, vertex) with the triangles around it.
+type NodeUses = HashMap<u32, Vec<(usize, u32, Vec<u32>)>>;
 
 /// Where settling a node to the mean of its faces' places folded a thin
 /// triangle beside it (two faces' borders a hair apart, a sliver narrower
 /// than the gap), tries the node at each place a face put it instead and
 /// keeps the one that leaves fewest triangles around it, in all its faces,
-/// folded or beyond the tolerance; the mean wins ties. Every face still
-/// gets the node at one position, so shared borders stay closed. `folded`:
-/// per face, its folded triangles. Returns per face the triangles changed.
+/// folded or beyond the tolerance; the mean wins ties. A triangle still
+/// folded with two or three such nodes then tries them together at one
+/// face's places: a face whose sliver lies along its border folds when
+/// either end moves off where it put them, so no node alone mends it (one
+/// face's row of slivers beside a surface that rolls over just inside its
+/// border). Every face still gets each node at one position, so shared
+/// borders stay closed. `folded`: per face, its folded triangles. Returns
+/// per face the triangles changed.
 pub(crate) fn resettle_folds(faces: &mut [FaceWork<'_>], places: &Places, folded: &[Vec<u32>]) -> Vec<Vec<u32>> {
     let mut changed: Vec<Vec<u32>> = alloc::vec![Vec::new(); faces.len()];
-    // The nodes of folded triangles that had more than one place.
+    // The nodes of folded triangles that had more than one place, and per
+    // folded triangle with more than one, those together.
     let mut nodes: Vec<u32> = Vec::new();
+    let mut groups: Vec<Vec<u32>> = Vec::new();
     for (f, ts) in faces.iter().zip(folded) {
         for &t in ts {
-            for &v in &f.mesh.tris[t as usize] {
-                let g = f.mesh.gid[v as usize];
-                if g != NONE && places.get(g).is_some() {
-                    nodes.push(g);
-                }
+            let mut group: Vec<u32> =
+                f.mesh.tris[t as usize].iter().map(|&v| f.mesh.gid[v as usize]).filter(|&g| places.has(g)).collect();
+            group.sort_unstable();
+            group.dedup();
+            nodes.extend_from_slice(&group);
+            if group.len() > 1 {
+                groups.push(group);
             }
         }
     }
@@ -572,9 +599,30 @@ pub(crate) fn resettle_folds(faces: &mut [FaceWork<'_>], places: &Places, folded
     if nodes.is_empty() {
         return changed;
     }
-    // Each such node's uses (face, vertex) and the triangles around each.
+    groups.sort_unstable();
+    groups.dedup();
+    let uses = node_uses(faces, &nodes);
+    let singles = nodes.iter().map(|&g| alloc::vec![g]);
+    for unit in singles.chain(groups) {
+        if place_best(faces, &uses, places, &unit) {
+            for g in &unit {
+                for (fi, _, ts) in uses.get(g).map_or(&[][..], |l| &l[..]) {
+                    changed[*fi].extend_from_slice(ts);
+                }
+            }
+        }
+    }
+    for c in &mut changed {
+        c.sort_unstable();
+        c.dedup();
+    }
+    changed
+}
+
+/// Each use of `nodes` (face, vertex) and the triangles around it.
+fn node_uses(faces: &[FaceWork<'_>], nodes: &[u32]) -> NodeUses {
     let wanted: crate::collections::HashSet<u32> = nodes.iter().copied().collect();
-    let mut uses: HashMap<u32, Vec<(usize, u32, Vec<u32>)>> = HashMap::default();
+    let mut uses: NodeUses = HashMap::default();
     for (fi, f) in faces.iter().enumerate() {
         let mut ring: HashMap<u32, Vec<u32>> = HashMap::default();
         for (v, &g) in f.mesh.gid.iter().enumerate() {
@@ -596,41 +644,45 @@ pub(crate) fn resettle_folds(faces: &mut [FaceWork<'_>], places: &Places, folded
             uses.entry(f.mesh.gid[v as usize]).or_default().push((fi, v, ts));
         }
     }
-    for g in nodes {
-        let (Some(list), Some(candidates)) = (uses.get(&g), places.get(g)) else { continue };
-        let Some(&(f0, v0, _)) = list.first() else { continue };
-        let settled = faces[f0].mesh.pos[v0 as usize];
-        let score = |faces: &mut [FaceWork<'_>], p: DVec3| -> usize {
-            let mut bad = 0;
-            for (fi, v, ts) in list {
-                let f = &mut faces[*fi];
-                f.mesh.pos[*v as usize] = p;
+    uses
+}
+
+/// Puts `unit`'s nodes where they leave fewest triangles around them
+/// failing ([`WorkMesh::failing`]): where they are, or together at the
+/// places one face put them ([`Places::sets`]); where they are wins ties.
+/// Returns whether they moved.
+fn place_best(faces: &mut [FaceWork<'_>], uses: &NodeUses, places: &Places, unit: &[u32]) -> bool {
+    let Some(lists) = unit.iter().map(|g| uses.get(g).filter(|l| !l.is_empty())).collect::<Option<Vec<_>>>() else {
+        return false;
+    };
+    let score = |faces: &mut [FaceWork<'_>], at: &[DVec3]| -> usize {
+        for (list, &p) in lists.iter().zip(at) {
+            for &(fi, v, _) in list.iter() {
+                faces[fi].mesh.pos[v as usize] = p;
+            }
+        }
+        let mut bad = 0;
+        for list in &lists {
+            for (fi, _, ts) in list.iter() {
+                let f = &faces[*fi];
                 bad += f.mesh.failing(f.surface, &f.crit, ts);
             }
-            bad
-        };
-        let mut best = (score(faces, settled), settled);
-        if best.0 == 0 {
-            continue;
         }
-        for p in candidates {
-            let s = score(faces, p);
-            if s < best.0 {
-                best = (s, p);
-            }
-        }
-        score(faces, best.1);
-        if best.1 != settled {
-            for (fi, _, ts) in list {
-                changed[*fi].extend_from_slice(ts);
-            }
+        bad
+    };
+    let now: Vec<DVec3> = lists.iter().map(|l| faces[l[0].0].mesh.pos[l[0].1 as usize]).collect();
+    let mut best = (score(faces, &now), now.clone());
+    if best.0 == 0 {
+        return false;
+    }
+    for set in places.sets(unit) {
+        let s = score(faces, &set);
+        if s < best.0 {
+            best = (s, set);
         }
     }
-    for c in &mut changed {
-        c.sort_unstable();
-        c.dedup();
-    }
-    changed
+    score(faces, &best.1);
+    best.1 != now
 }
 
 #[cfg(test)]
@@ -695,6 +747,33 @@ mod tests {
         assert!(faces.iter().all(|f| f.mesh.folded(&plane).is_empty()));
         assert_eq!(faces[0].mesh.pos[1], corner(1.0, 0.0));
         assert_eq!(faces[1].mesh.pos[0], corner(1.0, 0.0));
+    }
+
+    /// Face A's sliver (0.01 high) lies along its border from node 7 to
+    /// node 8; face B put both nodes 0.06 beside A's places. Settled
+    /// halfway, the sliver folds, and it still folds with either node alone
+    /// at either face's place; with both at A's places it unfolds, and B's
+    /// triangle, at A's places, faces the surface's way too.
+    #[test]
+    fn two_nodes_settled_into_a_fold_move_together_to_one_faces_places() {
+        let corner = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        let plane = plane();
+        let crit = CRIT;
+        let work = |mesh| FaceWork { surface: &plane, curves: Vec::new(), mesh, crit };
+        let a = mesh(&[(0.0, 0.0, 7), (1.0, 0.0, 8), (0.5, 0.01, 0)], &[[0, 1, 2]]);
+        let b = mesh(&[(0.0, 0.06, 7), (1.0, 0.06, 8), (0.5, 1.0, 0)], &[[0, 1, 2]]);
+        let mut faces = alloc::vec![work(a), work(b)];
+        let (_, places) = settle_nodes(&mut faces, 1e-9);
+        assert_eq!(faces[0].mesh.pos[0], corner(0.0, 0.03));
+        let folded: Vec<Vec<u32>> = faces.iter().map(|f| f.mesh.folded(&plane)).collect();
+        assert_eq!(folded, [alloc::vec![0], alloc::vec![]]);
+        let moved = resettle_folds(&mut faces, &places, &folded);
+        assert_eq!(moved, [alloc::vec![0], alloc::vec![0]]);
+        assert!(faces.iter().all(|f| f.mesh.folded(&plane).is_empty()));
+        for (v, x) in [(0, 0.0), (1, 1.0)] {
+            assert_eq!(faces[0].mesh.pos[v], corner(x, 0.0));
+            assert_eq!(faces[1].mesh.pos[v], corner(x, 0.0));
+        }
     }
 
     /// A triangle clockwise on the plane folds; the same with two corners a

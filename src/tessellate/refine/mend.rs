@@ -288,7 +288,7 @@ impl WorkMesh {
     /// hundred triangles, or its turns disagree). An edge of three
     /// triangles (the table holds two) can close the walk early, so callers
     /// still check every edge at `x`.
-    fn fan(&self, t: u32, x: u32) -> Option<Vec<u32>> {
+    pub(super) fn fan(&self, t: u32, x: u32) -> Option<Vec<u32>> {
         let mut ring = alloc::vec![t];
         let mut cur = t;
         while ring.len() <= 100 {

@@ -432,6 +432,43 @@ fn slivers_folded_by_their_shape_are_split() {
     assert!(m.tris.len() <= 8 * rows, "{} triangles", m.tris.len());
 }
 
+/// A face whose border curve bulges into it past an inner vertex (one
+/// split in on an inner edge between the chord and the curve, outside the
+/// face), on a sheet whose rows bend so that the triangle on the chord
+/// folds: the chord's split at the curve's middle would fold a child in
+/// (u,v), so the vertex moves to the centre of its neighbours first. The
+/// chord, longer than the edge limit, is split, and nothing stays folded.
+#[test]
+fn an_inner_vertex_beyond_its_border_curve_moves_in_for_the_split() {
+    let s = bent_rows(0.4);
+    // A and B on the border, X beyond its curve, then R, C and L.
+    let uv = [at(0.0, 0.0), at(1.0, 0.0), at(0.5, 0.03), at(1.0, 0.5), at(0.5, 1.0), at(0.0, 0.5)];
+    let mut m = WorkMesh::default();
+    for q in uv {
+        m.add_vertex(s.point(q), s.normal(q));
+    }
+    for t in [[0, 1, 2], [1, 3, 2], [3, 4, 2], [4, 5, 2], [5, 0, 2]] {
+        m.add_triangle(t, t.map(|v| uv[v as usize]));
+    }
+    let curve = |degree: usize, points: &[DVec2]| {
+        let knots = [alloc::vec![0.0; degree + 1], alloc::vec![1.0; degree + 1]].concat();
+        NurbsCurve::try_new(degree, knots, points.iter().map(|q| q.extend(0.0)).collect(), None).unwrap()
+    };
+    let mut curves = alloc::vec![curve(2, &[uv[0], at(0.5, 0.2), uv[1]])];
+    for (k, (a, b)) in [(1, 3), (3, 4), (4, 5), (5, 0)].into_iter().enumerate() {
+        curves.push(curve(1, &[uv[a as usize], uv[b as usize]]));
+        m.mark_trim(a, b, k as u32 + 1, 0.0, 1.0);
+    }
+    m.mark_trim(0, 1, 0, 0.0, 1.0);
+    assert_eq!(m.folded(&s), [0], "the triangle on the chord folds");
+    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 0.3, min_edge: 0.0, steps: 2, lift: Lift::NONE };
+    let curves: Vec<&NurbsCurve> = curves.iter().collect();
+    let out = m.refine(&s, &curves, &c, 10_000);
+    assert_eq!(out.unproven, 0, "edges left over the limit");
+    assert!(m.folded(&s).is_empty(), "{} triangles still folded", m.folded(&s).len());
+    assert_eq!(m.check_invariants(), Ok(()));
+}
+
 /// A surface that counts its evaluations.
 struct Counted<S> {
     s: S,
