@@ -343,6 +343,48 @@ impl Fit {
         out
     }
 
+    /// The largest distance to the original per key direction ([`Fit::check_point`])
+    /// over `checks` (distances at the starts with their keys, farthest
+    /// first), and how many points were projected.
+    ///
+    /// Every distance to an actual point of the original bounds the true
+    /// one (Newton can stall where the original's parameter speed jumps, so
+    /// the start's distance stays a bound too). A point whose bound is no
+    /// farther than the worst found so far cannot raise it: the far starts
+    /// go first and the rest are not projected, and a projection stops once
+    /// it is no farther than the worst. Before projecting, a point tries the
+    /// step (from start to projection) of a neighbour already checked: the
+    /// map's error changes slowly between neighbours, so the original's
+    /// point one borrowed step from the start is usually as close as the
+    /// projection's, and one evaluation proves what Newton's two or more would.
+    fn worst_distances(&self, old: &FaceSurface, facts: &SurfaceFacts, checks: &[(f64, u32)]) -> ([f64; 3], usize) {
+        let opts = projection();
+        let [lo, hi] = old.domain();
+        let row = 3 * self.map_v.new.len();
+        // Per key, the step from its start to the point that bounded it.
+        let mut moved: Vec<Option<DVec2>> = vec![None; self.check_keys()];
+        let (mut worst, mut projected) = ([0.0f64; 3], 0);
+        for &(near, key) in checks {
+            let (k, dir) = (key as usize, key as usize % 3);
+            let Some((st, start)) = self.check_point(k).filter(|_| near > worst[dir]) else { continue };
+            let p = self.surface.point(st);
+            // The node's other points, then the same point of the nodes beside it.
+            let beside = [k - dir, k - dir + 1, k - dir + 2, k.wrapping_sub(3), k + 3, k.wrapping_sub(row), k + row];
+            let borrowed = beside.into_iter().filter(|&b| b != k).find_map(|b| moved.get(b).copied().flatten());
+            if let Some(at) = borrowed.map(|step| (start + step).clamp(lo, hi)) {
+                if old.point(at).distance(p) <= worst[dir] {
+                    moved[k] = Some(at - start);
+                    continue;
+                }
+            }
+            let pr = project_with(old, facts, p, Some(start), &opts, worst[dir]);
+            projected += 1;
+            moved[k] = Some(pr.uv - start);
+            worst[dir] = worst[dir].max(pr.distance.min(near));
+        }
+        (worst, projected)
+    }
+
     /// Per checked point by key ([`Fit::check_point`]), in key order: the
     /// distance between the new surface's point and the original's at the
     /// start its parameters map to, with the key. The points are evaluated
@@ -474,24 +516,11 @@ fn fit_once(
     let (map_u, map_v) = (Map1 { old: us, new: s }, Map1 { old: vs, new: t });
     let (line_u, line_v) = (CheckLine::new(&map_u, arc_u.as_ref()), CheckLine::new(&map_v, arc_v.as_ref()));
     let mut fit = Fit { surface: new, map_u, map_v, line_u, line_v, errors: [0.0; 2] };
-    let opts = projection();
     // Each point with its distance to the original's point at the start
     // (kept small: a 400 × 400 rebuild checks half a million points).
     let mut checks = fit.start_distances(surface);
-    // Both the projection and the start point are actual points of the
-    // original, so the smaller distance still bounds the true one (Newton
-    // can stall where the original's parameter speed jumps). A point whose
-    // start is no farther than the worst found so far cannot raise it, so
-    // the far starts go first and the rest are not projected. For the same
-    // reason a projection stops once it is no farther than the worst.
     crate::sort::by_f64_desc(&mut checks, |c| c.0);
-    let mut worst = [0.0f64; 3];
-    for &(near, key) in &checks {
-        let dir = key as usize % 3;
-        let Some((st, start)) = fit.check_point(key as usize).filter(|_| near > worst[dir]) else { continue };
-        let p = fit.surface.point(st);
-        worst[dir] = worst[dir].max(project_with(surface, facts, p, Some(start), &opts, worst[dir]).distance.min(near));
-    }
+    let (worst, _) = fit.worst_distances(surface, facts, &checks);
     let (mut errors, centre) = ([worst[0], worst[1]], worst[2]);
     // A cell centre off the original is charged to the direction whose edges are worse.
     if errors[0] >= errors[1] {
@@ -655,6 +684,43 @@ mod tests {
             fit.surface = NurbsSurface::try_new([3, 3], ku, kv, &pts, None).unwrap();
             assert_eq!(fit.folds(&old, &facts), folds_one_by_one(&fit, &old));
             assert_eq!(fit.folds(&old, &facts), [true; 2], "{n} x {m} turned over");
+        }
+    }
+
+    /// The check's worst distances are those of projecting every point in
+    /// full, yet it projects fewer of the points whose start is farther than
+    /// the worst than there are (the check by starts alone projects each),
+    /// under half of them along a finely sampled direction: the others take
+    /// a neighbour's step and are proven by one evaluation.
+    #[test]
+    fn borrowed_steps_prove_most_points_without_projecting() {
+        let old = crowded_wave();
+        let facts = SurfaceFacts::default();
+        for (n, m) in [(40, 21), (60, 60), (200, 16)] {
+            let fit = fit_once(&old, &facts, (n, m), Spacing::Mean).unwrap();
+            let mut checks = fit.start_distances(&old);
+            crate::sort::by_f64_desc(&mut checks, |c| c.0);
+            let (worst, projected) = fit.worst_distances(&old, &facts, &checks);
+            let mut full = [0.0f64; 3];
+            let mut far = 0;
+            for &(near, key) in &checks {
+                let (st, start) = fit.check_point(key as usize).unwrap();
+                let pr = crate::nurbs::project_to_surface(&old, fit.surface.point(st), Some(start), &projection());
+                let dir = key as usize % 3;
+                full[dir] = full[dir].max(pr.distance.min(near));
+            }
+            for &(near, key) in &checks {
+                far += usize::from(near > full[key as usize % 3]);
+            }
+            for dir in 0..3 {
+                let (a, b) = (worst[dir], full[dir]);
+                assert!((a - b).abs() <= 1e-12 * b.max(1e-300), "{n} x {m}, direction {dir}: {a} against {b}");
+            }
+            // The check by starts alone projects every far start; along a
+            // direction sampled finely (as PRO20359's 17 × 400) neighbours'
+            // steps agree best.
+            let share = if n >= 10 * m { 2 } else { 1 };
+            assert!(far > 20 && share * projected < far, "{n} x {m}: {projected} projected of {far} far starts");
         }
     }
 
