@@ -314,6 +314,10 @@ pub(crate) struct Outline<'a> {
     pub pu: Vec<f64>,
     pub pv: Vec<f64>,
     pub gids: Vec<Vec<u32>>,
+    /// Sewing left its loops crossing after halving as many of their
+    /// crossing chords as it may ([`super::sew::split_crossing_chords`]):
+    /// curves that overlap along a stretch, which no halving parts.
+    pub crossed: bool,
 }
 
 /// The outline of face `index`: `loops` (the face's own, or [`domain_loop`]'s
@@ -355,7 +359,7 @@ pub(crate) fn outline<'a>(
     let (pu, pv) = grid((surface, samples), lo, hi, lim, Some(&loops), cells);
     align_to_grid(surface, &mut loops, &pu, &pv, whole);
     let gids = loops.polys.iter().map(|p| alloc::vec![u32::MAX; p.uv.len()]).collect();
-    Ok(Outline { loops, pu, pv, gids })
+    Ok(Outline { loops, pu, pv, gids, crossed: false })
 }
 
 /// The outline of an untrimmed face along [`domain_loop`]'s `loops`: the
@@ -414,7 +418,7 @@ fn domain_outline<'a>(
     let loops =
         Loops { polys: alloc::vec![Polyline { uv, at, seg }], curves: lp.curves.iter().collect(), mended: None };
     let gids = alloc::vec![alloc::vec![u32::MAX; n]];
-    Some(Outline { loops, pu, pv, gids })
+    Some(Outline { loops, pu, pv, gids, crossed: false })
 }
 
 /// See [`outline`]: nodes where grid lines cross loop pieces that run along
@@ -569,6 +573,10 @@ pub(crate) fn initial_from_outline(
     o: &Outline<'_>,
     budget: usize,
 ) -> Result<WorkMesh, Error> {
+    if o.crossed {
+        let message = "trim loops cross along a stretch that halving their chords cannot part".into();
+        return Err(Error::Mesh { face: index, message });
+    }
     // The grid's rectangle is the loops' box, which may reach far beyond
     // the region they keep (a rebuilt face's loops on its whole old domain):
     // a grid up to four times the budget is triangulated, and judged by the

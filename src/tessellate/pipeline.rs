@@ -129,6 +129,14 @@ impl Variants<'_> {
     }
 }
 
+impl Sewn<'_> {
+    /// Model node ids sewing named (the loops' nodes, shared ones once, and
+    /// those halving crossing chords added).
+    pub fn ids(&self) -> u32 {
+        self.ids
+    }
+}
+
 impl Works<'_> {
     /// Debug builds: every face's work mesh keeps its invariants
     /// ([`WorkMesh::check_invariants`]) after `stage`, but for the breaks

@@ -337,6 +337,32 @@ fn fuzz_folded_sheet_keeps_inner_triangles_counter_clockwise() {
     assert!(r.report.max_deviation <= r.report.tolerance, "{} > {}", r.report.max_deviation, r.report.tolerance);
 }
 
+/// Found by fuzzing (3.6 s natively, 61 s under the sanitizer): a mutated
+/// B-spline face whose trim loop runs over itself along a stretch. Sewing
+/// halved the crossing chords there round after round, and each halving
+/// crossed again, doubling the loop's nodes up to some 15 000 whose pair
+/// search was quadratic. Halvings of crossings are now bounded per face,
+/// and a face still crossing after them fails, naming itself.
+#[test]
+fn fuzz_overlapping_trim_loop_is_not_halved_without_end() {
+    let model = read_iges(&data("iges_fuzz_slow_sewing.igs")).unwrap();
+    let options = MeshOptions::default().with_relative_tolerance(0.05).with_max_triangles(5_000);
+    let plan = surfmesh::pipeline::Plan::new(&model, &options).unwrap();
+    let mut run = plan.start();
+    let variants = plan.choose_variants(&mut run).unwrap();
+    let nodes = variants.loop_nodes();
+    assert!(nodes > 0);
+    let sewn = plan.sew_outlines(&run, variants);
+    // A face halves as many crossings as it has nodes (at least 64), so the
+    // ids stay within a small multiple of the loops' nodes (unbounded, the
+    // halvings ran to thousands).
+    assert!((sewn.ids() as usize) <= 2 * nodes + 2 * 64, "{} ids for {nodes} loop nodes", sewn.ids());
+    match mesh_model(&model, &options) {
+        Err(Error::Mesh { face: 0, message }) => assert!(message.contains("trim loops"), "{message}"),
+        other => panic!("face 0 fails: {:?}", other.map(|r| r.report)),
+    }
+}
+
 #[test]
 fn format_from_extension_and_first_line() {
     assert_eq!(Format::from_name("igs").unwrap(), Format::Iges);

@@ -229,7 +229,7 @@ mod tests {
         }
         let gids = alloc::vec![alloc::vec![u32::MAX; poly.uv.len()]];
         let loops = Loops { polys: alloc::vec![poly], curves: curves.iter().collect(), mended: None };
-        Outline { loops, pu: alloc::vec![0.0, 3.0], pv: alloc::vec![0.0, 12.0], gids }
+        Outline { loops, pu: alloc::vec![0.0, 3.0], pv: alloc::vec![0.0, 12.0], gids, crossed: false }
     }
 
     /// Three faces of one plane side by side: `f` up to u = 1, a strip 0.3

@@ -162,7 +162,7 @@ mod tests {
         }
         let gids = alloc::vec![alloc::vec![u32::MAX; poly.uv.len()]];
         let loops = Loops { polys: alloc::vec![poly], curves: curves.iter().collect(), mended: None };
-        Outline { loops, pu: alloc::vec![0.0, 2.0], pv: alloc::vec![0.0, 1.0], gids }
+        Outline { loops, pu: alloc::vec![0.0, 2.0], pv: alloc::vec![0.0, 1.0], gids, crossed: false }
     }
 
     /// Nodes of `o` on the line u = 1 (the shared border), by v.

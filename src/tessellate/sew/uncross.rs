@@ -31,6 +31,10 @@ const MAX_ROUNDS: usize = 16;
 /// everywhere costs a bounded amount.
 const MAX_CUTS: usize = 4096;
 
+/// Fewest crossings a face may halve over all rounds, however few its nodes
+/// (a thin lens of two chords takes a few rounds to part).
+const MIN_CROSSING_CUTS: usize = 64;
+
 /// Halves, on their curves, the sewn border segments that cross another
 /// segment of their face's loops, in every face that has that segment (by
 /// its two end ids); `ids` is the count of node ids given so far, and the
@@ -45,11 +49,15 @@ pub(crate) fn split_crossing_chords(faces: &mut [Option<(&dyn Surface, &mut Outl
     // anywhere (nearly one curve twice) cannot double its nodes each round.
     let mut allowance: Vec<usize> =
         faces.iter().map(|f| f.as_ref().map_or(0, |(_, o)| o.gids.iter().map(Vec::len).sum())).collect();
+    // As many for crossing, at least `MIN_CROSSING_CUTS`: curves that
+    // overlap along a stretch (a fuzzed loop retracing itself) cross again
+    // at every halving, and would double the face's nodes each round.
+    let mut crossing: Vec<usize> = allowance.iter().map(|&n| n.max(MIN_CROSSING_CUTS)).collect();
     for _ in 0..MAX_ROUNDS {
         let mut cuts: Vec<((u32, u32), DVec3)> = Vec::new();
         let (pairs, alone) = border_uses(faces);
-        for ((surface, o), allowance) in
-            faces.iter().zip(allowance.iter_mut()).filter_map(|(f, a)| Some((f.as_ref()?, a)))
+        for ((surface, o), (allowance, crossing)) in
+            faces.iter().zip(allowance.iter_mut().zip(crossing.iter_mut())).filter_map(|(f, a)| Some((f.as_ref()?, a)))
         {
             let note = |k: usize, i: usize, cuts: &mut Vec<((u32, u32), DVec3)>| {
                 let (Some(poly), Some(g)) = (o.loops.polys.get(k), o.gids.get(k)) else { return };
@@ -65,11 +73,12 @@ pub(crate) fn split_crossing_chords(faces: &mut [Option<(&dyn Surface, &mut Outl
                 cuts.push(((ga.min(gb), ga.max(gb)), surface.point(curve.point(tm).truncate())));
             };
             crossings(&o.loops, |x| {
-                if !x.folds {
+                if !x.folds && *crossing > 0 {
+                    *crossing -= 1;
                     note(x.a.0, x.a.1, &mut cuts);
                     note(x.b.0, x.b.1, &mut cuts);
                 }
-                cuts.len() >= MAX_CUTS
+                cuts.len() >= MAX_CUTS || *crossing == 0
             });
             // A chord its neighbour's split would cross: both halved, so
             // each side keeps to its curve closer than the two come.
@@ -111,6 +120,12 @@ pub(crate) fn split_crossing_chords(faces: &mut [Option<(&dyn Surface, &mut Outl
             cut_face(*surface, o, &cuts, ids);
         }
         ids += cuts.len() as u32;
+    }
+    // A face that spent its halvings of crossings and still crosses fails.
+    for (item, &left) in faces.iter_mut().zip(&crossing) {
+        if let (Some((_, o)), 0) = (item, left) {
+            o.crossed = crossings(&o.loops, |x| !x.folds).is_some();
+        }
     }
     ids
 }
@@ -202,7 +217,7 @@ mod tests {
             gids.push(l.iter().map(|x| x.1).collect());
         }
         let loops = Loops { polys, curves: curves.iter().collect(), mended: None };
-        Outline { loops, pu: Vec::new(), pv: Vec::new(), gids }
+        Outline { loops, pu: Vec::new(), pv: Vec::new(), gids, crossed: false }
     }
 
     /// A face below an arc, with a hole that pokes up through the arc's
