@@ -581,7 +581,10 @@ pub(crate) fn resettle_folds(faces: &mut [FaceWork<'_>], places: &Places, folded
     // The nodes of folded triangles that had more than one place, and per
     // folded triangle with more than one, those together.
     let mut nodes: Vec<u32> = Vec::new();
-    let mut groups: Vec<Vec<u32>> = Vec::new();
+    // A group is its sorted nodes as a triple, 0 for a pair's third: a real
+    // third follows two smaller ids, so it is never 0, and the triples sort
+    // as the lists would (one shared sort, not a copy for lists of lists).
+    let mut groups: Vec<(u32, u32, u32)> = Vec::new();
     for (f, ts) in faces.iter().zip(folded) {
         for &t in ts {
             let mut group: Vec<u32> =
@@ -590,7 +593,7 @@ pub(crate) fn resettle_folds(faces: &mut [FaceWork<'_>], places: &Places, folded
             group.dedup();
             nodes.extend_from_slice(&group);
             if group.len() > 1 {
-                groups.push(group);
+                groups.push((group[0], group[1], group.get(2).copied().unwrap_or(0)));
             }
         }
     }
@@ -599,11 +602,12 @@ pub(crate) fn resettle_folds(faces: &mut [FaceWork<'_>], places: &Places, folded
     if nodes.is_empty() {
         return changed;
     }
-    groups.sort_unstable();
+    crate::sort::triples(&mut groups);
     groups.dedup();
     let uses = node_uses(faces, &nodes);
     let singles = nodes.iter().map(|&g| alloc::vec![g]);
-    for unit in singles.chain(groups) {
+    let joint = groups.into_iter().map(|(a, b, c)| if c == 0 { alloc::vec![a, b] } else { alloc::vec![a, b, c] });
+    for unit in singles.chain(joint) {
         if place_best(faces, &uses, places, &unit) {
             for g in &unit {
                 for (fi, _, ts) in uses.get(g).map_or(&[][..], |l| &l[..]) {
