@@ -112,8 +112,12 @@ test('a fresh module holds its 256 KiB stack, not the default 1 MiB, before its 
 // on the way there, set just above the size measured when it last dropped
 // (main at e3415cb: 672,275 bytes), so that new code that brings bloat back
 // (a dependency, a generic's copies, formatting) shows here. Lower it as
-// the module shrinks.
-const VIEWER_GZIP_BUDGET = 655_000;
+// the module shrinks. Raised from 655,000 when mending gained the joint
+// resettling of a sliver's nodes and the inner corner's move for a border
+// split, the fit check its borrowed steps, and sewing a bound on halving
+// crossing chords: 657,720 bytes, 655,216 once a list-of-lists sort they
+// brought went through the shared triple sort.
+const VIEWER_GZIP_BUDGET = 660_000;
 
 test('the viewer module stays within its gzip -9 budget', () => {
   const wasm = readFileSync(join(pkg, 'node', 'surfmesh_bg.wasm'));
