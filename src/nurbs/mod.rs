@@ -7,6 +7,8 @@
 
 pub(crate) mod analytic;
 mod bbox;
+#[cfg(test)]
+pub(crate) mod counted;
 mod curve;
 pub(crate) mod elevate;
 mod error;

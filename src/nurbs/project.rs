@@ -581,6 +581,7 @@ fn param(lo: DVec2, hi: DVec2, n: usize, i: usize, j: usize) -> DVec2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::nurbs::counted::Counted;
     use crate::nurbs::NurbsSurface;
     use alloc::vec;
 
@@ -591,33 +592,6 @@ mod tests {
             .collect();
         let k = vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
         NurbsSurface::try_new([3, 3], k.clone(), k, &pts, None).unwrap()
-    }
-
-    /// Counts a surface's evaluations: points, and points with derivatives.
-    struct Counted<'a> {
-        s: &'a NurbsSurface,
-        points: core::cell::Cell<usize>,
-        derivs: core::cell::Cell<usize>,
-    }
-
-    impl Surface for Counted<'_> {
-        fn domain(&self) -> [DVec2; 2] {
-            self.s.domain()
-        }
-        fn point(&self, uv: DVec2) -> DVec3 {
-            self.points.set(self.points.get() + 1);
-            self.s.point(uv)
-        }
-        fn derivs(&self, uv: DVec2) -> SurfaceDerivs {
-            self.derivs.set(self.derivs.get() + 1);
-            self.s.derivs(uv)
-        }
-        fn breaks(&self, along_u: bool) -> Vec<f64> {
-            self.s.breaks(along_u)
-        }
-        fn bounding_box(&self) -> super::super::Aabb {
-            self.s.bounding_box()
-        }
     }
 
     /// Newton off knot lines evaluates each point it moves to once, with
@@ -633,11 +607,11 @@ mod tests {
         for (k, uv) in [(0.7, 0.6), (0.3, 0.8), (0.55, 0.25)].into_iter().enumerate() {
             let target = s.point(DVec2::new(uv.0, uv.1)) + DVec3::new(0.01, -0.02, 0.01 * k as f64);
             let hint = DVec2::new(uv.0 - 0.04, uv.1 + 0.03);
-            let c = Counted { s: &s, points: 0.into(), derivs: 0.into() };
+            let c = Counted::new(&s);
             let got = project_to_surface(&c, target, Some(hint), &opts);
             assert_eq!(got, project_to_surface(&s, target, Some(hint), &opts));
             assert!(got.distance < 0.05, "{got:?}");
-            let (points, derivs) = (c.points.get(), c.derivs.get());
+            let (points, derivs) = (c.points.get(), c.derivs.get() + c.tangents.get());
             assert!(derivs >= 3 && points + 1 < derivs, "{points} points, {derivs} with derivatives");
         }
     }

@@ -680,6 +680,7 @@ fn near_pairs(segs: &[Seg], bounds: (DVec2, DVec2), mut visit: impl FnMut(&Seg, 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::nurbs::counted::Counted;
     use crate::NurbsCurve;
 
     /// A quadratic Bézier in (u,v) from `a` over control `c` to `b`.
@@ -720,34 +721,6 @@ mod tests {
         }
     }
 
-    /// A surface that counts its evaluations with second derivatives.
-    struct CountingDerivs<'a> {
-        inner: &'a dyn Surface,
-        derivs: core::cell::Cell<usize>,
-    }
-
-    impl Surface for CountingDerivs<'_> {
-        fn domain(&self) -> [DVec2; 2] {
-            self.inner.domain()
-        }
-        fn point(&self, uv: DVec2) -> DVec3 {
-            self.inner.point(uv)
-        }
-        fn derivs(&self, uv: DVec2) -> crate::nurbs::SurfaceDerivs {
-            self.derivs.set(self.derivs.get() + 1);
-            self.inner.derivs(uv)
-        }
-        fn tangents(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
-            self.inner.tangents(uv)
-        }
-        fn breaks(&self, along_u: bool) -> Vec<f64> {
-            self.inner.breaks(along_u)
-        }
-        fn bounding_box(&self) -> crate::nurbs::Aabb {
-            self.inner.bounding_box()
-        }
-    }
-
     /// Discretizing a trim curve tests chords, normals and tangents, all of
     /// first order: it evaluates the surface without second derivatives
     /// (each costs about a third more, for nothing), to the same nodes.
@@ -758,7 +731,7 @@ mod tests {
             .map(|i| (0..4).map(|j| DVec3::new(i as f64, j as f64, if (i + j) % 3 == 0 { 1.5 } else { 0.0 })).collect())
             .collect();
         let bump = crate::FaceSurface::Nurbs(crate::NurbsSurface::try_new([3, 3], k.clone(), k, &pts, None).unwrap());
-        let counting = CountingDerivs { inner: &bump, derivs: core::cell::Cell::new(0) };
+        let counting = Counted::new(&bump);
         let c = bezier(DVec2::new(0.05, 0.1), DVec2::new(0.9, 0.2), DVec2::new(0.7, 0.95));
         let lim = Limits { tol: 1e-3, angle: 0.2, max_edge: f64::INFINITY, min_edge: 1e-6 };
         let ts = curve_parameters(&c, &counting, &lim);

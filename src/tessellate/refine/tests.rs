@@ -1,6 +1,7 @@
 //! Tests of the work mesh and its refinement.
 
 use super::*;
+use crate::nurbs::counted::Counted;
 
 /// The plane z = 0 over [-10, 10]², u = x and v = y.
 fn plane() -> crate::nurbs::NurbsSurface {
@@ -469,42 +470,6 @@ fn an_inner_vertex_beyond_its_border_curve_moves_in_for_the_split() {
     assert_eq!(m.check_invariants(), Ok(()));
 }
 
-/// A surface that counts its evaluations.
-struct Counted<S> {
-    s: S,
-    calls: core::cell::Cell<usize>,
-}
-
-impl<S: Surface> Counted<S> {
-    fn tick(&self) {
-        self.calls.set(self.calls.get() + 1);
-    }
-}
-
-impl<S: Surface> Surface for Counted<S> {
-    fn domain(&self) -> [DVec2; 2] {
-        self.s.domain()
-    }
-    fn point(&self, uv: DVec2) -> DVec3 {
-        self.tick();
-        self.s.point(uv)
-    }
-    fn derivs(&self, uv: DVec2) -> crate::nurbs::SurfaceDerivs {
-        self.tick();
-        self.s.derivs(uv)
-    }
-    fn tangents(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
-        self.tick();
-        self.s.tangents(uv)
-    }
-    fn breaks(&self, along_u: bool) -> Vec<f64> {
-        self.s.breaks(along_u)
-    }
-    fn bounding_box(&self) -> crate::nurbs::Aabb {
-        self.s.bounding_box()
-    }
-}
-
 /// Measures a trial mesh took serve the model's mesh of the same face and
 /// criteria: refined from the same first mesh, it ends the same, bit for
 /// bit, measuring only the triangles the trial did not measure (here
@@ -512,7 +477,8 @@ impl<S: Surface> Surface for Counted<S> {
 /// a carried measure over the limits still fails its triangle.
 #[test]
 fn carried_measures_stand_in_for_measuring() {
-    let s = Counted { s: plane(), calls: core::cell::Cell::new(0) };
+    let p = plane();
+    let s = Counted::new(&p);
     let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 0.6, min_edge: 0.0, steps: 4, lift: Lift::NONE };
     let mut trial = grid();
     trial.log_measures();
@@ -521,11 +487,11 @@ fn carried_measures_stand_in_for_measuring() {
     carried.carried = trial.measured();
     assert!(carried.carried.len() > trial.tris.len(), "the split triangles' measures are carried too");
     let calls = [&mut fresh, &mut carried].map(|m| {
-        s.calls.set(0);
+        s.reset();
         let got = m.refine(&s, &[], &c, 100_000);
         assert_eq!(m.tris, trial.tris);
         assert_eq!((got.max.to_bits(), got.sum.to_bits(), got.unproven), (want.max.to_bits(), want.sum.to_bits(), 0));
-        s.calls.get()
+        s.total()
     });
     // What is left is placing the new vertices and checking for folds.
     assert!(calls[0] > 12 * trial.tris.len(), "{calls:?}");
