@@ -2,8 +2,9 @@
 
 use crate::numeric::{guarded_div, TINY};
 use alloc::borrow::Cow;
+use alloc::boxed::Box;
 use alloc::vec::Vec;
-use core::cell::OnceCell;
+use core::cell::{Cell, OnceCell};
 use glam::{DVec2, DVec3};
 
 use super::{Surface, SurfaceDerivs};
@@ -242,7 +243,7 @@ fn newton(
     let [lo, hi] = surface.domain();
     let size = (hi - lo).max(DVec2::splat(TINY));
     let mut uv = start.clamp(lo, hi);
-    let mut d = surface.derivs(uv);
+    let mut d = facts.kept(uv).unwrap_or_else(|| surface.derivs(uv));
     let mut point = d.point;
     let mut dist = point.distance(target);
     // Derivatives at `uv` that the last step's search already evaluated.
@@ -427,9 +428,14 @@ fn try_step(
 /// What projections learn about a surface independently of the point they
 /// project: its knot lines, which directions close on themselves (a full
 /// circle of a revolved surface), which domain edges collapse to a point, and
-/// the coarse search's grid of points. Each is found on first need.
+/// the coarse search's grid of points. Each is found on first need. Also the
+/// derivatives last asked of [`SurfaceFacts::derivs`], for a projection
+/// that starts where the previous one ended.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct SurfaceFacts {
+    /// The parameters and derivatives of the last [`SurfaceFacts::derivs`]
+    /// (boxed: the facts of most projections never hold any).
+    last: OnceCell<Box<Cell<(DVec2, SurfaceDerivs)>>>,
     breaks: OnceCell<[Vec<f64>; 2]>,
     closed: [OnceCell<bool>; 2],
     /// `[axis][0]`: the edge at the domain's low end along `axis`, `[axis][1]` the high one.
@@ -442,6 +448,30 @@ pub(crate) struct SurfaceFacts {
 }
 
 impl SurfaceFacts {
+    /// [`Surface::derivs`] at `uv`, the same values, kept for the next call:
+    /// a caller that projects samples along a curve, each from the previous
+    /// one's parameters, and asks for the derivatives where each ended (the
+    /// readers, to tell poles) pays for them once instead of twice.
+    pub(crate) fn derivs(&self, surface: &dyn Surface, uv: DVec2) -> SurfaceDerivs {
+        if let Some(d) = self.kept(uv) {
+            return d;
+        }
+        let d = surface.derivs(uv);
+        match self.last.get() {
+            Some(last) => last.set((uv, d)),
+            None => {
+                let _ = self.last.set(Box::new(Cell::new((uv, d))));
+            }
+        }
+        d
+    }
+
+    /// The derivatives the last [`SurfaceFacts::derivs`] found, if at `uv`.
+    fn kept(&self, uv: DVec2) -> Option<SurfaceDerivs> {
+        let (at, d) = self.last.get()?.get();
+        (at == uv).then_some(d)
+    }
+
     fn breaks(&self, surface: &dyn Surface) -> &[Vec<f64>; 2] {
         self.breaks.get_or_init(|| [surface.breaks(true), surface.breaks(false)])
     }
@@ -673,6 +703,36 @@ mod tests {
         }
         // The old loop took 305 evaluations with derivatives and 1008 in all here.
         assert!(2 * derivs <= 9 * n && total <= 990, "{derivs} with derivatives, {total} in all for {n} projections");
+    }
+
+    /// Projecting samples along a curve, each from where the previous one
+    /// ended, and asking the facts for the derivatives there (as the readers
+    /// do to tell poles): each projection starts with the derivatives already
+    /// found, one evaluation fewer per sample, and the results are those of
+    /// fresh projections.
+    #[test]
+    fn facts_keep_the_derivatives_a_projection_starts_from() {
+        let s = hill();
+        let c = Counted::new(&s);
+        let facts = SurfaceFacts::default();
+        let opts = ProjectionOptions::default();
+        let mut hint = DVec2::new(0.1, 0.3);
+        let n = 20;
+        let (mut kept, mut fresh) = (0, 0);
+        for i in 0..n {
+            let t = 0.1 + 0.8 * i as f64 / (n - 1) as f64;
+            let target = s.point(DVec2::new(t, 0.3 + 0.4 * t * t)) + DVec3::new(0.003, -0.002, 0.004);
+            let f = Counted::new(&s);
+            let alone = project_to_surface(&f, target, Some(hint), &opts);
+            fresh += f.derivs.get() + 1;
+            c.reset();
+            let got = project_with(&c, &facts, target, Some(hint), &opts, f64::NEG_INFINITY);
+            assert_eq!(facts.derivs(&c, got.uv), s.derivs(got.uv));
+            kept += c.derivs.get();
+            assert_eq!(got, alone);
+            hint = got.uv;
+        }
+        assert!(kept + n - 1 <= fresh, "{kept} evaluations with derivatives kept, {fresh} fresh");
     }
 
     /// Below `enough` nothing changes: the same point as a full projection.

@@ -40,8 +40,9 @@ pub(in crate::io) enum SurfDef {
         periods: [Option<f64>; 2],
         /// The parameter rectangle the entity asks for, when smaller than the knots' domain.
         natural: Option<[DVec2; 2]>,
-        /// What projections onto `surface` learnt about it (its loops' samples are projected one by one).
-        facts: SurfaceFacts,
+        /// What projections onto `surface` learnt about it (its loops' samples
+        /// are projected one by one); boxed, as it holds their last derivatives.
+        facts: Box<SurfaceFacts>,
     },
     /// `origin + a·x + b·y`, native coordinates `(a, b)`.
     Plane { origin: DVec3, x: DVec3, y: DVec3 },
@@ -156,7 +157,7 @@ impl SurfDef {
         match self {
             Self::Nurbs { surface, periods, .. } => {
                 let s = rotate_seam(surface, along_u, c)?;
-                Some(Self::Nurbs { surface: s, periods: *periods, natural: None, facts: SurfaceFacts::default() })
+                Some(Self::Nurbs { surface: s, periods: *periods, natural: None, facts: Box::default() })
             }
             Self::Offset { base, distance } => {
                 Some(Self::Offset { base: Box::new(base.rotate_seam(along_u, c)?), distance: *distance })
@@ -171,7 +172,7 @@ impl SurfDef {
         match self {
             Self::Nurbs { surface, periods, .. } => {
                 let s = unroll(surface, along_u, a, b)?;
-                Some(Self::Nurbs { surface: s, periods: *periods, natural: None, facts: SurfaceFacts::default() })
+                Some(Self::Nurbs { surface: s, periods: *periods, natural: None, facts: Box::default() })
             }
             Self::Offset { base, distance } => {
                 Some(Self::Offset { base: Box::new(base.unroll(along_u, a, b)?), distance: *distance })
@@ -203,8 +204,9 @@ impl SurfDef {
                         *retry = false;
                     }
                 }
-                // First derivatives only: the same values as `derivs` gives.
-                let (_, su, sv) = surface.tangents(pr.uv);
+                // Kept for the next sample's projection, which starts here.
+                let d = facts.derivs(surface, pr.uv);
+                let (su, sv) = (d.su, d.sv);
                 let (lu, lv) = (su.length(), sv.length());
                 // A collapsed edge written with control points a hair apart
                 // (3e-8 against 4.4 across it, in one STEP file) is a pole too.
@@ -424,7 +426,7 @@ fn plane(m: &DAffine3, o: DVec3, x: DVec3, y: DVec3) -> SurfDef {
 /// A B-spline surface definition, with its closedness detected.
 pub(in crate::io) fn nurbs_def(surface: NurbsSurface) -> SurfDef {
     let periods = closed_periods(&surface);
-    SurfDef::Nurbs { surface, periods, natural: None, facts: SurfaceFacts::default() }
+    SurfDef::Nurbs { surface, periods, natural: None, facts: Box::default() }
 }
 
 /// Periods of a surface whose opposite edges coincide.
@@ -500,7 +502,7 @@ fn bspline_surface(e: &Entity, m: &DAffine3) -> Result<SurfDef, Error> {
     let smaller = nlo.x > lo.x + eps.x || nlo.y > lo.y + eps.y || nhi.x < hi.x - eps.x || nhi.y < hi.y - eps.y;
     let natural = (smaller && nhi.x > nlo.x && nhi.y > nlo.y).then_some([nlo, nhi]);
     let periods = closed_periods(&s);
-    Ok(SurfDef::Nurbs { surface: s, periods, natural, facts: SurfaceFacts::default() })
+    Ok(SurfDef::Nurbs { surface: s, periods, natural, facts: Box::default() })
 }
 
 /// 114: bicubic patches in power form, each turned into Bézier form.
@@ -742,7 +744,7 @@ mod tests {
             [0.0, 1.0],
         )
         .unwrap();
-        SurfDef::Nurbs { surface, periods: [None; 2], natural: None, facts: SurfaceFacts::default() }
+        SurfDef::Nurbs { surface, periods: [None; 2], natural: None, facts: Box::default() }
     }
 
     /// At a pole written with control points a hair apart (3e-8 against
