@@ -26,6 +26,14 @@ pub(crate) use crate::warning::Mended;
 /// worst case, and a face with more is skipped as before.
 const MAX_SEGMENTS: usize = 50_000;
 
+/// Most steps mending may take per loop node: segment pairs tested for
+/// crossings, and pieces the winding rays meet. A loop crossing itself at a
+/// share of all its segment pairs (a fuzzed file's) is cut into
+/// quadratically many pieces crowded where the crossings are, and every ray
+/// meets them all; such a face is skipped like one with too many segments.
+/// Real loops take tens of steps per node, some hundreds at the segment limit.
+const STEPS_PER_NODE: usize = 2_000;
+
 /// Snapping distance as a share of the loops' size.
 const SNAP: f64 = 1e-9;
 
@@ -80,6 +88,22 @@ impl Points {
     }
 }
 
+std::thread_local! {
+    /// Steps mending took on this thread ([`steps`]).
+    static STEPS: core::cell::Cell<u64> = const { core::cell::Cell::new(0) };
+}
+
+/// Adds `n` to this thread's count of mending steps.
+fn count_steps(n: usize) {
+    STEPS.with(|s| s.set(s.get().saturating_add(n as u64)));
+}
+
+/// Steps mending has taken on this thread: segment pairs tested and pieces
+/// winding rays met, a measure of its work that does not depend on the machine.
+pub(crate) fn steps() -> u64 {
+    STEPS.with(|s| s.get())
+}
+
 /// Where a segment is cut: at another segment's end, or at a crossing point.
 #[derive(Debug, Clone, Copy)]
 enum Cut {
@@ -89,7 +113,8 @@ enum Cut {
 
 /// Mends `loops` in place so that they neither cross nor touch: returns
 /// what changed, or `None` when there was nothing to mend or it could not
-/// be done (too many segments, nothing left); the loops are then unchanged.
+/// be done (too many segments or steps, nothing left); the loops are then
+/// unchanged.
 /// `file_ccw` says per loop whether the file ran it counter-clockwise: that
 /// decides whether a loop beside the outer one is a region or nothing.
 pub(crate) fn mend(loops: &mut Loops<'_>, file_ccw: &[bool]) -> Option<Mended> {
@@ -119,7 +144,8 @@ pub(crate) fn mend(loops: &mut Loops<'_>, file_ccw: &[bool]) -> Option<Mended> {
             segs.push(if signs[k] { piece } else { piece.reversed() });
         }
     }
-    let (cuts, crossings) = cut_points(&segs, &pts);
+    let budget = STEPS_PER_NODE.saturating_mul(total);
+    let (cuts, crossings) = cut_points(&segs, &pts, budget)?;
     // Every segment split at its cuts, pieces grouped by their two ends.
     let mut groups: HashMap<(u32, u32), (i32, Piece)> = HashMap::default();
     for (s, seg) in segs.iter().enumerate() {
@@ -151,7 +177,7 @@ pub(crate) fn mend(loops: &mut Loops<'_>, file_ccw: &[bool]) -> Option<Mended> {
         .map(|(n, p)| (n.abs(), if (n > 0) == (p.a < p.b) { p } else { p.reversed() }))
         .collect();
     crate::sort::by_u64(&mut net, |(_, p)| crate::sort::pair(p.a, p.b));
-    let kept = boundary(&net, &pts);
+    let kept = boundary(&net, &pts, budget)?;
     let out = link(&kept, &pts);
     let before = loops.polys.len();
     let mut polys: Vec<Polyline> = Vec::new();
@@ -244,17 +270,20 @@ fn contains(p: &[DVec2], q: DVec2) -> bool {
     inside
 }
 
+/// One segment's cuts: the fraction along it, and the point.
+type SegCuts = Vec<(f64, Cut)>;
+
 /// Where each segment must be cut (fractions along it, strictly inside):
 /// at proper crossings (one point for both segments), and where an end of
 /// another segment lies on it (touching, overlapping: cut at that end, so
 /// overlapping pieces end at the same points). Returns the cuts and how
-/// many places they make.
-fn cut_points(segs: &[Piece], pts: &Points) -> (Vec<Vec<(f64, Cut)>>, usize) {
+/// many places they make; `None` when there are more than `budget` pairs to test.
+fn cut_points(segs: &[Piece], pts: &Points, budget: usize) -> Option<(Vec<SegCuts>, usize)> {
     let g = pts.g;
-    let mut cuts: Vec<Vec<(f64, Cut)>> = alloc::vec![Vec::new(); segs.len()];
+    let mut cuts: Vec<SegCuts> = alloc::vec![Vec::new(); segs.len()];
     let mut points = 0;
     let ends: Vec<(DVec2, DVec2)> = segs.iter().map(|s| (pts.get(s.a), pts.get(s.b))).collect();
-    for (i, j) in candidate_pairs(&ends) {
+    for (i, j) in candidate_pairs(&ends, budget)? {
         let ((a, b), (c, d)) = (ends[i], ends[j]);
         let (ab, cd) = (b - a, d - c);
         let (lab, lcd) = (ab.length(), cd.length());
@@ -292,11 +321,12 @@ fn cut_points(segs: &[Piece], pts: &Points) -> (Vec<Vec<(f64, Cut)>>, usize) {
         }
         points += usize::from(found);
     }
-    (cuts, points)
+    Some((cuts, points))
 }
 
-/// Pairs of segments whose boxes meet, found through a uniform grid.
-fn candidate_pairs(pts: &[(DVec2, DVec2)]) -> Vec<(usize, usize)> {
+/// Pairs of segments whose boxes meet, found through a uniform grid;
+/// `None` when the grid's cells hold more than `budget` pairs.
+fn candidate_pairs(pts: &[(DVec2, DVec2)], budget: usize) -> Option<Vec<(usize, usize)>> {
     let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
     for &(a, b) in pts {
         lo = lo.min(a.min(b));
@@ -317,7 +347,12 @@ fn candidate_pairs(pts: &[(DVec2, DVec2)]) -> Vec<(usize, usize)> {
             }
         }
     }
-    let mut pairs: Vec<(u32, u32)> = Vec::new();
+    let steps = grid.iter().fold(0usize, |s, b| s.saturating_add(b.len() * b.len().saturating_sub(1) / 2));
+    if steps > budget {
+        return None;
+    }
+    count_steps(steps);
+    let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(steps);
     for bucket in &grid {
         for (k, &i) in bucket.iter().enumerate() {
             for &j in &bucket[k + 1..] {
@@ -327,38 +362,48 @@ fn candidate_pairs(pts: &[(DVec2, DVec2)]) -> Vec<(usize, usize)> {
     }
     crate::sort::pairs(&mut pairs);
     pairs.dedup();
-    pairs.into_iter().map(|(i, j)| (i as usize, j as usize)).collect()
+    Some(pairs.into_iter().map(|(i, j)| (i as usize, j as usize)).collect())
 }
 
 /// The net pieces that bound the region of positive winding, each turned
-/// so that region is on its left.
-fn boundary(net: &[(i32, Piece)], pts: &Points) -> Vec<Piece> {
+/// so that region is on its left; `None` when the rays would meet more than
+/// `budget` pieces.
+fn boundary(net: &[(i32, Piece)], pts: &Points, budget: usize) -> Option<Vec<Piece>> {
     let ends: Vec<(DVec2, DVec2)> = net.iter().map(|(_, p)| (pts.get(p.a), pts.get(p.b))).collect();
     let bands = Bands::new(&ends);
-    let mut out = Vec::new();
-    for (k, &(n, p)) in net.iter().enumerate() {
-        let (a, b) = ends[k];
-        let m = 0.5 * (a + b);
-        let d = b - a;
-        // A ray from the piece's middle into its left side, along an axis.
-        let ray = if d.y.abs() >= d.x.abs() {
-            if d.y > 0.0 {
-                Ray::NegX
+    // A ray from each piece's middle into its left side, along an axis.
+    let rays: Vec<(DVec2, Ray)> = ends
+        .iter()
+        .map(|&(a, b)| {
+            let d = b - a;
+            let ray = if d.y.abs() >= d.x.abs() {
+                if d.y > 0.0 {
+                    Ray::NegX
+                } else {
+                    Ray::PosX
+                }
+            } else if d.x > 0.0 {
+                Ray::PosY
             } else {
-                Ray::PosX
-            }
-        } else if d.x > 0.0 {
-            Ray::PosY
-        } else {
-            Ray::NegY
-        };
+                Ray::NegY
+            };
+            (0.5 * (a + b), ray)
+        })
+        .collect();
+    let steps = rays.iter().fold(0usize, |s, &(m, ray)| s.saturating_add(bands.list(m, ray).len()));
+    if steps > budget {
+        return None;
+    }
+    count_steps(steps);
+    let mut out = Vec::new();
+    for (k, (&(n, p), &(m, ray))) in net.iter().zip(&rays).enumerate() {
         let left = bands.winding(net, &ends, k, m, ray);
         let right = left - n;
         if (left > 0) != (right > 0) {
             out.push(if left > 0 { p } else { p.reversed() });
         }
     }
-    out
+    Some(out)
 }
 
 /// An axis-parallel ray direction.
@@ -414,14 +459,19 @@ impl Bands {
         Self { lo, step, count, rows, cols }
     }
 
+    /// The pieces a ray from `m` may meet: those of its band.
+    fn list(&self, m: DVec2, ray: Ray) -> &[usize] {
+        let band = |x: f64, lo: f64, step: f64| (((x - lo) / step).floor().max(0.0) as usize).min(self.count - 1);
+        match ray {
+            Ray::PosX | Ray::NegX => &self.rows[band(m.y, self.lo.y, self.step.y)],
+            Ray::PosY | Ray::NegY => &self.cols[band(m.x, self.lo.x, self.step.x)],
+        }
+    }
+
     /// Winding number of the point just beside `m` on the ray's side, from
     /// the pieces other than `own` (with their multiplicities).
     fn winding(&self, net: &[(i32, Piece)], ends: &[(DVec2, DVec2)], own: usize, m: DVec2, ray: Ray) -> i32 {
-        let band = |x: f64, lo: f64, step: f64| (((x - lo) / step).floor().max(0.0) as usize).min(self.count - 1);
-        let list = match ray {
-            Ray::PosX | Ray::NegX => &self.rows[band(m.y, self.lo.y, self.step.y)],
-            Ray::PosY | Ray::NegY => &self.cols[band(m.x, self.lo.x, self.step.x)],
-        };
+        let list = self.list(m, ray);
         let q = ray.turn(m);
         let mut w = 0;
         for &k in list {
@@ -662,6 +712,28 @@ mod tests {
         let ar = mend_pair(&a, &b, on_curves);
         assert_eq!(ar.len(), 1, "{ar:?}");
         assert!((ar[0] - 3.0).abs() < 1e-6, "both regions: {ar:?}");
+    }
+
+    /// A star loop whose every chord crosses most others (as fuzzed files'
+    /// loops do) is cut into quadratically many pieces: mending gives up
+    /// within its steps per node, leaving the loop as it was.
+    #[test]
+    fn a_loop_crossing_itself_everywhere_is_refused_within_its_steps() {
+        let n = 101;
+        let pts: Vec<(f64, f64)> = (0..n)
+            .map(|i| {
+                let a = core::f64::consts::TAU * ((i * 50) % n) as f64 / n as f64;
+                (libm::cos(a), libm::sin(a))
+            })
+            .collect();
+        let curves = lines(&pts);
+        let mut l = Loops { polys: alloc::vec![poly(&pts, 0)], curves: curves.iter().collect(), mended: None };
+        let before = steps();
+        let m = mend(&mut l, &[true]);
+        let taken = steps() - before;
+        assert!(taken <= (STEPS_PER_NODE * n) as u64, "{taken} steps for {n} nodes");
+        assert!(m.is_none());
+        assert_eq!(l.polys[0].uv.len(), n, "unchanged");
     }
 
     /// Nodes a rounding apart and two loops touching at a corner: the

@@ -618,6 +618,16 @@ fn grow<T>(v: &mut Vec<T>, extra: usize) {
     }
 }
 
+/// Steps trim-loop mending has taken on this thread (segment pairs tested
+/// for crossings, pieces winding rays met): a measure of its work that does
+/// not depend on the machine, for tests; 0 without `std`.
+pub fn mend_steps() -> u64 {
+    #[cfg(feature = "std")]
+    return super::mend_loops::steps();
+    #[cfg(not(feature = "std"))]
+    0
+}
+
 /// Nanoseconds the mesher has spent measuring deviation (every triangle's
 /// samples projected on its surface) in this process, with the `timing`
 /// feature; `None` without it.

@@ -363,6 +363,26 @@ fn fuzz_overlapping_trim_loop_is_not_halved_without_end() {
     }
 }
 
+/// Found by fuzzing (20 s natively): a mutated sheet whose trim loop, a
+/// conic gone wild, crosses itself at tens of thousands of places. Mending
+/// cut it into some 150 000 pieces crowded where the crossings are, and the
+/// winding ray from each met most of them (4·10⁹ steps). Mending's steps
+/// are now bounded by the loop's nodes, and the face fails, naming its loop.
+#[test]
+fn fuzz_loop_crossing_itself_everywhere_is_not_mended_without_end() {
+    let model = read_iges(&data("iges_fuzz_slow_loop_mending.igs")).unwrap();
+    let options = MeshOptions::default().with_relative_tolerance(0.05).with_max_triangles(5_000);
+    let before = surfmesh::pipeline::mend_steps();
+    let result = mesh_model(&model, &options);
+    let steps = surfmesh::pipeline::mend_steps() - before;
+    // A few thousand loop nodes take a few million steps (unbounded, billions).
+    assert!(steps < 20_000_000, "{steps} mending steps");
+    match result {
+        Err(Error::Mesh { face: 0, message }) => assert!(message.contains("loop 0 crosses itself"), "{message}"),
+        other => panic!("face 0 fails: {:?}", other.map(|r| r.report)),
+    }
+}
+
 #[test]
 fn format_from_extension_and_first_line() {
     assert_eq!(Format::from_name("igs").unwrap(), Format::Iges);
