@@ -19,6 +19,9 @@ pub(super) struct Band {
     /// Per loop segment: its two nodes, its curve and the curve's parameters at them.
     pub segs: Vec<(usize, usize, u32, f64, f64)>,
     pub scale: DVec2,
+    /// The first node the triangulation added (crossings it split), or
+    /// `nodes.len()` when it added none.
+    pub added_from: usize,
 }
 
 impl Band {
@@ -49,7 +52,8 @@ impl Band {
                 }
             }
         }
-        Self { nodes, constraints, segs, scale }
+        let added_from = nodes.len();
+        Self { nodes, constraints, segs, scale, added_from }
     }
 
     /// The kept triangles (indices into `nodes`), counter-clockwise. Where
@@ -58,6 +62,7 @@ impl Band {
     pub fn triangulate(&mut self, index: usize) -> Result<Vec<[u32; 3]>, Error> {
         let scaled: Vec<DVec2> = self.nodes.iter().map(|&q| q * self.scale).collect();
         let r = super::cdt::triangulate_region(index, &scaled, &self.constraints)?;
+        self.added_from = self.nodes.len();
         self.nodes.extend(r.added.iter().map(|&q| q / self.scale));
         Ok(r.tris)
     }
@@ -109,11 +114,45 @@ impl Band {
             wm.add_triangle(v, uv);
         }
         for &(a, b, curve, ta, tb) in &self.segs {
-            let (va, vb) = (vid[a], vid[b]);
-            if va != vb && wm.edge_triangles(va, vb) == 1 {
-                wm.mark_trim(va, vb, curve, ta, tb);
+            let whole = wm.edge_triangles(vid[a], vid[b]) > 0 || self.added_from == self.nodes.len();
+            let pieces = if whole { alloc::vec![(a, b, 0.0, 1.0)] } else { self.pieces(a, b) };
+            for (x, y, fx, fy) in pieces {
+                let (vx, vy) = (vid[x], vid[y]);
+                if vx != vy && wm.edge_triangles(vx, vy) == 1 {
+                    wm.mark_trim(vx, vy, curve, ta + fx * (tb - ta), ta + fy * (tb - ta));
+                }
             }
         }
+    }
+
+    /// Loop segment `a-b` as the triangulation keeps it: whole, or in pieces
+    /// where it split the segment at crossings it added (nodes past the
+    /// loops'), each piece with its ends' fractions along the segment, so
+    /// that every piece is marked a trim edge.
+    fn pieces(&self, a: usize, b: usize) -> Vec<(usize, usize, f64, f64)> {
+        let added = self.nodes.get(self.added_from..).unwrap_or(&[]);
+        let (pa, pb) = (self.nodes[a], self.nodes[b]);
+        let d = pb - pa;
+        let len2 = d.length_squared();
+        let mut cuts: Vec<(f64, usize)> = Vec::new();
+        if len2 > 0.0 {
+            for (k, &q) in added.iter().enumerate() {
+                let f = (q - pa).dot(d) / len2;
+                // On the segment within rounding of the crossing's computation.
+                if f > 0.0 && f < 1.0 && (pa + d * f).distance_squared(q) <= 1e-18 * len2 {
+                    cuts.push((f, self.added_from + k));
+                }
+            }
+        }
+        crate::sort::by_f64(&mut cuts, |c| c.0);
+        let mut out = Vec::with_capacity(cuts.len() + 1);
+        let (mut prev, mut fp) = (a, 0.0);
+        for (f, k) in cuts {
+            out.push((prev, k, fp, f));
+            (prev, fp) = (k, f);
+        }
+        out.push((prev, b, fp, 1.0));
+        out
     }
 }
 

@@ -855,3 +855,19 @@ fn hyperbola_and_parabola_edges_are_exact() {
         assert!(gap <= 0.1 * tol && p.x <= 20.0 + f + 1e-9, "vertex {p} outside the parabola's segment");
     }
 }
+
+/// Found by fuzzing (a debug build's invariant check): a band round a
+/// cylinder whose outer loop meets itself tangentially. The first mesh's
+/// triangulation split two crossing loop segments at the point they cross,
+/// and the pieces were left unmarked as trim edges, border edges that no
+/// table knew. Every piece of a split segment is now a trim edge; the debug
+/// build checks every border edge after each stage.
+#[test]
+fn fuzz_loop_segments_split_at_a_crossing_stay_trim_edges() {
+    let model = read_step(&data("step_fuzz_split_crossing.stp")).unwrap();
+    let options = MeshOptions::default().with_relative_tolerance(0.05).with_max_triangles(5_000);
+    let r = mesh_model(&model, &options).expect("meshes");
+    assert!(r.report.triangles > 0, "{:?}", r.report.warnings);
+    assert!(r.report.max_deviation <= r.report.tolerance, "{} > {}", r.report.max_deviation, r.report.tolerance);
+    assert_eq!(r.report.inverted_triangles, 0);
+}
