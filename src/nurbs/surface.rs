@@ -354,13 +354,7 @@ impl NurbsSurface {
         uv: DVec2,
         order: usize,
     ) -> [[DVec4; 3]; 3] {
-        let mut bu = [[0.0; NU]; 3];
-        let mut bv = [[0.0; NV]; 3];
-        // Exact scratch already unrolls the basis; a degree class gets the
-        // basis in exact scratch (degrees up to 7) and copies it.
-        let su = self.basis_pair::<NU, NV, NU>(true, p, q, uv.x, order, &mut bu);
-        let sv = self.basis_pair::<NU, NV, NV>(false, p, q, uv.y, order, &mut bv);
-        let first = (su - p) * self.kv.control_count() + sv - q;
+        let (first, bu, bv) = self.bases::<NU, NV>(p, q, uv, order);
         // The same bits either way. In wasm the engine keeps the one pass's
         // nine accumulators in memory, and measured in Node it meshed
         // bicubics 13% slower (bug28366_fuselage) and high degrees no faster
@@ -370,6 +364,25 @@ impl NurbsSurface {
         } else {
             self.contract::<NU, NV>(first, p, q, &bu, &bv, order)
         }
+    }
+
+    /// The basis functions (and derivatives up to `order`) at `uv` along u
+    /// and v, and the index of the first control point they weigh.
+    #[inline(always)]
+    fn bases<const NU: usize, const NV: usize>(
+        &self,
+        p: usize,
+        q: usize,
+        uv: DVec2,
+        order: usize,
+    ) -> (usize, [[f64; NU]; MAX_DERIV + 1], [[f64; NV]; MAX_DERIV + 1]) {
+        let mut bu = [[0.0; NU]; 3];
+        let mut bv = [[0.0; NV]; 3];
+        // Exact scratch already unrolls the basis; a degree class gets the
+        // basis in exact scratch (degrees up to 7) and copies it.
+        let su = self.basis_pair::<NU, NV, NU>(true, p, q, uv.x, order, &mut bu);
+        let sv = self.basis_pair::<NU, NV, NV>(false, p, q, uv.y, order, &mut bv);
+        ((su - p) * self.kv.control_count() + sv - q, bu, bv)
     }
 
     /// `sum_v(contract_u(…))` in one pass, column by column: each column's
@@ -500,11 +513,7 @@ impl NurbsSurface {
         uv: DVec2,
         order: usize,
     ) -> [[DVec4; 3]; 3] {
-        let mut bu = [[0.0; NU]; 3];
-        let mut bv = [[0.0; NV]; 3];
-        let su = self.basis_pair::<NU, NV, NU>(true, p, q, uv.x, order, &mut bu);
-        let sv = self.basis_pair::<NU, NV, NV>(false, p, q, uv.y, order, &mut bv);
-        let first = (su - p) * self.kv.control_count() + sv - q;
+        let (first, bu, bv) = self.bases::<NU, NV>(p, q, uv, order);
         sum_v(&self.contract_u::<NU, NV>(first, p, q, &bu, order), &bv, q, order)
     }
 
