@@ -52,6 +52,31 @@ impl Polyline {
         self.uv.insert(i + 1, q);
         self.at.insert(i + 1, CurveRef { curve, t });
     }
+
+    /// Splits many segments at once, in one pass over the nodes: `splits`
+    /// holds `(i, t, q)` as [`Self::split_segment`] takes them, by rising
+    /// `i`, one per segment. Splitting one by one moves the nodes after
+    /// each, which costs a loop of n nodes n moves per split.
+    pub fn split_segments(&mut self, splits: &[(usize, f64, DVec2)]) {
+        let n = self.uv.len();
+        let mut uv = Vec::with_capacity(n + splits.len());
+        let mut at = Vec::with_capacity(n + splits.len());
+        let mut seg = Vec::with_capacity(n + splits.len());
+        let mut next = splits.iter().peekable();
+        for (i, ((&q, &r), &(curve, ta, tb))) in self.uv.iter().zip(&self.at).zip(&self.seg).enumerate() {
+            uv.push(q);
+            at.push(r);
+            match next.next_if(|s| s.0 == i) {
+                Some(&(_, t, m)) => {
+                    seg.extend([(curve, ta, t), (curve, t, tb)]);
+                    uv.push(m);
+                    at.push(CurveRef { curve, t });
+                }
+                None => seg.push((curve, ta, tb)),
+            }
+        }
+        (self.uv, self.at, self.seg) = (uv, at, seg);
+    }
 }
 
 /// All loops of one face, discretized and oriented: outer counter-clockwise
@@ -646,35 +671,138 @@ pub(crate) fn bulge_crossings(
 
 /// Calls `visit` with each pair of segments `segs` whose boxes share a cell
 /// of a uniform grid over `bounds` (a pair in two cells may come twice)
-/// until it returns true; returns whether it did.
+/// until it returns true; returns whether it did. A cell crowded with
+/// small segments (halvings heaped near one spot or along one line) is
+/// gridded again over its own segments' box, so a crowd costs about its
+/// size rather than its square.
 fn near_pairs(segs: &[Seg], bounds: (DVec2, DVec2), mut visit: impl FnMut(&Seg, &Seg) -> bool) -> bool {
-    let (lo, hi) = bounds;
-    let cells = (crate::math::sqrt(segs.len() as f64) as usize).clamp(1, 512);
-    let size = (hi - lo).max(DVec2::splat(TINY)) / cells as f64;
-    let cell_of = |p: DVec2| {
-        let c = ((p - lo) / size).floor();
-        (c.x.clamp(0.0, (cells - 1) as f64) as usize, c.y.clamp(0.0, (cells - 1) as f64) as usize)
-    };
-    let mut grid: Vec<Vec<u32>> = alloc::vec![Vec::new(); cells * cells];
-    for (s, seg) in segs.iter().enumerate() {
-        let (x0, y0) = cell_of(seg.a.min(seg.b));
-        let (x1, y1) = cell_of(seg.a.max(seg.b));
-        for x in x0..=x1 {
-            for y in y0..=y1 {
-                grid[y * cells + x].push(s as u32);
+    let all: Vec<u32> = (0..segs.len() as u32).collect();
+    let side = (crate::math::sqrt(segs.len() as f64) as usize).clamp(1, 512);
+    let grid = Grid::new(segs, &all, bounds, (side, side), usize::MAX, usize::MAX);
+    grid.is_some_and(|g| g.pairs(segs, 0, &mut visit))
+}
+
+/// Most segments a cell holds before it is gridded again: a quadratic
+/// scan of that many is cheap, and well above the fullest cell of any
+/// corpus part (about 120), whose pairs thus keep their order.
+const CROWDED: usize = 256;
+
+/// Most grids nested in one another's cells.
+const MAX_NESTING: usize = 8;
+
+/// Segments (by index) filed under every cell of a uniform grid that
+/// their boxes touch, and those too long to file ([`Grid::finer`]).
+struct Grid {
+    /// Cells along x and along y.
+    cells: (usize, usize),
+    lo: DVec2,
+    size: DVec2,
+    buckets: Vec<Vec<u32>>,
+    /// Segments each compared with every other of the grid instead.
+    long: Vec<u32>,
+    /// All the grid's segments, when some are long.
+    all: Vec<u32>,
+}
+
+impl Grid {
+    /// `cells` over `(lo, hi)` for the segments `idx`; a segment whose box
+    /// touches more than `span` cells is kept in [`Grid::long`]. `None`
+    /// once more than `most` entries would be filed.
+    fn new(
+        segs: &[Seg],
+        idx: &[u32],
+        (lo, hi): (DVec2, DVec2),
+        cells: (usize, usize),
+        span: usize,
+        most: usize,
+    ) -> Option<Grid> {
+        let (nx, ny) = (cells.0.max(1), cells.1.max(1));
+        let size = (hi - lo).max(DVec2::splat(TINY)) / DVec2::new(nx as f64, ny as f64);
+        let cell_of = |p: DVec2| {
+            let c = ((p - lo) / size).floor();
+            (c.x.clamp(0.0, (nx - 1) as f64) as usize, c.y.clamp(0.0, (ny - 1) as f64) as usize)
+        };
+        let mut buckets: Vec<Vec<u32>> = alloc::vec![Vec::new(); nx * ny];
+        let (mut long, mut filed) = (Vec::new(), 0usize);
+        for &s in idx {
+            let seg = segs.get(s as usize)?;
+            let (x0, y0) = cell_of(seg.a.min(seg.b));
+            let (x1, y1) = cell_of(seg.a.max(seg.b));
+            let touched = (x1 - x0 + 1) * (y1 - y0 + 1);
+            if touched > span {
+                long.push(s);
+                continue;
+            }
+            filed += touched;
+            if filed > most {
+                return None;
+            }
+            for x in x0..=x1 {
+                for y in y0..=y1 {
+                    buckets[y * nx + x].push(s);
+                }
             }
         }
+        let all = if long.is_empty() { Vec::new() } else { idx.to_vec() };
+        Some(Grid { cells: (nx, ny), lo, size, buckets, long, all })
     }
-    for bucket in &grid {
-        for (ii, &i) in bucket.iter().enumerate() {
-            for &j in &bucket[ii + 1..] {
-                if visit(&segs[i as usize], &segs[j as usize]) {
+
+    /// A finer grid for the crowded `bucket` of cell `c`, over the part of
+    /// the cell its segments cover (where two meet lies in both), with
+    /// about as many cells as segments, shaped like that box (a crowd along
+    /// one line is cut across it), the few long segments set apart; `None`
+    /// unless it files each segment a few times and leaves an eighth of the
+    /// pairs or fewer.
+    fn finer(&self, segs: &[Seg], c: usize, bucket: &[u32]) -> Option<Grid> {
+        let lo = self.lo + self.size * DVec2::new((c % self.cells.0) as f64, (c / self.cells.0) as f64);
+        let (mut a, mut b) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for &i in bucket {
+            let s = segs.get(i as usize)?;
+            (a, b) = (a.min(s.a).min(s.b), b.max(s.a).max(s.b));
+        }
+        let (a, b) = (a.max(lo), b.min(lo + self.size).max(a.max(lo)));
+        let n = bucket.len() as f64;
+        let e = (b - a).max(DVec2::splat(TINY));
+        let aspect = e.x / e.y;
+        let side = |x: f64| (crate::math::sqrt(x).min(n) as usize).clamp(1, 4096);
+        let cells = (side(n * aspect), side(n / aspect));
+        let n = bucket.len();
+        let g = Grid::new(segs, bucket, (a, b), cells, 16, 4 * n)?;
+        let pairs = g.buckets.iter().map(|b| b.len() * b.len() / 2).sum::<usize>() + g.long.len() * n;
+        (pairs <= n * n / 8).then_some(g)
+    }
+
+    /// [`near_pairs`] over this grid's cells, `depth` grids deep.
+    fn pairs(&self, segs: &[Seg], depth: usize, visit: &mut impl FnMut(&Seg, &Seg) -> bool) -> bool {
+        // A long segment against every other, once per pair of long ones
+        // (`long` rises, as the indices it was filed from do).
+        for &i in &self.long {
+            for &j in &self.all {
+                let earlier_long = j < i && self.long.binary_search(&j).is_ok();
+                if j != i && !earlier_long && visit(&segs[i as usize], &segs[j as usize]) {
                     return true;
                 }
             }
         }
+        for (c, bucket) in self.buckets.iter().enumerate() {
+            if bucket.len() > CROWDED && depth < MAX_NESTING {
+                if let Some(g) = self.finer(segs, c, bucket) {
+                    if g.pairs(segs, depth + 1, visit) {
+                        return true;
+                    }
+                    continue;
+                }
+            }
+            for (ii, &i) in bucket.iter().enumerate() {
+                for &j in &bucket[ii + 1..] {
+                    if visit(&segs[i as usize], &segs[j as usize]) {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
     }
-    false
 }
 
 #[cfg(test)]
@@ -818,5 +946,69 @@ mod tests {
         let message = alloc::format!("{}", crossing_error(3, &left, &[0]));
         assert!(message.contains("loop 0 crosses itself"), "{message}");
         assert!(loops.polys[0].uv.len() <= 6 + 2 * MAX_CROSSING_SPLITS);
+    }
+
+    /// 20 000 short segments of one wavy curve heaped in a speck of a large
+    /// loop's box. The flat grid files them in one cell and compares every
+    /// pair (2·10⁸); crowded cells gridded again keep it near linear, and
+    /// every touching pair (the curve's neighbours) is still met.
+    #[test]
+    fn a_crowd_of_segments_is_compared_in_near_linear_work() {
+        let seg = |a: DVec2, b: DVec2, idx: usize| Seg { a, b, lp: 0, idx, len: 0, half: false };
+        let square = [DVec2::ZERO, DVec2::new(1000.0, 0.0), DVec2::splat(1000.0), DVec2::new(0.0, 1000.0)];
+        let mut segs: Vec<Seg> = (0..4).map(|i| seg(square[i], square[(i + 1) % 4], i)).collect();
+        let n = 20_000;
+        let at = |i: usize| {
+            let t = i as f64 / n as f64;
+            DVec2::new(500.0 + 1e-3 * t, 500.0 + 1e-4 * libm::sin(40.0 * t))
+        };
+        segs.extend((0..n).map(|i| seg(at(i), at(i + 1), 4 + i)));
+        // Chords across the whole crowd, as a loop's unhalved chords lie
+        // along the stretch another retraces: each meets the curve.
+        let chords = 8;
+        segs.extend((0..chords).map(|k| seg(at(0) - DVec2::Y * 1e-5, at(n) + DVec2::Y * (k as f64 * 1e-5), 4 + n + k)));
+        let (mut visits, mut neighbours, mut across) =
+            (0usize, crate::collections::HashSet::default(), crate::collections::HashSet::default());
+        near_pairs(&segs, (DVec2::ZERO, DVec2::splat(1000.0)), |s, t| {
+            visits += 1;
+            let on_curve = |s: &Seg| (4..4 + n).contains(&s.idx);
+            if s.idx.abs_diff(t.idx) == 1 && on_curve(s) && on_curve(t) {
+                neighbours.insert(s.idx.min(t.idx));
+            }
+            if on_curve(s) != on_curve(t) && s.idx >= 4 && t.idx >= 4 && segments_meet(s.a, s.b, t.a, t.b) {
+                across.insert((s.idx.min(t.idx), s.idx.max(t.idx)));
+            }
+            false
+        });
+        assert!(visits < 50 * n, "{visits} pairs compared for {n} segments");
+        assert_eq!(neighbours.len(), n - 1, "every pair of touching neighbours is compared");
+        let meeting = (4..4 + n)
+            .flat_map(|i| (4 + n..4 + n + chords).map(move |j| (i, j)))
+            .filter(|&(i, j)| segments_meet(segs[i].a, segs[i].b, segs[j].a, segs[j].b))
+            .count();
+        assert!(meeting > chords, "the chords cross the curve");
+        assert_eq!(across.len(), meeting, "every crossing of a chord and the curve is met");
+    }
+
+    /// Splitting several segments in one pass gives the loop that splitting
+    /// them one by one from the last gives.
+    #[test]
+    fn split_segments_at_once_equals_one_by_one() {
+        let mut poly = Polyline::default();
+        let mut from = 0.0;
+        for i in 1..=6 {
+            let t = f64::from(i);
+            poly.push_on_curve(i % 2, &mut from, t, DVec2::new(t, t * t));
+        }
+        let splits = [(0, 0.5, DVec2::new(0.5, 0.0)), (3, 3.5, DVec2::new(3.5, 1.0)), (5, 5.5, DVec2::new(5.5, 2.0))];
+        let mut one_by_one = poly.clone();
+        for &(i, t, q) in splits.iter().rev() {
+            one_by_one.split_segment(i, t, q);
+        }
+        poly.split_segments(&splits);
+        assert_eq!(poly.uv, one_by_one.uv);
+        assert_eq!(poly.at, one_by_one.at);
+        assert_eq!(poly.seg, one_by_one.seg);
+        assert_eq!(poly.uv.len(), 9);
     }
 }

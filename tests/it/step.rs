@@ -8,7 +8,7 @@ use std::path::Path;
 
 use surfmesh::{
     edge_counts, mesh_model, mesh_model_in_units, read_model, read_step, read_step_parts, read_step_with_shells,
-    Entity, Format, Mesh, MeshOptions, MeshResult, Model, StepShell, Units, Warning, WarningKind,
+    Entity, Error, Format, Mesh, MeshOptions, MeshResult, Model, StepShell, Units, Warning, WarningKind,
 };
 
 use crate::corpus_files::{corpus_bytes, corpus_names};
@@ -870,4 +870,20 @@ fn fuzz_loop_segments_split_at_a_crossing_stay_trim_edges() {
     assert!(r.report.triangles > 0, "{:?}", r.report.warnings);
     assert!(r.report.max_deviation <= r.report.tolerance, "{} > {}", r.report.max_deviation, r.report.tolerance);
     assert_eq!(r.report.inverted_triangles, 0);
+}
+
+/// Found by fuzzing (11 s in a release build): a cylinder face whose loops
+/// run along each other over a stretch. Sewing halved the chords that cross
+/// there round after round, and the halves heaped up in one cell of the
+/// grid that finds crossing pairs, which compared all of them with all
+/// (5·10⁸ pairs a round). Crowded cells are now gridded again; the face
+/// still cannot be parted and fails with its typed error.
+#[test]
+fn fuzz_loops_along_each_other_fail_without_heaping_work() {
+    let model = read_step(&data("step_fuzz_slow_crossing_cylinder.stp")).unwrap();
+    let options = MeshOptions::default().with_relative_tolerance(0.05).with_max_triangles(5_000);
+    match mesh_model(&model, &options) {
+        Err(Error::Mesh { face: 0, message }) => assert!(message.contains("cannot part"), "{message}"),
+        other => panic!("face 0 fails: {:?}", other.map(|r| r.report)),
+    }
 }

@@ -162,11 +162,12 @@ fn cut_face(surface: &dyn Surface, o: &mut Outline<'_>, cuts: &[((u32, u32), DVe
         let poly = &mut o.loops.polys[k];
         let gids = &mut o.gids[k];
         let n = poly.uv.len();
-        if gids.len() != n {
+        if gids.len() != n || poly.seg.len() != n || poly.at.len() != n {
             continue;
         }
-        // From the last segment, so the earlier indices stay valid.
-        for i in (0..n).rev() {
+        let mut splits = Vec::new();
+        let mut ids = Vec::new();
+        for i in 0..n {
             let (ga, gb) = (gids[i], gids[(i + 1) % n]);
             let Ok(at) = cuts.binary_search_by_key(&(ga.min(gb), ga.max(gb)), |c| c.0) else { continue };
             let (c, ta, tb) = poly.seg[i];
@@ -176,9 +177,22 @@ fn cut_face(surface: &dyn Surface, o: &mut Outline<'_>, cuts: &[((u32, u32), DVe
             let (s, _) = nearest_fraction(&|s: f64| on_curve(s).distance(target), 0.5);
             let s = if s > 1e-9 && s < 1.0 - 1e-9 { s } else { 0.5 };
             let t = ta + (tb - ta) * s;
-            poly.split_segment(i, t, curve.point(t).truncate());
-            gids.insert(i + 1, first + at as u32);
+            splits.push((i, t, curve.point(t).truncate()));
+            ids.push((i, first + at as u32));
         }
+        if splits.is_empty() {
+            continue;
+        }
+        poly.split_segments(&splits);
+        let mut added = ids.iter().peekable();
+        let mut new_ids = Vec::with_capacity(n + ids.len());
+        for (i, &g) in gids.iter().enumerate() {
+            new_ids.push(g);
+            if let Some(&(_, id)) = added.next_if(|a| a.0 == i) {
+                new_ids.push(id);
+            }
+        }
+        *gids = new_ids;
     }
 }
 
