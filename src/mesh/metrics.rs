@@ -8,7 +8,7 @@ use super::{weld::weld_positions, FaceRange, Mesh};
 use crate::model::SkippedFace;
 use crate::nurbs::{Aabb, NurbsCurve};
 
-/// Edge census after welding coincident vertices of the faces' borders.
+/// Edge census after welding coincident vertices (see [`edge_counts`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct EdgeCounts {
     /// Edges with exactly one triangle.
@@ -27,10 +27,10 @@ pub struct EdgeCounts {
     pub hole_edges: usize,
 }
 
-/// Counts boundary, crack and non-manifold edges after welding vertices on
-/// their face's border closer than `weld_tol` (a face's inner vertices stay
-/// as its triangles join them); `sew_tol` is how close unconnected borders
-/// must be to count as a crack.
+/// Counts boundary, crack and non-manifold edges after welding vertices
+/// closer than `weld_tol` (a face's inner vertices never with its own nor
+/// with a border: its triangles join them); `sew_tol` is how close
+/// unconnected borders must be to count as a crack.
 pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
     edge_counts_in_bodies(mesh, &[], weld_tol, sew_tol)
 }
@@ -175,12 +175,15 @@ pub(crate) fn edge_census(
 }
 
 /// The census's weld: [`weld_scaled`] over the vertices on their face's
-/// border ([`on_face_border`]), each inner vertex of a face its own. Only
-/// a border can be joined to another face's or left open beside it (a
-/// crack); an inner vertex is joined to its neighbours by its face's own
-/// triangles, and welding it by distance joins layers of a face that passes
-/// near itself (a pleated or self-touching surface) into edges of four
-/// triangles that neither layer has. `one_scale`: every face's scale is 1.
+/// border ([`on_face_border`]) and, apart, over the inner ones, where two
+/// inner vertices of one face stay two. Only borders can be joined to
+/// another face's or left open beside it (a crack). A face's inner
+/// vertices are joined by its own triangles: welding two of one face joins
+/// layers of a face that passes near itself (a pleated or self-touching
+/// surface) into edges of four triangles that neither layer has, and one
+/// on another face's border is a layer touching that border, not a join.
+/// Inner vertices of two faces still weld: faces that lie on each other
+/// stay non-manifold. `one_scale`: every face's scale is 1.
 fn weld_borders(
     mesh: &Mesh,
     face_of: &dyn Fn(usize) -> u32,
@@ -194,25 +197,55 @@ fn weld_borders(
     }
     let of_vertex = if one_scale { Vec::new() } else { vertex_scales(mesh, face_of, scale) };
     let scale_at = |v: usize| of_vertex.get(v).copied().unwrap_or(1.0);
-    let mut scales: Vec<f64> = (0..border.len()).filter(|&v| border[v]).map(scale_at).collect();
+    let mut scales: Vec<f64> = if one_scale { alloc::vec![1.0] } else { of_vertex.clone() };
     crate::sort::f64s(&mut scales);
     scales.dedup();
     let mut map = alloc::vec![u32::MAX; mesh.positions.len()];
     let mut count = 0usize;
-    for k in scales {
-        let members: Vec<usize> = (0..border.len()).filter(|&v| border[v] && scale_at(v) == k).collect();
-        let points: Vec<DVec3> = members.iter().map(|&v| mesh.positions[v]).collect();
-        let (sub, n) = weld_positions(&points, weld * k);
-        for (&v, &m) in members.iter().zip(&sub) {
-            map[v] = (count + m as usize) as u32;
+    for on_border in [true, false] {
+        for &k in &scales {
+            let members: Vec<usize> =
+                (0..border.len()).filter(|&v| border[v] == on_border && scale_at(v) == k).collect();
+            let points: Vec<DVec3> = members.iter().map(|&v| mesh.positions[v]).collect();
+            let (sub, n) = weld_positions(&points, weld * k);
+            for (&v, &m) in members.iter().zip(&sub) {
+                map[v] = (count + m as usize) as u32;
+            }
+            count += n;
         }
-        count += n;
     }
-    for m in map.iter_mut().filter(|m| **m == u32::MAX) {
-        *m = count as u32;
-        count += 1;
-    }
+    count = split_layers(mesh, face_of, &border, &mut map, count);
     (map, count)
+}
+
+/// Of the welded inner vertices (`border` false, `map` to `count` ids),
+/// those welded with another of their face's get ids of their own (see
+/// [`weld_borders`]). Returns the new count.
+fn split_layers(
+    mesh: &Mesh,
+    face_of: &dyn Fn(usize) -> u32,
+    border: &[bool],
+    map: &mut [u32],
+    mut count: usize,
+) -> usize {
+    let mut face = alloc::vec![u32::MAX; mesh.positions.len()];
+    for (ti, t) in mesh.indices.chunks_exact(3).enumerate() {
+        for &v in t {
+            if let Some(x) = face.get_mut(v as usize) {
+                *x = face_of(ti);
+            }
+        }
+    }
+    let mut inner: Vec<(u64, u32)> =
+        (0..map.len()).filter(|&v| !border[v]).map(|v| (crate::sort::pair(map[v], face[v]), v as u32)).collect();
+    crate::sort::sort_u64_keys(&mut inner);
+    for run in inner.chunk_by(|x, y| x.0 == y.0).filter(|r| r.len() > 1) {
+        for &(_, v) in &run[1..] {
+            map[v as usize] = count as u32;
+            count += 1;
+        }
+    }
+    count
 }
 
 /// Each vertex's scale: that of the face of the last triangle using it (1
@@ -635,6 +668,10 @@ mod tests {
         let c = edge_counts(&m, 1e-9, 0.1);
         assert_eq!(c.nonmanifold_edges, 0, "{c:?}");
         assert_eq!(c.boundary_edges, 24);
+        // Two faces so placed lie on each other: their inner vertices still
+        // weld, and the grids' five inner edges have four triangles each.
+        m.face_ranges = alloc::vec![FaceRange { first: 0, count: 18 }, FaceRange { first: 18, count: 18 }];
+        assert_eq!(edge_counts(&m, 1e-9, 0.1).nonmanifold_edges, 5);
     }
 
     /// Two faces side by side: the second's first column on the first's
