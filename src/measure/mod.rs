@@ -14,7 +14,8 @@
 //!   (a grid inside each face's trim loops, by the even-odd rule over their
 //!   polylines, and points on the loops) to the mesh, through a BVH over the
 //!   triangles. Holes and dropped faces show up here and nowhere else.
-//! - **Edges** after welding coincident vertices ([`crate::edge_counts`]),
+//! - **Edges** after welding coincident vertices, a face's inner ones never
+//!   with its own ([`crate::edge_counts`]; one census for every mesher's mesh),
 //!   per body of the model as the mesher's own report counts them: each face
 //!   range's body is found from the model faces nearest its triangles
 //!   (`bodies.rs`), since another program numbers its faces its own way.

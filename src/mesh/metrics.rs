@@ -4,11 +4,11 @@ use crate::warning::{Warning, WarningKind};
 use alloc::vec::Vec;
 use glam::DVec3;
 
-use super::{weld::weld_positions, Mesh};
+use super::{weld::weld_positions, FaceRange, Mesh};
 use crate::model::SkippedFace;
 use crate::nurbs::{Aabb, NurbsCurve};
 
-/// Edge census after welding coincident vertices.
+/// Edge census after welding coincident vertices (see [`edge_counts`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct EdgeCounts {
     /// Edges with exactly one triangle.
@@ -27,8 +27,10 @@ pub struct EdgeCounts {
     pub hole_edges: usize,
 }
 
-/// Counts boundary, crack and non-manifold edges after welding vertices closer
-/// than `weld_tol`; `sew_tol` is how close unconnected borders must be to count as a crack.
+/// Counts boundary, crack and non-manifold edges after welding vertices
+/// closer than `weld_tol` (a face's inner vertices never with its own nor
+/// with a border: its triangles join them); `sew_tol` is how close
+/// unconnected borders must be to count as a crack.
 pub fn edge_counts(mesh: &Mesh, weld_tol: f64, sew_tol: f64) -> EdgeCounts {
     edge_counts_in_bodies(mesh, &[], weld_tol, sew_tol)
 }
@@ -81,12 +83,7 @@ pub(crate) fn edge_census(
 ) -> (EdgeCounts, Vec<Gap>) {
     let face_of = face_lookup(mesh);
     let scale_of = |f: u32| scale.get(f as usize).copied().unwrap_or(1.0);
-    // One scale throughout (most models): no per-vertex scales held beside the mesh.
-    let (mut map, mut nverts) = if scale.iter().all(|&k| k == 1.0) {
-        weld_positions(&mesh.positions, weld_tol)
-    } else {
-        weld_scaled(mesh, &face_of, &scale_of, weld_tol)
-    };
+    let (mut map, mut nverts) = weld_borders(mesh, &face_of, &scale_of, scale.iter().all(|&k| k == 1.0), weld_tol);
     let body_of_face = |f: u32| crate::model::body_of(bodies, f as usize);
     if !bodies.is_empty() {
         split_by_body(mesh, body_of_face, &face_of, &mut map, &mut nverts);
@@ -177,6 +174,139 @@ pub(crate) fn edge_census(
     (out, gaps)
 }
 
+/// The census's weld: [`weld_scaled`] over the vertices on their face's
+/// border ([`on_face_border`]) and, apart, over the inner ones, where two
+/// inner vertices of one face stay two. Only borders can be joined to
+/// another face's or left open beside it (a crack). A face's inner
+/// vertices are joined by its own triangles: welding two of one face joins
+/// layers of a face that passes near itself (a pleated or self-touching
+/// surface) into edges of four triangles that neither layer has, and one
+/// on another face's border is a layer touching that border, not a join.
+/// Inner vertices of two faces still weld: faces that lie on each other
+/// stay non-manifold. `one_scale`: every face's scale is 1.
+fn weld_borders(
+    mesh: &Mesh,
+    face_of: &dyn Fn(usize) -> u32,
+    scale: &dyn Fn(u32) -> f64,
+    one_scale: bool,
+    weld: f64,
+) -> (Vec<u32>, usize) {
+    let border = on_face_border(mesh);
+    if border.iter().all(|&b| b) {
+        return if one_scale { weld_positions(&mesh.positions, weld) } else { weld_scaled(mesh, face_of, scale, weld) };
+    }
+    let of_vertex = if one_scale { Vec::new() } else { vertex_scales(mesh, face_of, scale) };
+    let scale_at = |v: usize| of_vertex.get(v).copied().unwrap_or(1.0);
+    let mut scales: Vec<f64> = if one_scale { alloc::vec![1.0] } else { of_vertex.clone() };
+    crate::sort::f64s(&mut scales);
+    scales.dedup();
+    let mut map = alloc::vec![u32::MAX; mesh.positions.len()];
+    let mut count = 0usize;
+    for on_border in [true, false] {
+        for &k in &scales {
+            let members: Vec<usize> =
+                (0..border.len()).filter(|&v| border[v] == on_border && scale_at(v) == k).collect();
+            let points: Vec<DVec3> = members.iter().map(|&v| mesh.positions[v]).collect();
+            let (sub, n) = weld_positions(&points, weld * k);
+            for (&v, &m) in members.iter().zip(&sub) {
+                map[v] = (count + m as usize) as u32;
+            }
+            count += n;
+        }
+    }
+    count = split_layers(mesh, face_of, &border, &mut map, count);
+    (map, count)
+}
+
+/// Of the welded inner vertices (`border` false, `map` to `count` ids),
+/// those welded with another of their face's get ids of their own (see
+/// [`weld_borders`]). Returns the new count.
+fn split_layers(
+    mesh: &Mesh,
+    face_of: &dyn Fn(usize) -> u32,
+    border: &[bool],
+    map: &mut [u32],
+    mut count: usize,
+) -> usize {
+    let mut face = alloc::vec![u32::MAX; mesh.positions.len()];
+    for (ti, t) in mesh.indices.chunks_exact(3).enumerate() {
+        for &v in t {
+            if let Some(x) = face.get_mut(v as usize) {
+                *x = face_of(ti);
+            }
+        }
+    }
+    let mut inner: Vec<(u64, u32)> =
+        (0..map.len()).filter(|&v| !border[v]).map(|v| (crate::sort::pair(map[v], face[v]), v as u32)).collect();
+    crate::sort::sort_u64_keys(&mut inner);
+    for run in inner.chunk_by(|x, y| x.0 == y.0).filter(|r| r.len() > 1) {
+        for &(_, v) in &run[1..] {
+            map[v as usize] = count as u32;
+            count += 1;
+        }
+    }
+    count
+}
+
+/// Each vertex's scale: that of the face of the last triangle using it (1
+/// for a vertex no triangle uses).
+fn vertex_scales(mesh: &Mesh, face_of: &dyn Fn(usize) -> u32, scale: &dyn Fn(u32) -> f64) -> Vec<f64> {
+    let mut of_vertex = alloc::vec![1.0f64; mesh.positions.len()];
+    for (ti, t) in mesh.indices.chunks_exact(3).enumerate() {
+        let k = scale(face_of(ti));
+        for &v in t {
+            if let Some(x) = of_vertex.get_mut(v as usize) {
+                *x = k;
+            }
+        }
+    }
+    of_vertex
+}
+
+/// Per vertex, whether it lies on its face's border by index: on an edge
+/// that one triangle of its face uses (or more than two), or on no
+/// triangle with three corners. Faces are the mesh's face ranges (none: the mesh is one face);
+/// a vertex two faces share by index is on both borders.
+fn on_face_border(mesh: &Mesh) -> Vec<bool> {
+    let mut border = alloc::vec![false; mesh.positions.len()];
+    let count = mesh.indices.len() / 3;
+    let whole = [FaceRange { first: 0, count: count as u32 }];
+    let ranges = if mesh.face_ranges.is_empty() { &whole[..] } else { &mesh.face_ranges[..] };
+    let mut used = alloc::vec![false; mesh.positions.len()];
+    let mut edges: Vec<(u32, u32)> = Vec::new();
+    for r in ranges {
+        edges.clear();
+        let (lo, hi) = (r.first as usize, (r.first as usize + r.count as usize).min(count));
+        for t in mesh.indices.get(3 * lo..3 * hi).unwrap_or(&[]).chunks_exact(3) {
+            if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
+                continue;
+            }
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                edges.push((a.min(b), a.max(b)));
+                if let Some(u) = used.get_mut(a as usize) {
+                    *u = true;
+                }
+            }
+        }
+        crate::sort::pairs(&mut edges);
+        for run in edges.chunk_by(|x, y| x == y) {
+            if run.len() == 2 {
+                continue;
+            }
+            for v in [run[0].0, run[0].1] {
+                if let Some(b) = border.get_mut(v as usize) {
+                    *b = true;
+                }
+            }
+        }
+    }
+    for (b, u) in border.iter_mut().zip(used) {
+        *b |= !u;
+    }
+    border
+}
+
 /// [`weld_positions`] within `weld` times the scale of each vertex's face
 /// (`face_of` triangle, `scale` of face; 1 for a vertex no triangle uses):
 /// each scale's vertices welded on their own, their ids following the last
@@ -187,15 +317,7 @@ pub(crate) fn weld_scaled(
     scale: &dyn Fn(u32) -> f64,
     weld: f64,
 ) -> (Vec<u32>, usize) {
-    let mut of_vertex = alloc::vec![1.0f64; mesh.positions.len()];
-    for (ti, t) in mesh.indices.chunks_exact(3).enumerate() {
-        let k = scale(face_of(ti));
-        for &v in t {
-            if let Some(x) = of_vertex.get_mut(v as usize) {
-                *x = k;
-            }
-        }
-    }
+    let of_vertex = vertex_scales(mesh, face_of, scale);
     if of_vertex.iter().all(|&k| k == 1.0) {
         return weld_positions(&mesh.positions, weld);
     }
@@ -511,5 +633,61 @@ mod tests {
         let c = edge_counts(&m, 1e-9, 1.0);
         assert_eq!(c.boundary_edges, 8);
         assert_eq!(c.free_edges, 0);
+    }
+
+    /// A 4 x 4 grid of points `(x0 + i, j, z(i, j))`, two triangles a
+    /// cell, appended to `m` as a face of its own.
+    fn grid(m: &mut Mesh, x0: f64, z: impl Fn(usize, usize) -> f64) {
+        let base = m.positions.len() as u32;
+        for j in 0..4 {
+            for i in 0..4 {
+                m.positions.push(DVec3::new(x0 + i as f64, j as f64, z(i, j)));
+            }
+        }
+        let first = (m.indices.len() / 3) as u32;
+        let at = |i: u32, j: u32| base + 4 * j + i;
+        for j in 0..3 {
+            for i in 0..3 {
+                m.indices.extend([at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        m.face_ranges.push(FaceRange { first, count: 18 });
+    }
+
+    /// A pleat: one face whose two layers pass through the same points
+    /// inside it (the four inner vertices of two grids coincide to 1e-12,
+    /// their borders bent a unit apart). Its triangles join no layer to the
+    /// other, and the census welds only borders: no edge has four triangles.
+    #[test]
+    fn layers_of_one_face_touching_inside_it_are_not_welded() {
+        let mut m = Mesh::default();
+        grid(&mut m, 0.0, |_, _| 0.0);
+        grid(&mut m, 0.0, |i, j| if (1..3).contains(&i) && (1..3).contains(&j) { 1e-12 } else { -1.0 });
+        // The two grids one face.
+        m.face_ranges = alloc::vec![FaceRange { first: 0, count: 36 }];
+        let c = edge_counts(&m, 1e-9, 0.1);
+        assert_eq!(c.nonmanifold_edges, 0, "{c:?}");
+        assert_eq!(c.boundary_edges, 24);
+        // Two faces so placed lie on each other: their inner vertices still
+        // weld, and the grids' five inner edges have four triangles each.
+        m.face_ranges = alloc::vec![FaceRange { first: 0, count: 18 }, FaceRange { first: 18, count: 18 }];
+        assert_eq!(edge_counts(&m, 1e-9, 0.1).nonmanifold_edges, 5);
+    }
+
+    /// Two faces side by side: the second's first column on the first's
+    /// last, to 1e-12, joins (no crack); moved 0.05 off it, within the
+    /// sewing distance, it is a crack on both sides. Borders weld as before.
+    #[test]
+    fn borders_of_two_faces_still_weld_and_crack() {
+        let mut m = Mesh::default();
+        grid(&mut m, 0.0, |_, _| 0.0);
+        grid(&mut m, 3.0, |i, _| if i == 0 { 1e-12 } else { 0.0 });
+        let c = edge_counts(&m, 1e-9, 0.1);
+        assert_eq!((c.boundary_edges, c.free_edges, c.nonmanifold_edges), (18, 0, 0), "{c:?}");
+        let mut cracked = Mesh::default();
+        grid(&mut cracked, 0.0, |_, _| 0.0);
+        grid(&mut cracked, 3.0, |i, _| if i == 0 { 0.05 } else { 0.0 });
+        let c = edge_counts(&cracked, 1e-9, 0.1);
+        assert_eq!((c.boundary_edges, c.free_edges), (24, 6), "{c:?}");
     }
 }
