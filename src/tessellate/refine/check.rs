@@ -103,8 +103,8 @@ pub(crate) struct Known {
     /// table then lists the third on it; none is flipped or collapsed.
     pub non_manifold: bool,
     /// Triangles folded against the surface in space, which mending could
-    /// not unfold and the report counts as inverted (bug25013_25013faces
-    /// of the wide corpus at 1e-3, next to border nodes sewing moved).
+    /// not unfold and the report counts as inverted (next to border nodes
+    /// sewing moved; no corpus part has one now, hostile input may).
     pub folds: bool,
 }
 
