@@ -46,6 +46,9 @@ pub(super) fn grid(
     cells: usize,
 ) -> (Vec<f64>, Vec<f64>) {
     let kept = (surface, samples);
+    if surface.even_parameters() {
+        samples.reserve_even_grid(loops.is_some());
+    }
     #[cfg(feature = "std")]
     let pieces = |along_u: bool, s: f64| loops.map_or_else(Vec::new, |l| l.line_pieces(along_u, s));
     #[cfg(feature = "std")]
@@ -736,6 +739,22 @@ mod tests {
             assert_eq!(grid((&s, &kept), lo, hi, &l, None, usize::MAX), fresh, "{l:?} again");
             assert_eq!(kept.len(), n, "{l:?}: evaluated again");
         }
+    }
+
+    /// The grid of an evenly parameterized surface (a rebuild) sizes its
+    /// store for the fine demand's values before keeping the first: it
+    /// never grows (each growth rehashed every value kept).
+    #[test]
+    fn an_even_grid_sizes_its_samples_at_once() {
+        let s = wavy();
+        let [lo, hi] = s.domain();
+        let lim = Limits { tol: 1e-3, angle: 0.5, max_edge: f64::INFINITY, min_edge: 1e-6 };
+        let kept = Samples::default();
+        let g = grid((&s, &kept), lo, hi, &lim, None, usize::MAX);
+        assert!(kept.len() > 4000, "{} values", kept.len());
+        assert_eq!(kept.growths(), 0, "{} values kept", kept.len());
+        let (pu, pv) = g;
+        assert!(pu.len() > 2 && pv.len() > 2, "{} x {}", pu.len(), pv.len());
     }
 
     /// A trial's cell limit (see [`grid`]): a grid within it is the grid

@@ -26,31 +26,65 @@ use crate::nurbs::Surface;
 /// again gives the same bits without the evaluation. Kept for one surface
 /// only; past [`Samples::MOST`] values new ones are evaluated, not kept.
 #[derive(Default)]
-pub(crate) struct Samples(core::cell::RefCell<HashMap<[u64; 2], (DVec3, DVec3)>>);
+pub(crate) struct Samples(
+    core::cell::RefCell<HashMap<[u64; 2], (DVec3, DVec3)>>,
+    /// Times a value was kept in a full store (it grew), for tests.
+    #[cfg(test)]
+    core::cell::Cell<usize>,
+);
 
 impl Samples {
     /// Most values kept (about 70 bytes each).
     const MOST: usize = 1 << 20;
 
     /// The surface's point and unit normal at `uv`, evaluated once (by
-    /// `eval`, which gives the bits [`Surface::point_normal`] gives).
+    /// `eval`, which gives the bits [`Surface::point_normal`] gives and
+    /// must not read this store). The key is hashed and looked up once,
+    /// for the value and for the place a new one goes.
     fn point_normal_with(&self, uv: DVec2, eval: impl FnOnce() -> (DVec3, DVec3)) -> (DVec3, DVec3) {
         let key = [uv.x.to_bits(), uv.y.to_bits()];
-        if let Some(&x) = self.0.borrow().get(&key) {
-            return x;
-        }
-        let x = eval();
         let mut kept = self.0.borrow_mut();
-        if kept.len() < Self::MOST {
-            kept.insert(key, x);
+        let room = kept.len() < Self::MOST;
+        #[cfg(test)]
+        let full = kept.len() == kept.capacity();
+        match kept.entry(key) {
+            hashbrown::hash_map::Entry::Occupied(o) => *o.get(),
+            hashbrown::hash_map::Entry::Vacant(slot) => {
+                let x = eval();
+                if room {
+                    #[cfg(test)]
+                    self.1.set(self.1.get() + usize::from(full));
+                    slot.insert(x);
+                }
+                x
+            }
         }
-        x
+    }
+
+    /// Room for the values a grid of an evenly parameterized surface
+    /// ([`even_demand`]) evaluates, made before the first is kept: both
+    /// directions' [`FINE`] intervals, each tested at its ends and quarter
+    /// points, on every probe line (`trimmed`: every eighth of the
+    /// rectangle, else every quarter). Grown a value at a time, the store
+    /// doubled and rehashed every value about fifteen times on the way.
+    pub(crate) fn reserve_even_grid(&self, trimmed: bool) {
+        let lines = if trimmed { 9 } else { 5 };
+        let want = (2 * lines * (4 * FINE + 1)).min(Self::MOST);
+        let mut kept = self.0.borrow_mut();
+        let more = want.saturating_sub(kept.len());
+        kept.reserve(more);
     }
 
     /// How many values are kept.
     #[cfg(test)]
     pub(crate) fn len(&self) -> usize {
         self.0.borrow().len()
+    }
+
+    /// How many times the store grew.
+    #[cfg(test)]
+    pub(crate) fn growths(&self) -> usize {
+        self.1.get()
     }
 }
 
