@@ -46,9 +46,6 @@ pub(super) fn grid(
     cells: usize,
 ) -> (Vec<f64>, Vec<f64>) {
     let kept = (surface, samples);
-    if surface.even_parameters() {
-        samples.reserve_even_grid(loops.is_some());
-    }
     #[cfg(feature = "std")]
     let pieces = |along_u: bool, s: f64| loops.map_or_else(Vec::new, |l| l.line_pieces(along_u, s));
     #[cfg(feature = "std")]
@@ -741,9 +738,10 @@ mod tests {
         }
     }
 
-    /// The grid of an evenly parameterized surface (a rebuild) sizes its
-    /// store for the fine demand's values before keeping the first: it
-    /// never grows (each growth rehashed every value kept).
+    /// The grid of an evenly parameterized surface (a rebuild) makes room
+    /// in its store for each direction's fine demand before keeping its
+    /// first value: no value is kept in a full store (each growth rehashed
+    /// every value kept).
     #[test]
     fn an_even_grid_sizes_its_samples_at_once() {
         let s = wavy();

@@ -30,6 +30,8 @@ pub(crate) struct Samples(
     core::cell::RefCell<HashMap<[u64; 2], (DVec3, DVec3)>>,
     /// The fine intervals' shapes ([`Samples::shape_with`]).
     core::cell::RefCell<HashMap<[u64; 7], Shape>>,
+    /// Whether room for a direction's fine demand was made, along u and v.
+    core::cell::Cell<[bool; 2]>,
     /// Times a value was kept in a full store (it grew), and shapes
     /// measured, for tests.
     #[cfg(test)]
@@ -56,7 +58,7 @@ impl Samples {
                 let x = eval();
                 if room {
                     #[cfg(test)]
-                    self.2.set([self.2.get()[0] + usize::from(full), self.2.get()[1]]);
+                    self.3.set([self.3.get()[0] + usize::from(full), self.3.get()[1]]);
                     slot.insert(x);
                 }
                 x
@@ -64,18 +66,30 @@ impl Samples {
         }
     }
 
-    /// Room for the values a grid of an evenly parameterized surface
-    /// ([`even_demand`]) evaluates, made before the first is kept: both
-    /// directions' [`FINE`] intervals, each tested at its ends and quarter
-    /// points, on every probe line (`trimmed`: every eighth of the
-    /// rectangle, else every quarter). Grown a value at a time, the store
+    /// Room for the values the fine demand along u (`along_u`) or v of an
+    /// evenly parameterized surface ([`fine_demand`]) evaluates on
+    /// `probes` over `[t0, t1]`, made once per direction before the first
+    /// is kept: each line's [`FINE`] intervals inside its pieces, tested
+    /// at their ends and quarter points, and half as many again. Grown a value at a time, the store
     /// doubled and rehashed every value about fifteen times on the way.
-    pub(crate) fn reserve_even_grid(&self, trimmed: bool) {
-        let lines = if trimmed { 9 } else { 5 };
-        let want = (2 * lines * (4 * FINE + 1)).min(Self::MOST);
+    fn reserve_fine(&self, along_u: bool, probes: &[Probe<'_>], t0: f64, t1: f64) {
+        let mut made = self.2.get();
+        if made[usize::from(along_u)] || t1 <= t0 {
+            return;
+        }
+        made[usize::from(along_u)] = true;
+        self.2.set(made);
+        let values = |p: &Probe<'_>| -> f64 {
+            let Some(pieces) = &p.inside else { return (4 * FINE + 1) as f64 };
+            let share: f64 = pieces.iter().map(|&(lo, hi)| ((hi.min(t1) - lo.max(t0)) / (t1 - t0)).max(0.0)).sum();
+            share * (4 * FINE) as f64 + 2.0 * pieces.len() as f64
+        };
+        // Half as many again: the lines placed and the intervals split
+        // after it test points of their own.
+        let want: f64 = 1.5 * probes.iter().map(values).sum::<f64>();
         let mut kept = self.0.borrow_mut();
-        let more = want.saturating_sub(kept.len());
-        kept.reserve(more);
+        let room = Self::MOST.saturating_sub(kept.len());
+        kept.reserve((ceil(want) as usize).min(room));
     }
 
     /// How many values are kept.
@@ -87,13 +101,13 @@ impl Samples {
     /// How many times the store grew.
     #[cfg(test)]
     pub(crate) fn growths(&self) -> usize {
-        self.2.get()[0]
+        self.3.get()[0]
     }
 
     /// How many fine intervals' shapes were measured.
     #[cfg(test)]
     pub(crate) fn shapes_measured(&self) -> usize {
-        self.2.get()[1]
+        self.3.get()[1]
     }
 
     /// The shape of the fine interval `[a, b]` of the iso-line `line`
@@ -118,7 +132,7 @@ impl Samples {
         }
         let s = measure();
         #[cfg(test)]
-        self.2.set([self.2.get()[0], self.2.get()[1] + 1]);
+        self.3.set([self.3.get()[0], self.3.get()[1] + 1]);
         let mut kept = self.1.borrow_mut();
         if kept.len() < Self::MOST {
             kept.insert(key, s);
@@ -668,6 +682,9 @@ fn fine_params(t0: f64, t1: f64) -> Vec<f64> {
 /// [`Samples::shape_with`]) and judged within `lim`: the same demand,
 /// bit for bit, as [`interval_demand`] gives.
 fn fine_demand(probes: &[Probe<'_>], xs: &[f64], lim: &Limits) -> Vec<f64> {
+    if let (Some((kept, line)), Some(&t0), Some(&t1)) = (probes.first().and_then(|p| p.line), xs.first(), xs.last()) {
+        kept.reserve_fine(line[0] == 1, probes, t0, t1);
+    }
     xs.windows(2)
         .map(|w| {
             let mut need: f64 = 0.0;
