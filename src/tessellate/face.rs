@@ -738,6 +738,47 @@ mod tests {
         }
     }
 
+    /// The grid of an evenly parameterized surface (a rebuild) makes room
+    /// in its store for each direction's fine demand before keeping its
+    /// first value: no value is kept in a full store (each growth rehashed
+    /// every value kept).
+    #[test]
+    fn an_even_grid_sizes_its_samples_at_once() {
+        let s = wavy();
+        let [lo, hi] = s.domain();
+        let lim = Limits { tol: 1e-3, angle: 0.5, max_edge: f64::INFINITY, min_edge: 1e-6 };
+        let kept = Samples::default();
+        let g = grid((&s, &kept), lo, hi, &lim, None, usize::MAX);
+        assert!(kept.len() > 4000, "{} values", kept.len());
+        assert_eq!(kept.growths(), 0, "{} values kept", kept.len());
+        let (pu, pv) = g;
+        assert!(pu.len() > 2 && pv.len() > 2, "{} x {}", pu.len(), pv.len());
+    }
+
+    /// The trials of a rebuilt face place their grids within other
+    /// tolerance shares and edge limits on the same fine intervals: each
+    /// interval's shape is measured by the first grid only, and each grid
+    /// is the one fresh samples give.
+    #[test]
+    fn kept_shapes_serve_the_grids_of_other_limits() {
+        let s = wavy();
+        let [lo, hi] = s.domain();
+        let kept = Samples::default();
+        let lim = |tol: f64, max_edge: f64| Limits { tol, angle: 0.5, max_edge, min_edge: 1e-6 };
+        let first = lim(1e-3, f64::INFINITY);
+        assert_eq!(
+            grid((&s, &kept), lo, hi, &first, None, usize::MAX),
+            grid((&s, &Samples::default()), lo, hi, &first, None, usize::MAX)
+        );
+        let measured = kept.shapes_measured();
+        assert!(measured >= 2 * 5 * 256, "{measured} shapes measured");
+        for l in [lim(1e-3, 0.7), lim(8e-4, 0.3), lim(1e-2, f64::INFINITY), lim(3e-4, 2.0)] {
+            let fresh = grid((&s, &Samples::default()), lo, hi, &l, None, usize::MAX);
+            assert_eq!(grid((&s, &kept), lo, hi, &l, None, usize::MAX), fresh, "{l:?}");
+            assert_eq!(kept.shapes_measured(), measured, "{l:?}: measured again");
+        }
+    }
+
     /// A trial's cell limit (see [`grid`]): a grid within it is the grid
     /// without one, line for line; one far over it is cut short, still
     /// with more cells than the limit, so the caller's budget refuses it.

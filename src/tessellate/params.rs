@@ -26,31 +26,118 @@ use crate::nurbs::Surface;
 /// again gives the same bits without the evaluation. Kept for one surface
 /// only; past [`Samples::MOST`] values new ones are evaluated, not kept.
 #[derive(Default)]
-pub(crate) struct Samples(core::cell::RefCell<HashMap<[u64; 2], (DVec3, DVec3)>>);
+pub(crate) struct Samples(
+    core::cell::RefCell<HashMap<[u64; 2], (DVec3, DVec3)>>,
+    /// The fine intervals' shapes ([`Samples::shape_with`]).
+    core::cell::RefCell<HashMap<[u64; 7], Shape>>,
+    /// Whether room for a direction's fine demand was made, along u and v.
+    core::cell::Cell<[bool; 2]>,
+    /// Times a value was kept in a full store (it grew), and shapes
+    /// measured, for tests.
+    #[cfg(test)]
+    core::cell::Cell<[usize; 2]>,
+);
 
 impl Samples {
     /// Most values kept (about 70 bytes each).
     const MOST: usize = 1 << 20;
 
     /// The surface's point and unit normal at `uv`, evaluated once (by
-    /// `eval`, which gives the bits [`Surface::point_normal`] gives).
+    /// `eval`, which gives the bits [`Surface::point_normal`] gives and
+    /// must not read this store). The key is hashed and looked up once,
+    /// for the value and for the place a new one goes.
     fn point_normal_with(&self, uv: DVec2, eval: impl FnOnce() -> (DVec3, DVec3)) -> (DVec3, DVec3) {
         let key = [uv.x.to_bits(), uv.y.to_bits()];
-        if let Some(&x) = self.0.borrow().get(&key) {
-            return x;
-        }
-        let x = eval();
         let mut kept = self.0.borrow_mut();
-        if kept.len() < Self::MOST {
-            kept.insert(key, x);
+        let room = kept.len() < Self::MOST;
+        #[cfg(test)]
+        let full = kept.len() == kept.capacity();
+        match kept.entry(key) {
+            hashbrown::hash_map::Entry::Occupied(o) => *o.get(),
+            hashbrown::hash_map::Entry::Vacant(slot) => {
+                let x = eval();
+                if room {
+                    #[cfg(test)]
+                    self.3.set([self.3.get()[0] + usize::from(full), self.3.get()[1]]);
+                    slot.insert(x);
+                }
+                x
+            }
         }
-        x
+    }
+
+    /// Room for the values the fine demand along u (`along_u`) or v of an
+    /// evenly parameterized surface ([`fine_demand`]) evaluates on
+    /// `probes` over `[t0, t1]`, made once per direction before the first
+    /// is kept: each line's [`FINE`] intervals inside its pieces, tested
+    /// at their ends and quarter points, and half as many again. Grown a value at a time, the store
+    /// doubled and rehashed every value about fifteen times on the way.
+    fn reserve_fine(&self, along_u: bool, probes: &[Probe<'_>], t0: f64, t1: f64) {
+        let mut made = self.2.get();
+        if made[usize::from(along_u)] || t1 <= t0 {
+            return;
+        }
+        made[usize::from(along_u)] = true;
+        self.2.set(made);
+        let values = |p: &Probe<'_>| -> f64 {
+            let Some(pieces) = &p.inside else { return (4 * FINE + 1) as f64 };
+            let share: f64 = pieces.iter().map(|&(lo, hi)| ((hi.min(t1) - lo.max(t0)) / (t1 - t0)).max(0.0)).sum();
+            share * (4 * FINE) as f64 + 2.0 * pieces.len() as f64
+        };
+        // Half as many again: the lines placed and the intervals split
+        // after it test points of their own.
+        let want: f64 = 1.5 * probes.iter().map(values).sum::<f64>();
+        let mut kept = self.0.borrow_mut();
+        let room = Self::MOST.saturating_sub(kept.len());
+        kept.reserve((ceil(want) as usize).min(room));
     }
 
     /// How many values are kept.
     #[cfg(test)]
     pub(crate) fn len(&self) -> usize {
         self.0.borrow().len()
+    }
+
+    /// How many times the store grew.
+    #[cfg(test)]
+    pub(crate) fn growths(&self) -> usize {
+        self.3.get()[0]
+    }
+
+    /// How many fine intervals' shapes were measured.
+    #[cfg(test)]
+    pub(crate) fn shapes_measured(&self) -> usize {
+        self.3.get()[1]
+    }
+
+    /// The shape of the fine interval `[a, b]` of the iso-line `line`
+    /// (direction and fixed parameter) within the turn limit `angle` and
+    /// `side`, measured by `measure` once: the grid of every trial of a
+    /// rebuilt face (other tolerance shares and edge limits) sums the
+    /// demand of the same fine intervals, and what it measures of them
+    /// does not depend on those limits. `measure` must not use this store.
+    fn shape_with(
+        &self,
+        line: [u64; 2],
+        (a, b): (f64, f64),
+        angle: f64,
+        side: Side,
+        measure: impl FnOnce() -> Shape,
+    ) -> Shape {
+        let (lo, hi) = side.piece.map_or((u64::MAX, u64::MAX), |(lo, hi)| (lo.to_bits(), hi.to_bits()));
+        let one_sided = u64::from(side.one_sided) << 1;
+        let key = [line[0] | one_sided, line[1], a.to_bits(), b.to_bits(), lo, hi, angle.to_bits()];
+        if let Some(s) = self.1.borrow().get(&key) {
+            return *s;
+        }
+        let s = measure();
+        #[cfg(test)]
+        self.3.set([self.3.get()[0], self.3.get()[1] + 1]);
+        let mut kept = self.1.borrow_mut();
+        if kept.len() < Self::MOST {
+            kept.insert(key, s);
+        }
+        s
     }
 }
 
@@ -122,6 +209,29 @@ struct Side {
 
 /// [`interval_demand`] with the fold's part apart ([`Demand`]).
 fn demand_parts(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limits, side: Side) -> Demand {
+    judge(&shape(eval, a, b, lim.angle, side), lim)
+}
+
+/// What [`demand_parts`] measures of an interval, whatever the tolerance
+/// and edge limits: its chord's length, largest sag, the normal's turn
+/// (judged from inside where it turns more than `angle`, see [`shape`])
+/// and whether that turn is a fold, and for a turn by a trim border the
+/// nearer piece end's distance. A rebuild's trials test the same fine
+/// intervals within other limits ([`Samples::shape_with`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Shape {
+    len: f64,
+    sag: f64,
+    turn: f64,
+    /// The turn is past a right angle between neighbouring samples.
+    fold: bool,
+    /// Distance from the interval's nearer end to its piece's end, where
+    /// the turn is judged against a trim border; infinite elsewhere.
+    gap: f64,
+}
+
+/// [`Shape`] of `[a, b]` on `eval` with the turn limit `angle`.
+fn shape(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, angle: f64, side: Side) -> Shape {
     let one_sided = side.one_sided;
     let (pa, na) = eval(a);
     let (pb, nb) = eval(b);
@@ -141,7 +251,7 @@ fn demand_parts(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limi
     };
     let mut turn = turn_of(na, nb);
     let mut ends = (na, nb);
-    if one_sided && turn > lim.angle {
+    if one_sided && turn > angle {
         // On a crease (a C0 knot: a folded strip, a polyline's corner) an
         // end's own normal or tangent is the next piece's: the interval
         // turns by what it sees from inside, or it is split down to the
@@ -167,6 +277,21 @@ fn demand_parts(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limi
         let pairs = if one_sided { &n[..] } else { &n[1..4] };
         pairs.windows(2).any(|w| crate::math::angle_between(w[0], w[1]) > FOLD_TURN)
     };
+    let fold = turn > FOLD_TURN && sharp();
+    let mut gap = f64::INFINITY;
+    if !fold && turn > 0.0 && one_sided {
+        if let Some((lo, hi)) = side.piece {
+            let end_gap = |t: f64, p: DVec3, end: f64| if t == end { 0.0 } else { p.distance(eval(end).0) };
+            gap = end_gap(a, pa, lo).min(end_gap(b, pb, hi));
+        }
+    }
+    Shape { len, sag, turn, fold, gap }
+}
+
+/// The demand of an interval of shape `s` within `lim` (whose turn limit
+/// `s` was measured with).
+fn judge(s: &Shape, lim: &Limits) -> Demand {
+    let Shape { len, sag, turn, fold: folds, gap } = *s;
     if len <= lim.min_edge {
         return Demand { smooth: 0.0, fold: 0.0, sag };
     }
@@ -175,7 +300,7 @@ fn demand_parts(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limi
     if sag > 0.0 {
         demand = demand.max(sqrt(sag / lim.tol));
     }
-    if turn > FOLD_TURN && sharp() {
+    if folds {
         if len > lim.tol {
             fold = turn / lim.angle;
         }
@@ -187,11 +312,7 @@ fn demand_parts(eval: &dyn Fn(f64) -> (DVec3, DVec3), a: f64, b: f64, lim: &Limi
         // slivers between them and the border, whose facets fold on the
         // surface's bend along them.
         let floor = BEND_FLOOR * lim.tol;
-        let at_border = one_sided
-            && side.piece.is_some_and(|(lo, hi)| {
-                let gap = |t: f64, p: DVec3, end: f64| if t == end { 0.0 } else { p.distance(eval(end).0) };
-                gap(a, pa, lo).min(gap(b, pb, hi)) <= floor
-            });
+        let at_border = gap <= floor;
         let most = if at_border { len / floor } else { f64::INFINITY };
         demand = demand.max((turn / lim.angle).min(most));
     }
@@ -228,12 +349,15 @@ pub(crate) struct Probe<'e> {
     /// disagree (a surface's iso-lines across a crease). Trim curves are
     /// not: [`coarsen`] judges their runs by the ends' own tangents.
     pub one_sided: bool,
+    /// For an iso-line of a surface, where its fine intervals' shapes are
+    /// kept and the line's key there ([`Samples::shape_with`]).
+    pub line: Option<(&'e Samples, [u64; 2])>,
 }
 
 /// Each of `evals` as a probe tested over the whole interval, on both sides.
 #[cfg(feature = "std")]
 fn whole_curves<'e>(evals: &[&'e dyn Fn(f64) -> (DVec3, DVec3)]) -> Vec<Probe<'e>> {
-    evals.iter().map(|&eval| Probe { eval, inside: None, one_sided: false }).collect()
+    evals.iter().map(|&eval| Probe { eval, inside: None, one_sided: false, line: None }).collect()
 }
 
 /// Subdivides `[t0, t1]` (already split at `breaks`) until every interval passes
@@ -554,8 +678,29 @@ fn fine_params(t0: f64, t1: f64) -> Vec<f64> {
 }
 
 /// The fractional chord demand of each interval between `xs`.
+/// A probe's intervals are measured once per surface and turn limit (see
+/// [`Samples::shape_with`]) and judged within `lim`: the same demand,
+/// bit for bit, as [`interval_demand`] gives.
 fn fine_demand(probes: &[Probe<'_>], xs: &[f64], lim: &Limits) -> Vec<f64> {
-    xs.windows(2).map(|w| over_probes(probes, w[0], w[1], lim, interval_demand, 0.0).0).collect()
+    if let (Some((kept, line)), Some(&t0), Some(&t1)) = (probes.first().and_then(|p| p.line), xs.first(), xs.last()) {
+        kept.reserve_fine(line[0] == 1, probes, t0, t1);
+    }
+    xs.windows(2)
+        .map(|w| {
+            let mut need: f64 = 0.0;
+            each_part(probes, w[0], w[1], |p, x, y, side| {
+                let s = match p.line {
+                    Some((kept, line)) => {
+                        kept.shape_with(line, (x, y), lim.angle, side, || shape(p.eval, x, y, lim.angle, side))
+                    }
+                    None => shape(p.eval, x, y, lim.angle, side),
+                };
+                let d = judge(&s, lim);
+                need = need.max(d.smooth.max(d.fold));
+            });
+            need
+        })
+        .collect()
 }
 
 /// The iso-curves one direction is tested on: at `lines + 1` even steps of
@@ -598,7 +743,12 @@ fn with_probes<R>(
     let curves = iso_curves(surface, lo, hi, along_u, if region.is_some() { 8 } else { 4 });
     let probes: Vec<Probe<'_>> = curves
         .iter()
-        .map(|(s, c)| Probe { eval: c, inside: region.map(|r| r(along_u, *s)), one_sided: true })
+        .map(|(s, c)| Probe {
+            eval: c,
+            inside: region.map(|r| r(along_u, *s)),
+            one_sided: true,
+            line: Some((surface.1, [u64::from(along_u), s.to_bits()])),
+        })
         .collect();
     f(&probes)
 }
@@ -758,7 +908,7 @@ mod tests {
             let s = ((t - fold) / 1e-6).clamp(-1.0, 1.0);
             (p, DVec3::new((1.0 - s * s).sqrt(), 0.0, -s).normalize())
         };
-        let probes = [Probe { eval: &pleat, inside: None, one_sided: true }];
+        let probes = [Probe { eval: &pleat, inside: None, one_sided: true, line: None }];
         let l = lim(0.05);
         let (ts, _) = subdivide_probes(&probes, &[0.0, 0.5, 1.0], &l, MAX_PARAMS);
         assert!(ts.len() < 40, "{} lines: {ts:?}", ts.len());
@@ -779,7 +929,7 @@ mod tests {
             let a = core::f64::consts::PI * t;
             (DVec3::new(a.cos(), a.sin(), 0.0), DVec3::new(a.cos(), a.sin(), 0.0))
         };
-        let probes = [Probe { eval: &bend, inside: None, one_sided: true }];
+        let probes = [Probe { eval: &bend, inside: None, one_sided: true, line: None }];
         let (ts, _) = subdivide_probes(&probes, &[0.0, 1.0], &l, MAX_PARAMS);
         let steps: Vec<f64> = ts.windows(2).map(|w| w[1] - w[0]).collect();
         assert!(steps.iter().all(|d| (d - steps[0]).abs() < 1e-12), "{ts:?}");
@@ -803,12 +953,12 @@ mod tests {
         let l = lim(0.05);
         let floor = BEND_FLOOR * l.tol;
         let (edge, border) = (curl_at(0.9985), 0.9995);
-        let probes = [Probe { eval: &edge, inside: Some(alloc::vec![(0.0, border)]), one_sided: true }];
+        let probes = [Probe { eval: &edge, inside: Some(alloc::vec![(0.0, border)]), one_sided: true, line: None }];
         let (ts, _) = subdivide_probes(&probes, &[0.0, 1.0], &l, MAX_PARAMS);
         let packed = ts.iter().filter(|&&t| t < border && border - t < 0.5 * floor).count();
         assert!(packed == 0, "{packed} lines within {} of the border: {ts:?}", 0.5 * floor);
         let inner = curl_at(0.5);
-        let probes = [Probe { eval: &inner, inside: Some(alloc::vec![(0.0, border)]), one_sided: true }];
+        let probes = [Probe { eval: &inner, inside: Some(alloc::vec![(0.0, border)]), one_sided: true, line: None }];
         let (ts, _) = subdivide_probes(&probes, &[0.0, 1.0], &l, MAX_PARAMS);
         let across = ts.iter().filter(|&&t| (0.5..=0.502).contains(&t)).count();
         assert!(across >= 2, "{ts:?}");
@@ -825,7 +975,7 @@ mod tests {
             let d = DVec3::new(3.0, 0.0, -6.0 * (1.0 - t) * (1.0 - t)).normalize();
             (p, DVec3::new(-d.z, 0.0, d.x))
         };
-        let probes = [Probe { eval: &curve, inside: None, one_sided: false }];
+        let probes = [Probe { eval: &curve, inside: None, one_sided: false, line: None }];
         let l = lim(1e-3);
         let (even, _) = equidistribute(&probes, 0.0, 1.0, &l, MAX_PARAMS, None);
         let breaks: Vec<f64> = (0..=16).map(|k| k as f64 / 16.0).collect();
