@@ -190,7 +190,8 @@ impl WorkMesh {
         self.add_triangle([r, a, x], [ur, ua, uv]);
         self.measure_slots();
         self.measures[t as usize] = STALE;
-        let good = [t, t2, t2 + 1].iter().all(|&y| self.holds(surface, c, y, sense));
+        let good = [t, t2, t2 + 1].iter().all(|&y| self.faces_right(surface, y, sense))
+            && [t, t2, t2 + 1].iter().all(|&y| self.holds(surface, c, y, sense));
         if good {
             return Some(alloc::vec![(t, a, b), (t2, b, r), (t2 + 1, r, a)]);
         }

@@ -503,3 +503,20 @@ fn carried_measures_stand_in_for_measuring() {
     over.refine(&s, &[], &Criteria { max_edge: f64::INFINITY, ..c }, 100_000);
     assert!(over.tris.len() > grid().tris.len(), "{} triangles", over.tris.len());
 }
+
+/// A changed triangle turned over in (u,v) fails the mending checks on its
+/// orientation alone: nothing is measured against the surface for it (a
+/// fuzzed face folded all over spent most of its time measuring such
+/// candidates before their orientation ruled them out).
+#[test]
+fn a_triangle_turned_over_is_ruled_out_before_it_is_measured() {
+    let s = plane();
+    let counted = Counted::new(&s);
+    let m = grid();
+    let c = Criteria { tol: 0.1, angle: 0.5, max_edge: 100.0, min_edge: 0.0, steps: 2, lift: Lift::default() };
+    // Triangle 0 runs counter-clockwise in (u,v): the opposite sense rules it out.
+    assert!(!m.holds(&counted, &c, 0, -1.0));
+    assert_eq!(counted.total(), 0, "{} evaluations", counted.total());
+    assert!(m.holds(&counted, &c, 0, 1.0), "the right way round it holds");
+    assert!(counted.total() > 0, "and is measured");
+}
