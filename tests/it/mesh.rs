@@ -820,6 +820,23 @@ fn mesh_warns_when_a_grid_direction_reaches_its_cap() {
     assert_eq!(r.report.faces_skipped, 1, "{:?}", r.report.warnings);
 }
 
+/// A tube whose wall (0.2) is thinner than the sewing distance at 2e-2
+/// and 4e-2, each skin a cylinder split into two halves at one seam: the
+/// outer seam's nodes are one with the outer halves', the inner's with the
+/// inner halves', and the two pairs lie off each other along the normals.
+/// Joined, the seam edges each had four triangles.
+#[test]
+fn mesh_thin_tube_keeps_its_two_skins_seams_apart() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/thin_tube_halves.json");
+    let model = surfmesh::read_json(&std::fs::read(path).unwrap()).unwrap();
+    for rel in [2e-2, 4e-2] {
+        let rep = mesh(&model, rel).report;
+        assert!(rep.max_deviation <= rep.tolerance, "@ {rel}: deviation {} > {}", rep.max_deviation, rep.tolerance);
+        let edges = (rep.free_edges, rep.nonmanifold_edges, rep.inverted_triangles);
+        assert_eq!(edges, (0, 0, 0), "@ {rel}: cracks, non-manifold edges, inverted triangles");
+    }
+}
+
 /// Two domes 0.5 apart (a wall thinner than the sewing distance at 1e-2,
 /// 0.72) closed by a rim at their equators: their seams run side by side.
 /// A seam's inner nodes are no border another face meets, so the seams

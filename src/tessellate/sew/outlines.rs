@@ -19,6 +19,9 @@ const PAIR_MIN: usize = 3;
 /// faces lie along them: a gap of the model's, as the sewing closes gaps
 /// below an eighth of its distance whatever the rest of the model needs.
 const GAP: f64 = 0.125;
+/// Least |cos| between a node pair's offset and both nodes' surface
+/// normals for the two to be layers of a wall (see [`Clusters::layers`]).
+const LAYER_COS: f64 = 0.9;
 
 /// A node of some face's outline: face, loop, index.
 pub(super) type NodeRef = (u32, u32, u32);
@@ -597,6 +600,9 @@ struct Clusters<'n> {
     /// Per node, whether its face lies all around it ([`Inside`]): it is
     /// never one with another face's node. Empty: none is.
     inside: Vec<bool>,
+    /// Per node, its face's unit surface normal there, where a pair of
+    /// faces wider apart than `tight` may need it (zero: unknown).
+    normal: Vec<DVec3>,
 }
 
 impl<'n> Clusters<'n> {
@@ -611,6 +617,7 @@ impl<'n> Clusters<'n> {
             tight,
             apart: crate::collections::HashSet::default(),
             inside: Vec::new(),
+            normal: Vec::new(),
         }
     }
 
@@ -663,6 +670,9 @@ impl<'n> Clusters<'n> {
         if x == y {
             return;
         }
+        if self.layers(a, b, x, y) {
+            return;
+        }
         let tight = self.tight;
         let clash = self.member_ids(x).any(|i| {
             let (f, p, rp) = self.node(i);
@@ -675,6 +685,32 @@ impl<'n> Clusters<'n> {
             return;
         }
         self.merge(x, y);
+    }
+
+    /// Whether joining nodes `a` and `b` (clusters with roots `x` and `y`)
+    /// would fold two layers of a wall thinner than the sewing distance
+    /// into one: each cluster is a join of two faces already, and `b` lies
+    /// off `a` along both their normals, not beside it. The two sheets
+    /// (a tube's outer and inner skins, each split at one seam) would
+    /// otherwise share their seams' edges four ways.
+    fn layers(&self, a: u32, b: u32, x: u32, y: u32) -> bool {
+        let normal = |i: u32| self.normal.get(i as usize).copied().unwrap_or(DVec3::ZERO);
+        let (na, nb) = (normal(a), normal(b));
+        let (pa, pb) = (self.nodes[a as usize].1, self.nodes[b as usize].1);
+        let d = pb - pa;
+        let len = d.length();
+        if na == DVec3::ZERO || nb == DVec3::ZERO || len <= self.tight || len <= TINY {
+            return false;
+        }
+        let dir = d / len;
+        if na.dot(dir).abs() < LAYER_COS || nb.dot(dir).abs() < LAYER_COS {
+            return false;
+        }
+        let two_faces = |r: u32| {
+            let f = self.nodes[r as usize].0;
+            self.member_ids(r).any(|i| self.nodes[i as usize].0 != f)
+        };
+        two_faces(x) && two_faces(y)
     }
 
     /// Joins the lone node `a` to the cluster of `b`, its neighbour a
@@ -795,6 +831,7 @@ fn name_nodes(
     cl.inside = Inside::new(faces, &pos, tight).node.into_iter().flatten().flatten().collect();
     let pairs = if sew > 0.0 { cl.near_pairs(bodies, sew) } else { Vec::new() };
     cl.apart = folds_across(faces, bodies, &pos, &index, &r_flat, &pairs, sew, tight);
+    cl.normal = pair_normals(faces, &index, &flat, &pairs, tight);
     // Twins first (they are one node by construction), then neighbours by distance.
     let id_of = |n: NodeRef, index: &PerNode<u32>| index[n.0 as usize][n.1 as usize].get(n.2 as usize).copied();
     for &(n, q) in twins {
@@ -875,6 +912,41 @@ fn folds_across(
     let reach_of = |n: NodeRef| reach[index[n.0 as usize][n.1 as usize][n.2 as usize] as usize];
     let across = super::across::between(faces, bodies, pos, &nodes, &probes, &reach_of, sew, tight);
     one_face.iter().zip(across.chunks(2)).filter(|(_, x)| x.iter().any(|&x| x)).map(|(&pr, _)| pr).collect()
+}
+
+/// Per node of `flat`, its face's unit surface normal where it is in one
+/// of the `pairs` of two faces farther apart than `tight` (zero elsewhere):
+/// what [`Clusters::layers`] reads.
+fn pair_normals(
+    faces: &[Option<(&dyn Surface, &mut Outline<'_>)>],
+    index: &PerNode<u32>,
+    flat: &[(u32, DVec3)],
+    pairs: &[(f64, u32, u32)],
+    tight: f64,
+) -> Vec<DVec3> {
+    let mut wanted = alloc::vec![false; flat.len()];
+    for &(d, a, b) in pairs {
+        if d > tight && flat[a as usize].0 != flat[b as usize].0 {
+            wanted[a as usize] = true;
+            wanted[b as usize] = true;
+        }
+    }
+    let mut normal = alloc::vec![DVec3::ZERO; flat.len()];
+    if !wanted.contains(&true) {
+        return normal;
+    }
+    for (item, per_loop) in faces.iter().zip(index) {
+        let Some((s, o)) = item else { continue };
+        for (poly, ids) in o.loops.polys.iter().zip(per_loop) {
+            for (&uv, &x) in poly.uv.iter().zip(ids) {
+                if wanted.get(x as usize).copied().unwrap_or(false) {
+                    let n = s.normal(uv);
+                    normal[x as usize] = if n.is_finite() { n.normalize_or_zero() } else { DVec3::ZERO };
+                }
+            }
+        }
+    }
+    normal
 }
 
 /// Every outline node in one list: its face and place, where each node
