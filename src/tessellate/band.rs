@@ -115,7 +115,8 @@ impl Band {
         }
         for &(a, b, curve, ta, tb) in &self.segs {
             let whole = wm.edge_triangles(vid[a], vid[b]) > 0 || self.added_from == self.nodes.len();
-            let pieces = if whole { alloc::vec![(a, b, 0.0, 1.0)] } else { self.pieces(a, b) };
+            let joined = |x: usize, y: usize| wm.edge_triangles(vid[x], vid[y]) > 0;
+            let pieces = if whole { alloc::vec![(a, b, 0.0, 1.0)] } else { self.pieces(a, b, joined) };
             for (x, y, fx, fy) in pieces {
                 let (vx, vy) = (vid[x], vid[y]);
                 if vx != vy && wm.edge_triangles(vx, vy) == 1 {
@@ -128,8 +129,11 @@ impl Band {
     /// Loop segment `a-b` as the triangulation keeps it: whole, or in pieces
     /// where it split the segment at crossings it added (nodes past the
     /// loops'), each piece with its ends' fractions along the segment, so
-    /// that every piece is marked a trim edge.
-    fn pieces(&self, a: usize, b: usize) -> Vec<(usize, usize, f64, f64)> {
+    /// that every piece is marked a trim edge. A crossing of two nearly
+    /// parallel segments is computed far less exactly across them than
+    /// along: nodes within 10⁻⁶ of the segment's length count, taken in
+    /// order along it where the triangulation `joined` them to the last.
+    fn pieces(&self, a: usize, b: usize, joined: impl Fn(usize, usize) -> bool) -> Vec<(usize, usize, f64, f64)> {
         let added = self.nodes.get(self.added_from..).unwrap_or(&[]);
         let (pa, pb) = (self.nodes[a], self.nodes[b]);
         let d = pb - pa;
@@ -138,8 +142,7 @@ impl Band {
         if len2 > 0.0 {
             for (k, &q) in added.iter().enumerate() {
                 let f = (q - pa).dot(d) / len2;
-                // On the segment within rounding of the crossing's computation.
-                if f > 0.0 && f < 1.0 && (pa + d * f).distance_squared(q) <= 1e-18 * len2 {
+                if f > 0.0 && f < 1.0 && (pa + d * f).distance_squared(q) <= 1e-12 * len2 {
                     cuts.push((f, self.added_from + k));
                 }
             }
@@ -148,8 +151,10 @@ impl Band {
         let mut out = Vec::with_capacity(cuts.len() + 1);
         let (mut prev, mut fp) = (a, 0.0);
         for (f, k) in cuts {
-            out.push((prev, k, fp, f));
-            (prev, fp) = (k, f);
+            if joined(prev, k) {
+                out.push((prev, k, fp, f));
+                (prev, fp) = (k, f);
+            }
         }
         out.push((prev, b, fp, 1.0));
         out
