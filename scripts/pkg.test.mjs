@@ -116,8 +116,11 @@ test('a fresh module holds its 256 KiB stack, not the default 1 MiB, before its 
 // resettling of a sliver's nodes and the inner corner's move for a border
 // split, the fit check its borrowed steps, and sewing a bound on halving
 // crossing chords: 657,720 bytes, 655,216 once a list-of-lists sort they
-// brought went through the shared triple sort.
-const VIEWER_GZIP_BUDGET = 660_000;
+// brought went through the shared triple sort. Raised again when the
+// edge census learned faces' borders, sewing kept a thin wall's skins
+// apart, the trim crossing grid nested crowded cells and rebuilt faces kept
+// their grid samples: 663,835 bytes.
+const VIEWER_GZIP_BUDGET = 667_000;
 
 test('the viewer module stays within its gzip -9 budget', () => {
   const wasm = readFileSync(join(pkg, 'node', 'surfmesh_bg.wasm'));
