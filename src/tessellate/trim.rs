@@ -58,25 +58,39 @@ impl Polyline {
     /// `i`, one per segment. Splitting one by one moves the nodes after
     /// each, which costs a loop of n nodes n moves per split.
     pub fn split_segments(&mut self, splits: &[(usize, f64, DVec2)]) {
-        let n = self.uv.len();
-        let mut uv = Vec::with_capacity(n + splits.len());
-        let mut at = Vec::with_capacity(n + splits.len());
-        let mut seg = Vec::with_capacity(n + splits.len());
-        let mut next = splits.iter().peekable();
-        for (i, ((&q, &r), &(curve, ta, tb))) in self.uv.iter().zip(&self.at).zip(&self.seg).enumerate() {
-            uv.push(q);
-            at.push(r);
-            match next.next_if(|s| s.0 == i) {
-                Some(&(_, t, m)) => {
-                    seg.extend([(curve, ta, t), (curve, t, tb)]);
-                    uv.push(m);
-                    at.push(CurveRef { curve, t });
-                }
-                None => seg.push((curve, ta, tb)),
-            }
+        let mut tails = Vec::with_capacity(splits.len());
+        let mut nodes = Vec::with_capacity(splits.len());
+        let mut refs = Vec::with_capacity(splits.len());
+        for &(i, t, q) in splits {
+            let Some(s) = self.seg.get_mut(i) else { continue };
+            let (curve, _, tb) = *s;
+            s.2 = t;
+            tails.push((i, (curve, t, tb)));
+            nodes.push((i, q));
+            refs.push((i, CurveRef { curve, t }));
         }
-        (self.uv, self.at, self.seg) = (uv, at, seg);
+        insert_after(&mut self.seg, &tails);
+        insert_after(&mut self.uv, &nodes);
+        insert_after(&mut self.at, &refs);
     }
+}
+
+/// Inserts each `(i, x)` of `adds` (by rising `i`, one per `i`) right after
+/// item `i` of `v`, in one pass: inserting one by one moves every later item
+/// each time.
+pub(crate) fn insert_after<T: Copy>(v: &mut Vec<T>, adds: &[(usize, T)]) {
+    if adds.is_empty() {
+        return;
+    }
+    let mut out = Vec::with_capacity(v.len() + adds.len());
+    let mut next = adds.iter().peekable();
+    for (i, &x) in v.iter().enumerate() {
+        out.push(x);
+        if let Some(&(_, a)) = next.next_if(|a| a.0 == i) {
+            out.push(a);
+        }
+    }
+    *v = out;
 }
 
 /// All loops of one face, discretized and oriented: outer counter-clockwise
@@ -679,7 +693,7 @@ fn near_pairs(segs: &[Seg], bounds: (DVec2, DVec2), mut visit: impl FnMut(&Seg, 
     let all: Vec<u32> = (0..segs.len() as u32).collect();
     let side = (crate::math::sqrt(segs.len() as f64) as usize).clamp(1, 512);
     let grid = Grid::new(segs, &all, bounds, (side, side), usize::MAX, usize::MAX);
-    grid.is_some_and(|g| g.pairs(segs, 0, &mut visit))
+    grid.is_some_and(|g| g.pairs(segs, &all, 0, &mut visit))
 }
 
 /// Most segments a cell holds before it is gridded again: a quadratic
@@ -700,8 +714,6 @@ struct Grid {
     buckets: Vec<Vec<u32>>,
     /// Segments each compared with every other of the grid instead.
     long: Vec<u32>,
-    /// All the grid's segments, when some are long.
-    all: Vec<u32>,
 }
 
 impl Grid {
@@ -743,8 +755,7 @@ impl Grid {
                 }
             }
         }
-        let all = if long.is_empty() { Vec::new() } else { idx.to_vec() };
-        Some(Grid { cells: (nx, ny), lo, size, buckets, long, all })
+        Some(Grid { cells: (nx, ny), lo, size, buckets, long })
     }
 
     /// A finer grid for the crowded `bucket` of cell `c`, over the part of
@@ -772,12 +783,13 @@ impl Grid {
         (pairs <= n * n / 8).then_some(g)
     }
 
-    /// [`near_pairs`] over this grid's cells, `depth` grids deep.
-    fn pairs(&self, segs: &[Seg], depth: usize, visit: &mut impl FnMut(&Seg, &Seg) -> bool) -> bool {
+    /// [`near_pairs`] over this grid's cells, `depth` grids deep; `idx` are
+    /// the segments it was built from.
+    fn pairs(&self, segs: &[Seg], idx: &[u32], depth: usize, visit: &mut impl FnMut(&Seg, &Seg) -> bool) -> bool {
         // A long segment against every other, once per pair of long ones
         // (`long` rises, as the indices it was filed from do).
         for &i in &self.long {
-            for &j in &self.all {
+            for &j in idx {
                 let earlier_long = j < i && self.long.binary_search(&j).is_ok();
                 if j != i && !earlier_long && visit(&segs[i as usize], &segs[j as usize]) {
                     return true;
@@ -787,7 +799,7 @@ impl Grid {
         for (c, bucket) in self.buckets.iter().enumerate() {
             if bucket.len() > CROWDED && depth < MAX_NESTING {
                 if let Some(g) = self.finer(segs, c, bucket) {
-                    if g.pairs(segs, depth + 1, visit) {
+                    if g.pairs(segs, bucket, depth + 1, visit) {
                         return true;
                     }
                     continue;

@@ -22,7 +22,7 @@ use super::nearest_fraction;
 use crate::collections::{HashMap, HashSet};
 use crate::nurbs::Surface;
 use crate::tessellate::face::Outline;
-use crate::tessellate::trim::{bulge_crossings, crossings};
+use crate::tessellate::trim::{bulge_crossings, crossings, insert_after};
 
 /// Most rounds of halving; curves that really cross stay crossing after it.
 const MAX_ROUNDS: usize = 16;
@@ -184,15 +184,7 @@ fn cut_face(surface: &dyn Surface, o: &mut Outline<'_>, cuts: &[((u32, u32), DVe
             continue;
         }
         poly.split_segments(&splits);
-        let mut added = ids.iter().peekable();
-        let mut new_ids = Vec::with_capacity(n + ids.len());
-        for (i, &g) in gids.iter().enumerate() {
-            new_ids.push(g);
-            if let Some(&(_, id)) = added.next_if(|a| a.0 == i) {
-                new_ids.push(id);
-            }
-        }
-        *gids = new_ids;
+        insert_after(gids, &ids);
     }
 }
 
