@@ -14,6 +14,8 @@ pub(crate) mod elevate;
 mod error;
 pub(crate) mod join;
 mod knots;
+#[cfg(any(test, all(target_arch = "wasm32", target_feature = "simd128")))]
+mod pairs;
 mod project;
 pub(crate) mod reparam;
 pub(crate) mod seam;

@@ -355,10 +355,16 @@ impl NurbsSurface {
         order: usize,
     ) -> [[DVec4; 3]; 3] {
         let (first, bu, bv) = self.bases::<NU, NV>(p, q, uv, order);
+        // With wasm's SIMD the two passes pair up each point's lanes.
+        #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+        {
+            super::pairs::contract::<NU, NV>(&self.points, self.kv.control_count(), first, (p, q), &bu, &bv, order)
+        }
         // The same bits either way. In wasm the engine keeps the one pass's
         // nine accumulators in memory, and measured in Node it meshed
         // bicubics 13% slower (bug28366_fuselage) and high degrees no faster
         // (BUC50025) than the two passes, which stay there.
+        #[cfg(not(all(target_arch = "wasm32", target_feature = "simd128")))]
         if cfg!(target_arch = "wasm32") {
             sum_v(&self.contract_u::<NU, NV>(first, p, q, &bu, order), &bv, q, order)
         } else {
@@ -391,6 +397,7 @@ impl NurbsSurface {
     /// back. Every sum has the same terms in the same order (over `r`, then
     /// over `s`, each from zero), so the values are the same bits.
     #[inline(always)]
+    #[cfg_attr(all(target_arch = "wasm32", target_feature = "simd128"), allow(dead_code))]
     fn contract<const NU: usize, const NV: usize>(
         &self,
         first: usize,
@@ -515,6 +522,20 @@ impl NurbsSurface {
     ) -> [[DVec4; 3]; 3] {
         let (first, bu, bv) = self.bases::<NU, NV>(p, q, uv, order);
         sum_v(&self.contract_u::<NU, NV>(first, p, q, &bu, order), &bv, q, order)
+    }
+
+    /// [`NurbsSurface::homogeneous_derivs`] as wasm's paired lanes sum it
+    /// ([`super::pairs::contract`]), here with plain pairs of numbers.
+    #[cfg(test)]
+    fn derivs_by_pairs<const NU: usize, const NV: usize>(
+        &self,
+        p: usize,
+        q: usize,
+        uv: DVec2,
+        order: usize,
+    ) -> [[DVec4; 3]; 3] {
+        let (first, bu, bv) = self.bases::<NU, NV>(p, q, uv, order);
+        super::pairs::contract::<NU, NV>(&self.points, self.kv.control_count(), first, (p, q), &bu, &bv, order)
     }
 
     /// Inserts knot `t` once along u (`along_u`) or v; same shape.
@@ -841,6 +862,30 @@ mod tests {
                             bits(want),
                             "({p},{q}) at {uv} order {order}"
                         );
+                    }
+                }
+            }
+        }
+    }
+
+    /// The sums wasm forms two lanes at a time are bit for bit the two
+    /// passes, for every scratch size and order, at knots, inside slivers and
+    /// outside the domain: the lanes only pair operations, never reorder them.
+    #[test]
+    fn paired_sums_equal_two_passes_bitwise() {
+        let ts = [-0.1, 0.0, 0.1, 0.2, 0.3, 0.3 + 5e-18, 0.31, 0.45, 0.5, 0.551, 0.7, 0.9999, 1.0, 1.2];
+        let bits = |a: [[DVec4; 3]; 3]| a.map(|r| r.map(|h| h.to_array().map(f64::to_bits)));
+        for (p, q) in
+            [(1, 1), (1, 2), (2, 1), (2, 2), (3, 3), (1, 3), (3, 2), (2, 4), (5, 5), (7, 7), (1, 8), (8, 11), (4, 13)]
+        {
+            let s = wavy(p, q);
+            for &u in &ts {
+                for &v in &ts {
+                    let uv = DVec2::new(u, v);
+                    for order in 0..=2 {
+                        let want = by_scratch_size!(s, derivs_by_rows(uv, order));
+                        let got = by_scratch_size!(s, derivs_by_pairs(uv, order));
+                        assert_eq!(bits(got), bits(want), "({p},{q}) at {uv} order {order}");
                     }
                 }
             }
