@@ -20,9 +20,19 @@ import { readFileSync } from 'node:fs';
 const SLOW_MS = 10_000;
 const SLOWER = 1.5;
 
-const REGENERATE =
-  'cargo build --release --bin surfmesh && target/release/surfmesh check ../shared/corpus-wide ' +
-  '--tol-rel 1e-2 --timeout 60 --json tests/baseline/corpus-wide-1e-2.json';
+/**
+ * The command that writes baseline `path` again, from the folder and the
+ * tolerance its sweep records ("relative 0.01" or "absolute 0.5").
+ */
+export function regenerateCommand(path, sweep) {
+  const [kind, value] = String(sweep.tolerance).split(' ');
+  const tol = kind === 'absolute' ? `--tol ${value}` : `--tol-rel ${value}`;
+  const units = sweep.units && sweep.units !== 'file' ? ` --units ${sweep.units}` : '';
+  return (
+    `cargo build --release --bin surfmesh && target/release/surfmesh check ${sweep.dir} ` +
+    `${tol}${units} --timeout 60 --json ${path}`
+  );
+}
 
 function load(path) {
   try {
@@ -126,7 +136,7 @@ function main(argv) {
   }
   console.log(
     `\n${worse.length ? 'check-baseline: worse than the baseline' : 'check-baseline: nothing worse than the baseline'}` +
-      `${better.length || added.length ? '; to take the improvements as the new baseline' : '; to regenerate the baseline'}:\n  ${REGENERATE}`,
+      `${better.length || added.length ? '; to take the improvements as the new baseline' : '; to regenerate the baseline'}:\n  ${regenerateCommand(argv[0], base)}`,
   );
   process.exit(worse.length ? 1 : 0);
 }

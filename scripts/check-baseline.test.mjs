@@ -12,7 +12,7 @@ import { dirname, join } from 'node:path';
 import { test } from 'node:test';
 import { fileURLToPath } from 'node:url';
 
-import { compareRows } from './check-baseline.mjs';
+import { compareRows, regenerateCommand } from './check-baseline.mjs';
 
 const script = join(dirname(fileURLToPath(import.meta.url)), 'check-baseline.mjs');
 
@@ -78,7 +78,8 @@ test('the command fails on a worse file or a missing one, and passes otherwise',
     assert.equal(same.status, 0, same.stdout + same.stderr);
     assert.match(same.stdout, /improved \(1\):\n {2}b\.igs: cracks 3 -> 1/);
     assert.match(same.stdout, /not in the baseline \(1\):\n {2}new\.stp: meshes/);
-    assert.match(same.stdout, /surfmesh check \.\.\/shared\/corpus-wide --tol-rel 1e-2/);
+    // How to take them: the baseline's own folder, tolerance and path.
+    assert.ok(same.stdout.includes(`surfmesh check x --tol-rel 0.01 --timeout 60 --json ${base}`), same.stdout);
     const worse = run(write('worse.json', [row({ cracks: 5 })]));
     assert.equal(worse.status, 1);
     assert.match(worse.stdout, /WORSE \(2\):\n {2}a\.stp: cracks 0 -> 5\n {2}b\.igs: in the baseline, not in the sweep/);
@@ -88,4 +89,15 @@ test('the command fails on a worse file or a missing one, and passes otherwise',
   } finally {
     rmSync(dir, { recursive: true, force: true });
   }
+});
+
+test('the command to regenerate a baseline names its own folder, tolerance and file', () => {
+  const rel = regenerateCommand('tests/baseline/corpus-3e-3.json', {
+    dir: '../shared/corpus',
+    tolerance: 'relative 0.003',
+    units: 'file',
+  });
+  assert.match(rel, / check \.\.\/shared\/corpus --tol-rel 0\.003 --timeout 60 --json tests\/baseline\/corpus-3e-3\.json$/);
+  const abs = regenerateCommand('b.json', { dir: 'parts', tolerance: 'absolute 0.5', units: 'mm' });
+  assert.match(abs, / check parts --tol 0\.5 --units mm --timeout 60 --json b\.json$/);
 });
