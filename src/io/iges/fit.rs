@@ -10,7 +10,6 @@ use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 
 use super::surfaces::{AxisMap, SurfDef};
-use crate::model::FaceSurface;
 use crate::numeric::TINY;
 use crate::nurbs::reparam::{map_points, segment};
 use crate::nurbs::{NurbsCurve, Surface};
@@ -236,7 +235,7 @@ impl Track {
     pub fn fit(
         &mut self,
         def: &SurfDef,
-        surface: &FaceSurface,
+        surface: &dyn Surface,
         maps: &[AxisMap; 2],
         periods: [Option<f64>; 2],
         tol: f64,
@@ -245,11 +244,45 @@ impl Track {
             return (Some(c), true);
         }
         let map = |q: DVec2| DVec2::new(maps[0].apply(q.x), maps[1].apply(q.y));
-        let mut met = false;
+        let mut points = Vec::new();
+        let met = self.refine(def, surface, &map, periods, tol, &mut points);
+        let mut ws: Vec<DVec2> = self.qs.iter().map(|&q| map(q)).collect();
+        let mut ts = self.ts.clone();
+        if met {
+            (ts, ws) = coarsen(ts, ws, points, surface, 0.5 * tol);
+        }
+        let ms = tangents(&ts, &ws);
+        let [lo, hi] = surface.domain();
+        (hermite_curve(&ts, &ws, &ms, lo, hi), met)
+    }
+
+    /// Adds samples at the midpoints of the intervals where the cubic
+    /// through the samples strays more than `tol` from the surface, round
+    /// after round (24 at most); whether it ends within `tol`.
+    ///
+    /// Each evaluation is made once: `points[i]` is the surface's point at
+    /// sample `i` (left `None` until needed, kept for [`coarsen`]), and an
+    /// interval's [`Mid`] is kept until the interval is split, as projecting
+    /// its midpoint again from the same hint gives the same result, and the
+    /// same cubic midpoint the same distance. The kept midpoints are dropped
+    /// if a projection gives up the global retry, which changes what
+    /// projecting them again gives.
+    fn refine(
+        &mut self,
+        def: &SurfDef,
+        surface: &dyn Surface,
+        map: &impl Fn(DVec2) -> DVec2,
+        periods: [Option<f64>; 2],
+        tol: f64,
+        points: &mut Vec<Option<DVec3>>,
+    ) -> bool {
+        *points = alloc::vec![None; self.ts.len()];
+        let mut mids: Vec<Option<Mid>> = alloc::vec![None; self.ts.len().saturating_sub(1)];
+        let mut mids_retry = self.retry;
         for _ in 0..24 {
             let ws: Vec<DVec2> = self.qs.iter().map(|&q| map(q)).collect();
             let ms = tangents(&self.ts, &ws);
-            let mut add: Vec<(usize, f64, DVec2)> = Vec::new();
+            let mut add: Vec<(usize, f64, DVec2, DVec3)> = Vec::new();
             for i in 0..self.ts.len().saturating_sub(1) {
                 let (t0, t1) = (self.ts[i], self.ts[i + 1]);
                 let h = t1 - t0;
@@ -257,37 +290,52 @@ impl Track {
                     continue;
                 }
                 // Below this chord the samples resolve the file's own noise, not the curve.
-                if surface.point(ws[i]).distance(surface.point(ws[i + 1])) < 16.0 * tol {
+                let a = *points[i].get_or_insert_with(|| surface.point(ws[i]));
+                let b = *points[i + 1].get_or_insert_with(|| surface.point(ws[i + 1]));
+                if a.distance(b) < 16.0 * tol {
                     continue;
                 }
+                if self.retry != mids_retry {
+                    mids.fill(None);
+                    mids_retry = self.retry;
+                }
                 let tm = 0.5 * (t0 + t1);
-                let (qm, _) = self.at(def, tm, Some(0.5 * (self.qs[i] + self.qs[i + 1])), periods);
-                let exact = surface.point(map(qm));
+                let mid = match &mut mids[i] {
+                    Some(m) => m,
+                    slot => {
+                        let (q, _) = self.at(def, tm, Some(0.5 * (self.qs[i] + self.qs[i + 1])), periods);
+                        slot.insert(Mid { q, exact: surface.point(map(q)), checked: None })
+                    }
+                };
                 let hm = (ws[i] + ws[i + 1]) * 0.5 + (ms[i] - ms[i + 1]) * (h / 8.0);
-                if surface.point(hm).distance(exact) > tol {
-                    add.push((i, tm, qm));
+                let off = match mid.checked {
+                    Some((at, off)) if at == hm => off,
+                    _ => {
+                        let off = surface.point(hm).distance(mid.exact) > tol;
+                        mid.checked = Some((hm, off));
+                        off
+                    }
+                };
+                if off {
+                    add.push((i, tm, mid.q, mid.exact));
                 }
             }
             if add.is_empty() {
-                met = true;
-                break;
+                return true;
             }
             if self.ts.len() + add.len() > MAX_SAMPLES {
-                break;
+                return false;
             }
-            for &(i, tm, qm) in add.iter().rev() {
+            // A new sample's point is its midpoint's; the two halves' midpoints are new.
+            for &(i, tm, qm, exact) in add.iter().rev() {
                 self.ts.insert(i + 1, tm);
                 self.qs.insert(i + 1, qm);
+                points.insert(i + 1, Some(exact));
+                mids[i] = None;
+                mids.insert(i + 1, None);
             }
         }
-        let mut ws: Vec<DVec2> = self.qs.iter().map(|&q| map(q)).collect();
-        let mut ts = self.ts.clone();
-        if met {
-            (ts, ws) = coarsen(ts, ws, surface, 0.5 * tol);
-        }
-        let ms = tangents(&ts, &ws);
-        let [lo, hi] = surface.domain();
-        (hermite_curve(&ts, &ws, &ms, lo, hi), met)
+        false
     }
 
     /// On a plane, a model-space curve's native coordinates are the curve
@@ -296,7 +344,7 @@ impl Track {
     /// pieces per circle (a plate of 1000 holes held 11 MB of them). `None`
     /// when that does not apply or the result leaves the surface's domain or
     /// misses the samples (the loop then gets the fitted cubic).
-    fn exact_on_plane(&self, def: &SurfDef, maps: &[AxisMap; 2], surface: &FaceSurface) -> Option<NurbsCurve> {
+    fn exact_on_plane(&self, def: &SurfDef, maps: &[AxisMap; 2], surface: &dyn Surface) -> Option<NurbsCurve> {
         let SurfDef::Plane { .. } = def else { return None };
         if !self.model || maps.iter().any(|m| *m != AxisMap::Identity) {
             return None;
@@ -321,10 +369,33 @@ impl Track {
     }
 }
 
+/// What [`Track::refine`] found at an interval's midpoint: its native
+/// coordinates `q` (the curve's midpoint projected) and the surface's point
+/// there, and the last cubic midpoint checked against it (in the face
+/// surface's parameters) with whether it was farther than the tolerance.
+#[derive(Debug, Clone, Copy)]
+struct Mid {
+    q: DVec2,
+    exact: DVec3,
+    checked: Option<(DVec2, bool)>,
+}
+
 /// Drops samples the cubic does not need: repeatedly tries to remove every
 /// other inner sample, keeping those where the cubic through the rest
 /// passes farther than `tol` (on the surface) from the removed exact point.
-fn coarsen(mut ts: Vec<f64>, mut ws: Vec<DVec2>, surface: &FaceSurface, tol: f64) -> (Vec<f64>, Vec<DVec2>) {
+/// `points[i]` is the surface's point at `ws[i]` when already known. A
+/// sample kept because the cubic missed it is not checked again while the
+/// cubic's point there stays the same (a round that removed nothing near it).
+fn coarsen(
+    mut ts: Vec<f64>,
+    mut ws: Vec<DVec2>,
+    mut points: Vec<Option<DVec3>>,
+    surface: &dyn Surface,
+    tol: f64,
+) -> (Vec<f64>, Vec<DVec2>) {
+    points.resize(ts.len(), None);
+    // Per sample: the last cubic point checked against it and whether it was within `tol`.
+    let mut checked: Vec<Option<(DVec2, bool)>> = alloc::vec![None; ts.len()];
     loop {
         let n = ts.len();
         if n <= 2 {
@@ -347,7 +418,16 @@ fn coarsen(mut ts: Vec<f64>, mut ws: Vec<DVec2>, surface: &FaceSurface, tol: f64
                     + km[k] * (h * (s3 - 2.0 * s2 + s))
                     + kw[k + 1] * (3.0 * s2 - 2.0 * s3)
                     + km[k + 1] * (h * (s3 - s2));
-                if surface.point(hp).distance(surface.point(ws[i])) <= tol {
+                let within = match checked[i] {
+                    Some((at, within)) if at == hp => within,
+                    _ => {
+                        let exact = *points[i].get_or_insert_with(|| surface.point(ws[i]));
+                        let within = surface.point(hp).distance(exact) <= tol;
+                        checked[i] = Some((hp, within));
+                        within
+                    }
+                };
+                if within {
                     keep[i] = false;
                     removed += 1;
                 }
@@ -356,18 +436,21 @@ fn coarsen(mut ts: Vec<f64>, mut ws: Vec<DVec2>, surface: &FaceSurface, tol: f64
         if removed == 0 {
             break;
         }
-        let mut i = 0;
-        ts.retain(|_| {
-            i += 1;
-            keep[i - 1]
-        });
-        let mut j = 0;
-        ws.retain(|_| {
-            j += 1;
-            keep[j - 1]
-        });
+        retain_kept(&mut ts, &keep);
+        retain_kept(&mut ws, &keep);
+        retain_kept(&mut points, &keep);
+        retain_kept(&mut checked, &keep);
     }
     (ts, ws)
+}
+
+/// Keeps the items of `v` whose `keep` entry is true.
+fn retain_kept<T>(v: &mut Vec<T>, keep: &[bool]) {
+    let mut i = 0;
+    v.retain(|_| {
+        i += 1;
+        keep.get(i - 1).copied().unwrap_or(true)
+    });
 }
 
 /// Derivatives at the samples, shape-preserving per coordinate (Fritsch
@@ -444,4 +527,80 @@ fn hermite_curve(ts: &[f64], ws: &[DVec2], ms: &[DVec2], lo: DVec2, hi: DVec2) -
     }
     knots.push(ts[keep[keep.len() - 1]]);
     NurbsCurve::try_new(3, knots, pts, None).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nurbs::analytic::circle_arc;
+    use crate::nurbs::{Aabb, NurbsSurface, SurfaceDerivs};
+    use alloc::boxed::Box;
+    use core::cell::RefCell;
+
+    /// `s`, remembering the parameters of every point asked of it.
+    struct Seen<'a> {
+        s: &'a dyn Surface,
+        uvs: RefCell<Vec<[u64; 2]>>,
+    }
+
+    impl Surface for Seen<'_> {
+        fn domain(&self) -> [DVec2; 2] {
+            self.s.domain()
+        }
+        fn point(&self, uv: DVec2) -> DVec3 {
+            self.uvs.borrow_mut().push([uv.x.to_bits(), uv.y.to_bits()]);
+            self.s.point(uv)
+        }
+        fn derivs(&self, uv: DVec2) -> SurfaceDerivs {
+            self.s.derivs(uv)
+        }
+        fn breaks(&self, along_u: bool) -> Vec<f64> {
+            self.s.breaks(along_u)
+        }
+        fn bounding_box(&self) -> Aabb {
+            self.s.bounding_box()
+        }
+    }
+
+    /// A biquadratic bump over the square [0, 2]², 2 high in the middle.
+    fn dome() -> NurbsSurface {
+        let pts: Vec<Vec<DVec3>> = (0..3)
+            .map(|i| (0..3).map(|j| DVec3::new(i as f64, j as f64, if i == 1 && j == 1 { 2.0 } else { 0.0 })).collect())
+            .collect();
+        let k = alloc::vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0];
+        NurbsSurface::try_new([2, 2], k.clone(), k, &pts, None).unwrap()
+    }
+
+    /// Refining a fitted trim curve asks the surface for each point once
+    /// (a sample's point serves both intervals it ends, and an interval a
+    /// round leaves unchanged keeps its midpoint), and coarsening the result
+    /// asks for none of the samples' points again, nor for a cubic point
+    /// that an earlier round checked.
+    #[test]
+    fn fitting_evaluates_no_point_of_the_surface_twice() {
+        let s = dome();
+        let def = SurfDef::Nurbs { surface: s.clone(), periods: [None; 2], natural: None, facts: Box::default() };
+        let arc = circle_arc(DVec3::new(1.0, 1.0, 1.2), DVec3::X, DVec3::Y, 0.7, 0.0, 4.5).unwrap();
+        let mut tr = Track::sample(&def, arc, true, None, [None; 2]);
+        let tol = 1e-7;
+        let repeats = |seen: Seen<'_>| {
+            let mut uvs = seen.uvs.take();
+            let asked = uvs.len();
+            uvs.sort_unstable();
+            uvs.dedup();
+            (asked - uvs.len(), uvs)
+        };
+        let seen = Seen { s: &s, uvs: RefCell::default() };
+        let mut points = Vec::new();
+        assert!(tr.refine(&def, &seen, &|q| q, [None; 2], tol, &mut points));
+        assert!(tr.ts.len() > MIN_SAMPLES, "the fit refined: {} samples", tr.ts.len());
+        assert_eq!(repeats(seen).0, 0, "refining asked for a point twice");
+        let seen = Seen { s: &s, uvs: RefCell::default() };
+        let (ts, _) = coarsen(tr.ts.clone(), tr.qs.clone(), points, &seen, 0.5 * tol);
+        assert!(ts.len() < tr.ts.len(), "coarsening removed samples");
+        let (again, uvs) = repeats(seen);
+        assert_eq!(again, 0, "coarsening asked for a point twice");
+        let samples: Vec<[u64; 2]> = tr.qs.iter().map(|q| [q.x.to_bits(), q.y.to_bits()]).collect();
+        assert!(!uvs.iter().any(|uv| samples.contains(uv)), "coarsening asked for a sample's point again");
+    }
 }

@@ -17,6 +17,7 @@
 //! ends only at a quote followed by `,` or `)`), a damaged HEADER section
 //! ([`header`]). Anything else malformed is an error naming its line.
 
+use alloc::borrow::Cow;
 use alloc::format;
 use alloc::string::String;
 use alloc::vec::Vec;
@@ -34,16 +35,18 @@ pub(super) const MAX_VALUES: usize = 1 << 26;
 /// Most instances.
 pub(super) const MAX_INSTANCES: usize = 1 << 24;
 
-/// A token.
+/// A token. Keywords and enumerations are upper case: the file's own text
+/// when it is written so (as writers do), else an upper-case copy, so a
+/// token costs no allocation.
 #[derive(Debug, Clone, PartialEq)]
-enum Tok {
-    Keyword(String),
+enum Tok<'a> {
+    Keyword(Cow<'a, str>),
     Instance(u64),
     Int(i64),
     Real(f64),
     /// Decoded string: `len` bytes at the end of the graph's text.
     Str(u32, u32),
-    Enum(String),
+    Enum(Cow<'a, str>),
     Binary,
     Omitted,
     Derived,
@@ -59,7 +62,7 @@ enum Tok {
 /// `ENDSEC`"), as the file spells it rather than as the derived `Debug`
 /// (`Keyword("ENDSEC")`), which is left to tests: the wasm module no longer
 /// carries the derived formatter for these messages.
-impl core::fmt::Display for Tok {
+impl core::fmt::Display for Tok<'_> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             Self::Keyword(k) => write!(f, "the keyword `{k}`"),
@@ -124,7 +127,7 @@ impl<'a> Lexer<'a> {
         }
     }
 
-    fn next(&mut self, g: &mut Graph, id: u64) -> Result<Tok, Error> {
+    fn next(&mut self, g: &mut Graph, id: u64) -> Result<Tok<'a>, Error> {
         self.skip(id)?;
         let Some(&c) = self.b.get(self.pos) else { return Ok(Tok::End) };
         let tok = match c {
@@ -194,7 +197,7 @@ impl<'a> Lexer<'a> {
                 let name = self.take(|c| c.is_ascii_alphanumeric() || c == b'_' || c == b'-');
                 let mut k = ascii_upper(name);
                 if user {
-                    k.insert(0, '!');
+                    k.to_mut().insert(0, '!');
                 }
                 Tok::Keyword(k)
             }
@@ -218,7 +221,7 @@ impl<'a> Lexer<'a> {
         &self.b[start..self.pos]
     }
 
-    fn number(&mut self, id: u64) -> Result<Tok, Error> {
+    fn number(&mut self, id: u64) -> Result<Tok<'a>, Error> {
         let start = self.pos;
         if matches!(self.b.get(self.pos), Some(b'+' | b'-')) {
             self.pos += 1;
@@ -254,7 +257,7 @@ impl<'a> Lexer<'a> {
     }
 
     /// A string token; its decoded text is appended to `g.text`.
-    fn string(&mut self, g: &mut Graph, id: u64) -> Result<Tok, Error> {
+    fn string(&mut self, g: &mut Graph, id: u64) -> Result<Tok<'a>, Error> {
         let start_line = self.line;
         self.pos += 1;
         let mut out: Vec<u8> = Vec::new();
@@ -289,16 +292,19 @@ impl<'a> Lexer<'a> {
             }
         }
         // Raw bytes above 127 are UTF-8 where they decode as such, else ISO 8859-1 (the standard's default).
-        let text: String = match core::str::from_utf8(&out) {
-            Ok(t) => t.into(),
-            Err(_) => out.iter().map(|&b| char::from(b)).collect(),
-        };
         let start = g.text.len();
-        if start + text.len() > u32::MAX as usize / 2 {
+        let len = match core::str::from_utf8(&out) {
+            Ok(t) => t.len(),
+            Err(_) => out.iter().map(|&b| char::from(b).len_utf8()).sum(),
+        };
+        if start + len > u32::MAX as usize / 2 {
             return Err(self.error(id, "more than 2 GB of strings"));
         }
-        g.text.push_str(&text);
-        Ok(Tok::Str(start as u32, text.len() as u32))
+        match core::str::from_utf8(&out) {
+            Ok(t) => g.text.push_str(t),
+            Err(_) => g.text.extend(out.iter().map(|&b| char::from(b))),
+        }
+        Ok(Tok::Str(start as u32, len as u32))
     }
 
     /// After a quote in a string: whether the string ends there, that is
@@ -415,8 +421,13 @@ fn parse_u64(d: &[u8]) -> Option<u64> {
     Some(v)
 }
 
-fn ascii_upper(b: &[u8]) -> String {
-    b.iter().map(|c| char::from(c.to_ascii_uppercase())).collect()
+/// An ASCII word in upper case: borrowed when it already is (`b` holds
+/// only ASCII letters, digits, `_` and `-`, as the lexer takes them).
+fn ascii_upper(b: &[u8]) -> Cow<'_, str> {
+    match core::str::from_utf8(b) {
+        Ok(s) if !b.iter().any(u8::is_ascii_lowercase) => Cow::Borrowed(s),
+        _ => Cow::Owned(b.iter().map(|c| char::from(c.to_ascii_uppercase())).collect()),
+    }
 }
 
 /// Parses a whole exchange structure.
@@ -492,20 +503,18 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Graph, Error> {
 /// fail at its first one), and [`Graph::shrink`] gives back what strings'
 /// separators over-counted.
 fn presize(g: &mut Graph, bytes: &[u8]) {
+    // Branch-free sums, which the compiler vectorizes.
     let (mut ends, mut semis) = (0usize, 0usize);
     for &c in bytes {
-        match c {
-            b',' | b')' => ends += 1,
-            b';' => semis += 1,
-            _ => {}
-        }
+        ends += usize::from((c == b',') | (c == b')'));
+        semis += usize::from(c == b';');
     }
     let _ = g.values.try_reserve_exact(ends.min(bytes.len() / 4).min(MAX_VALUES));
     let _ = g.instances.try_reserve_exact(semis);
     let _ = g.parts.try_reserve_exact(semis);
 }
 
-fn expect(lx: &mut Lexer<'_>, g: &mut Graph, id: u64, want: &Tok, what: &str) -> Result<(), Error> {
+fn expect(lx: &mut Lexer<'_>, g: &mut Graph, id: u64, want: &Tok<'_>, what: &str) -> Result<(), Error> {
     let t = lx.next(g, id)?;
     if &t == want {
         Ok(())
@@ -601,17 +610,21 @@ enum Frame {
 /// Parses parameters after an opening parenthesis up to its matching
 /// closing one; returns their range in the arena.
 fn parse_params(lx: &mut Lexer<'_>, g: &mut Graph, scratch: &mut Vec<Value>, id: u64) -> Result<(u32, u32), Error> {
-    // Each open frame: its kind and where its items start in `scratch`.
-    let mut frames: Vec<(Frame, usize)> = alloc::vec![(Frame::List, scratch.len())];
+    // Each open frame: its kind and where its items start in `scratch`
+    // (`frames[..depth]`, on the stack: no allocation per instance).
+    let mut frames = [(Frame::List, 0usize); MAX_DEPTH + 1];
+    frames[0].1 = scratch.len();
+    let mut depth: usize = 1;
     let base = scratch.len();
     let mut expect_value = true; // after '(' or ','
     loop {
         let t = lx.next(g, id)?;
         match t {
             Tok::Close => {
-                let Some((frame, start)) = frames.pop() else {
+                let Some(&(frame, start)) = depth.checked_sub(1).and_then(|d| frames.get(d)) else {
                     return Err(lx.error(id, "unbalanced ')'"));
                 };
+                depth -= 1;
                 if expect_value && scratch.len() > start {
                     return Err(lx.error(id, "a value is missing before ')'"));
                 }
@@ -622,7 +635,7 @@ fn parse_params(lx: &mut Lexer<'_>, g: &mut Graph, scratch: &mut Vec<Value>, id:
                 let at = g.values.len() as u32;
                 g.values.extend_from_slice(&scratch[start..]);
                 scratch.truncate(start);
-                if frames.is_empty() {
+                if depth == 0 {
                     debug_assert_eq!(start, base);
                     return Ok((at, items as u32));
                 }
@@ -664,10 +677,11 @@ fn parse_params(lx: &mut Lexer<'_>, g: &mut Graph, scratch: &mut Vec<Value>, id:
                     }
                     _ => Frame::List,
                 };
-                if frames.len() >= MAX_DEPTH {
+                let Some(slot) = frames.get_mut(depth).filter(|_| depth < MAX_DEPTH) else {
                     return Err(lx.error(id, format!("lists nested deeper than {MAX_DEPTH}")));
-                }
-                frames.push((frame, scratch.len()));
+                };
+                *slot = (frame, scratch.len());
+                depth += 1;
                 expect_value = true;
                 continue;
             }

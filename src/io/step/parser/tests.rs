@@ -208,3 +208,22 @@ fn syntax_errors_name_the_token_as_the_file_spells_it() {
     let m = message(file("#1 FOO(1);").as_bytes());
     assert!(m.contains("found the keyword `FOO`"), "{m}");
 }
+
+#[test]
+fn keywords_borrow_the_file_and_lower_case_ones_read_the_same() {
+    assert!(matches!(ascii_upper(b"B_SPLINE_SURFACE_WITH_KNOTS"), Cow::Borrowed("B_SPLINE_SURFACE_WITH_KNOTS")));
+    assert_eq!(ascii_upper(b"Cartesian_point-2"), "CARTESIAN_POINT-2");
+    let upper =
+        parse(file("#1 = CARTESIAN_POINT('',(1.,2.,3.));\n#2 = FOO(.T.,BAR(#1),!USER(1));").as_bytes()).unwrap();
+    let lower =
+        parse(file("#1 = cartesian_point('',(1.,2.,3.));\n#2 = Foo(.t.,bar(#1),!user(1));").as_bytes()).unwrap();
+    for g in [&upper, &lower] {
+        assert_eq!(g.get(1, 0).unwrap().name(), "CARTESIAN_POINT");
+        let e = g.get(2, 0).unwrap();
+        assert_eq!(e.name(), "FOO");
+        let a = e.attrs();
+        assert!(a.boolean(0, false).unwrap());
+        assert!(matches!(a.value(1).unwrap(), Value::Typed { name, .. } if g.name(name) == "BAR"));
+        assert!(matches!(a.value(2).unwrap(), Value::Typed { name, .. } if g.name(name) == "!USER"));
+    }
+}
