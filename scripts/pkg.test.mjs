@@ -119,8 +119,11 @@ test('a fresh module holds its 256 KiB stack, not the default 1 MiB, before its 
 // brought went through the shared triple sort. Raised again when the
 // edge census learned faces' borders, sewing kept a thin wall's skins
 // apart, the trim crossing grid nested crowded cells and rebuilt faces kept
-// their grid samples: 663,835 bytes.
-const VIEWER_GZIP_BUDGET = 667_000;
+// their grid samples: 663,835 bytes. Raised when wasm's tensor-product
+// sums went to SIMD lanes (+2,584 bytes, the sums inlined into each degree's
+// evaluation) and the STEP reader kept its trim-fit points and borrowed
+// keywords (+1,893): 668,312 bytes.
+const VIEWER_GZIP_BUDGET = 670_000;
 
 test('the viewer module stays within its gzip -9 budget', () => {
   const wasm = readFileSync(join(pkg, 'node', 'surfmesh_bg.wasm'));
